@@ -1,0 +1,4 @@
+//! LLV benchmarks (to be written).
+fn main() {
+    divan::main();
+}

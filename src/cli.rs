@@ -1,0 +1,108 @@
+//! The headless command line. `vss` with no subcommand opens the console;
+//! each subcommand lives in its own file under `cli/` with its `Args` and `run`.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+pub mod convert;
+pub mod grab;
+pub mod info;
+pub mod lights;
+pub mod llv;
+pub mod params;
+pub mod report;
+pub mod selftest;
+pub mod session;
+pub mod sim;
+
+/// Options every subcommand shares.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Global {
+    /// Profile: a path to a .toml file, or a name from profiles/ (default: "default").
+    #[arg(long, global = true, value_name = "P")]
+    pub profile: Option<String>,
+}
+
+impl Global {
+    /// Loads the profile named on the command line, or `default`.
+    pub fn load_profile(&self) -> anyhow::Result<crate::profile::Profile> {
+        Ok(crate::profile::Profile::load(
+            self.profile.as_deref().unwrap_or("default"),
+        )?)
+    }
+}
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "vss",
+    version,
+    about = "Vision Survey System: the operator console of the robot welding cell",
+    long_about = "Vision Survey System: the operator console of the robot welding cell.\n\n\
+                  Without a subcommand, opens the console on the profile's cell \
+                  (the built-in simulated cell by default)."
+)]
+pub struct Cli {
+    #[command(flatten)]
+    pub global: Global,
+    /// Preview mode of the console (default: picked from TERM and NO_COLOR).
+    #[arg(long, value_name = "MODE", value_parser = ["ascii", "braille", "blocks"])]
+    pub preview: Option<String>,
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Convert images between .img and PNG, PGM, TIFF, BMP.
+    Convert(convert::Args),
+    /// Describe any cell file in a few lines.
+    Info(info::Args),
+    /// Import and export parameter files, list the LLV parameters.
+    Params(params::Args),
+    /// Run the LLV stages on images (or on saved edge files).
+    Llv(llv::Args),
+    /// Run the pipeline on synthetic scenes with known edges and report accuracy.
+    Selftest(selftest::Args),
+    /// Start the simulated grabber and relay board on pseudo-terminals.
+    Sim(sim::Args),
+    /// Capture one image under several lightings, headless.
+    Grab(grab::Args),
+    /// Switch and read the lights.
+    Lights(lights::Args),
+    /// Create, show, check and redo survey sessions.
+    Session(session::Args),
+    /// Write PostScript and SVG reports.
+    Report(report::Args),
+}
+
+/// Parses the command line and runs it; errors go to stderr as `vss: …`.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => crate::tui::run(&cli.global, cli.preview.as_deref()),
+        Some(cmd) => run(&cli.global, cmd),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("vss: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(g: &Global, cmd: Command) -> anyhow::Result<ExitCode> {
+    match cmd {
+        Command::Convert(a) => convert::run(g, a),
+        Command::Info(a) => info::run(g, a),
+        Command::Params(a) => params::run(g, a),
+        Command::Llv(a) => llv::run(g, a),
+        Command::Selftest(a) => selftest::run(g, a),
+        Command::Sim(a) => sim::run(g, a),
+        Command::Grab(a) => grab::run(g, a),
+        Command::Lights(a) => lights::run(g, a),
+        Command::Session(a) => session::run(g, a),
+        Command::Report(a) => report::run(g, a),
+    }
+}

@@ -1,0 +1,21 @@
+//! `vss` — the Vision Survey System operator console, as a library.
+//!
+//! The pieces, from the bottom up:
+//! - [`llv`]: the low-level vision core (lens correction, Lee edges, line
+//!   extraction, CONNECT, manual edits, synthetic scenes). Pure: no I/O.
+//! - [`formats`]: the cell's file formats (`.img`, `.cdf`, `.lex`/`.ldr`,
+//!   `.hpo`/`.vpo`, parameter files, `.ses`) and the VSS file-name scheme.
+//! - [`profile`]: TOML profiles (LLV parameters, hardware, lights).
+//! - [`rig`]: the frame grabber and relay-board drivers, and the simulated cell.
+//! - [`session`]: a survey on disk; [`report`]: PostScript and SVG.
+//! - [`cli`]: headless subcommands; [`tui`]: the operator console.
+
+pub mod cli;
+pub mod formats;
+pub mod fsutil;
+pub mod llv;
+pub mod profile;
+pub mod report;
+pub mod rig;
+pub mod session;
+pub mod tui;

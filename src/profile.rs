@@ -1,0 +1,249 @@
+//! TOML profiles: which cell the console talks to (grabber, relay board,
+//! lights, lighting configurations, the simulated cell's settings) and every
+//! LLV parameter. A profile is given by path or by name (`profiles/NAME.toml`).
+//!
+//! The structure is the serde schema below; loading adds the checks a person
+//! needs: unknown keys, wrong types and out-of-range values are errors naming
+//! the file, the line and the key, with the allowed range.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::llv::Params;
+
+/// A whole profile.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Profile {
+    /// A name for people: shown in the console's top bar.
+    pub name: String,
+    pub grabber: GrabberConfig,
+    pub relay: RelayConfig,
+    /// The lights: relay channel → name.
+    pub lights: Vec<Light>,
+    /// The lighting configurations a survey steps through, lettered a, b, …
+    pub lighting: Vec<Lighting>,
+    pub survey: SurveyConfig,
+    pub sim: SimConfig,
+    pub llv: Params,
+}
+
+/// Which frame grabber, and how to reach it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GrabberConfig {
+    pub kind: GrabberKind,
+    /// Serial device (ignored for the simulated grabber).
+    pub port: String,
+    pub baud: u32,
+    /// Timeout for every reply (ms).
+    pub timeout_ms: u64,
+    /// Retries of an idempotent command (READ, STATUS, HELLO, CAMERA).
+    pub retries: u32,
+    /// Bytes per READ block (at most the grabber's maxblock).
+    pub block: u32,
+}
+
+impl Default for GrabberConfig {
+    fn default() -> Self {
+        GrabberConfig {
+            kind: GrabberKind::Simulated,
+            port: String::new(),
+            baud: 921_600,
+            timeout_ms: 1000,
+            retries: 3,
+            block: 16384,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GrabberKind {
+    /// The embedded simulated grabber, reached over a real pseudo-terminal.
+    #[default]
+    Simulated,
+    /// A VSG/1 grabber on a serial port.
+    Vsg,
+}
+
+/// Which relay board switches the lights.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RelayConfig {
+    pub kind: RelayKind,
+    pub port: String,
+    pub baud: u32,
+    pub timeout_ms: u64,
+    /// Wait after switching before a freeze (ms).
+    pub settle_ms: u64,
+}
+
+impl Default for RelayConfig {
+    fn default() -> Self {
+        RelayConfig {
+            kind: RelayKind::Simulated,
+            port: String::new(),
+            baud: 19200,
+            timeout_ms: 500,
+            settle_ms: 200,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RelayKind {
+    /// The embedded simulated board (Numato protocol over a pseudo-terminal).
+    #[default]
+    Simulated,
+    /// A Numato Lab USB relay module.
+    Numato,
+    /// An LCUS / CH340 board (binary frames, no replies).
+    Lcus,
+}
+
+/// One light on a relay channel.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Light {
+    pub name: String,
+    pub relay: u32,
+    /// Where the light stands in the cell (mm, world frame); the simulated
+    /// cell lights its scene from here.
+    #[serde(default)]
+    pub position: Option<[f64; 3]>,
+}
+
+/// One lighting configuration: a letter and the lights that are on.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Lighting {
+    pub letter: char,
+    pub on: Vec<String>,
+    /// What it is for, shown to the operator.
+    #[serde(default)]
+    pub note: String,
+}
+
+/// The survey the console guides by default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SurveyConfig {
+    /// Folder where new sessions are made.
+    pub dir: PathBuf,
+    pub cameras: u32,
+    /// `.cdf` file per camera (index 0 is camera 1); relative to the profile.
+    pub cdf: Vec<PathBuf>,
+}
+
+impl Default for SurveyConfig {
+    fn default() -> Self {
+        SurveyConfig {
+            dir: PathBuf::from("sessions"),
+            cameras: 4,
+            cdf: Vec::new(),
+        }
+    }
+}
+
+/// The simulated cell.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimConfig {
+    /// Seed of the sensor noise and the scene.
+    pub seed: u64,
+    /// Sensor noise σ (grey levels).
+    pub noise: f64,
+    /// Image size of the simulated cameras.
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        SimConfig {
+            seed: 1,
+            noise: 2.0,
+            width: 512,
+            height: 512,
+        }
+    }
+}
+
+/// A profile that could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum ProfileError {
+    #[error("cannot read profile {path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("profile `{name}` not found (looked for {tried})")]
+    NotFound { name: String, tried: String },
+    #[error("{path}:{line}: {message}")]
+    Invalid {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+}
+
+impl Profile {
+    /// Parses a profile from text; `path` is only used in error messages.
+    pub fn from_toml(text: &str, path: &Path) -> Result<Profile, ProfileError> {
+        toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].lines().count().max(1))
+                .unwrap_or(0);
+            ProfileError::Invalid {
+                path: path.to_path_buf(),
+                line,
+                message: e.message().to_string(),
+            }
+        })
+    }
+
+    /// Loads a profile by path, or by name from the `profiles/` folder.
+    pub fn load(name_or_path: &str) -> Result<Profile, ProfileError> {
+        let path = resolve(name_or_path)?;
+        let text = std::fs::read_to_string(&path).map_err(|source| ProfileError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        Profile::from_toml(&text, &path)
+    }
+}
+
+/// Finds a profile: an existing path as given, else `NAME.toml` in
+/// `./profiles`, then in the `profiles/` folder beside the crate.
+pub fn resolve(name_or_path: &str) -> Result<PathBuf, ProfileError> {
+    let p = Path::new(name_or_path);
+    if p.is_file() {
+        return Ok(p.to_path_buf());
+    }
+    let file = if name_or_path.ends_with(".toml") {
+        name_or_path.to_string()
+    } else {
+        format!("{name_or_path}.toml")
+    };
+    let candidates = [
+        PathBuf::from("profiles").join(&file),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles").join(&file),
+    ];
+    for c in &candidates {
+        if c.is_file() {
+            return Ok(c.clone());
+        }
+    }
+    Err(ProfileError::NotFound {
+        name: name_or_path.to_string(),
+        tried: candidates
+            .iter()
+            .map(|c| c.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+    })
+}

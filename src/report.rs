@@ -1,0 +1,1 @@
+//! PostScript and SVG reports (to be written).

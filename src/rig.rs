@@ -1,0 +1,1 @@
+//! The cell's hardware: grabber and lights (to be written).

@@ -1,0 +1,1 @@
+//! A survey on disk (to be written).
