@@ -6,7 +6,9 @@
 //! grey image(s) ─► lens ─► edges ─► lines ─► connect ─► (edit)
 //! ```
 
+pub mod auto;
 pub mod connect;
+pub mod corners;
 pub mod edges;
 pub mod edit;
 pub mod fit;
@@ -16,6 +18,7 @@ pub mod lines;
 pub mod params;
 pub mod photometric;
 pub mod pipeline;
+pub mod shadow;
 pub mod synth;
 
 pub use image::GreyImage;
@@ -35,7 +38,9 @@ pub enum LlvError {
         actual: usize,
     },
     /// Below the smallest size the stages support.
-    #[error("image of {width} × {height} pixels is too small: the stages need at least {min} × {min}")]
+    #[error(
+        "image of {width} × {height} pixels is too small: the stages need at least {min} × {min}"
+    )]
     TooSmall {
         width: usize,
         height: usize,
@@ -43,7 +48,10 @@ pub enum LlvError {
     },
     /// Images that must share a size (lightings of one view, a lens map) do not.
     #[error("image sizes differ: {a:?} and {b:?}")]
-    SizeMismatch { a: (usize, usize), b: (usize, usize) },
+    SizeMismatch {
+        a: (usize, usize),
+        b: (usize, usize),
+    },
     /// A parameter is outside its allowed range.
     #[error("parameter {name} = {value} is out of range ({range})")]
     Param {

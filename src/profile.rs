@@ -231,7 +231,9 @@ pub fn resolve(name_or_path: &str) -> Result<PathBuf, ProfileError> {
     };
     let candidates = [
         PathBuf::from("profiles").join(&file),
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles").join(&file),
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("profiles")
+            .join(&file),
     ];
     for c in &candidates {
         if c.is_file() {

@@ -21,7 +21,7 @@ impl GreyImage {
     /// Wraps a pixel buffer; the buffer must hold exactly `width * height`
     /// bytes and neither side may be zero.
     pub fn new(width: usize, height: usize, data: Vec<u8>) -> Result<Self, LlvError> {
-        let expected = width.checked_mul(height).unwrap_or(usize::MAX);
+        let expected = width.saturating_mul(height);
         if width == 0 || height == 0 || data.len() != expected {
             return Err(LlvError::BufferSize {
                 width,

@@ -187,22 +187,166 @@ macro_rules! spec {
 
 /// Every tunable LLV parameter, in the order the console shows them.
 pub const PARAMS: &[ParamSpec] = &[
-    spec!("lens.enabled", Bool, Lens, "", 0.0, 1.0, 1.0, "apply lens correction when the camera's .cdf has distortion"),
-    spec!("edges.half_width", Int, Edges, "px", 3.0, 7.0, 1.0, "Lee kernel half-width A; wider smooths more"),
-    spec!("edges.floor", Float, Edges, "grey levels", 0.0, 255.0, 0.5, "floor threshold T: weaker peaks are never edges"),
-    spec!("edges.per_region", Int, Edges, "points", 1.0, 4096.0, 1.0, "adaptive threshold M: strongest edge points kept per region"),
-    spec!("edges.region_lines", Int, Edges, "lines", 1.0, 4096.0, 1.0, "scan lines per adaptive-threshold region"),
-    spec!("edges.noise_factor", Float, Edges, "× median", 0.5, 20.0, 0.25, "several lightings: noise level tau as a multiple of the median |response|"),
-    spec!("lines.max_gap", Int, Lines, "rows", 1.0, 20.0, 1.0, "rows a line may bridge without an edge point"),
-    spec!("lines.search_width", Float, Lines, "px", 0.5, 10.0, 0.25, "half-width of the search window around the predicted point"),
-    spec!("lines.min_length", Float, Lines, "px", 0.0, 1000.0, 1.0, "extracted segments must be longer than this"),
-    spec!("lines.min_scan_angle_deg", Float, Lines, "deg", 0.0, 45.0, 0.5, "least angle between a line and the scan direction"),
-    spec!("connect.enabled", Bool, Connect, "", 0.0, 1.0, 1.0, "run CONNECT post-processing"),
-    spec!("connect.wl", Float, Connect, "px", 0.0, 100.0, 0.5, "environment length beyond each endpoint"),
-    spec!("connect.wd", Float, Connect, "px", 0.0, 20.0, 0.25, "environment half-width to each side"),
-    spec!("connect.max_angle_deg", Float, Connect, "deg", 0.0, 45.0, 0.25, "largest direction difference that still merges"),
-    spec!("connect.min_line_length", Float, Connect, "px", 0.0, 1000.0, 1.0, "merged segments shorter than this are dropped"),
-    spec!("connect.corner_radius", Float, Connect, "px", 0.0, 50.0, 0.5, "corner closing radius; 0 is off"),
+    spec!(
+        "lens.enabled",
+        Bool,
+        Lens,
+        "",
+        0.0,
+        1.0,
+        1.0,
+        "apply lens correction when the camera's .cdf has distortion"
+    ),
+    spec!(
+        "edges.half_width",
+        Int,
+        Edges,
+        "px",
+        3.0,
+        7.0,
+        1.0,
+        "Lee kernel half-width A; wider smooths more"
+    ),
+    spec!(
+        "edges.floor",
+        Float,
+        Edges,
+        "grey levels",
+        0.0,
+        255.0,
+        0.5,
+        "floor threshold T: weaker peaks are never edges"
+    ),
+    spec!(
+        "edges.per_region",
+        Int,
+        Edges,
+        "points",
+        1.0,
+        4096.0,
+        1.0,
+        "adaptive threshold M: strongest edge points kept per region"
+    ),
+    spec!(
+        "edges.region_lines",
+        Int,
+        Edges,
+        "lines",
+        1.0,
+        4096.0,
+        1.0,
+        "scan lines per adaptive-threshold region"
+    ),
+    spec!(
+        "edges.noise_factor",
+        Float,
+        Edges,
+        "× median",
+        0.5,
+        20.0,
+        0.25,
+        "several lightings: noise level tau as a multiple of the median |response|"
+    ),
+    spec!(
+        "lines.max_gap",
+        Int,
+        Lines,
+        "rows",
+        1.0,
+        20.0,
+        1.0,
+        "rows a line may bridge without an edge point"
+    ),
+    spec!(
+        "lines.search_width",
+        Float,
+        Lines,
+        "px",
+        0.5,
+        10.0,
+        0.25,
+        "half-width of the search window around the predicted point"
+    ),
+    spec!(
+        "lines.min_length",
+        Float,
+        Lines,
+        "px",
+        0.0,
+        1000.0,
+        1.0,
+        "extracted segments must be longer than this"
+    ),
+    spec!(
+        "lines.min_scan_angle_deg",
+        Float,
+        Lines,
+        "deg",
+        0.0,
+        45.0,
+        0.5,
+        "least angle between a line and the scan direction"
+    ),
+    spec!(
+        "connect.enabled",
+        Bool,
+        Connect,
+        "",
+        0.0,
+        1.0,
+        1.0,
+        "run CONNECT post-processing"
+    ),
+    spec!(
+        "connect.wl",
+        Float,
+        Connect,
+        "px",
+        0.0,
+        100.0,
+        0.5,
+        "environment length beyond each endpoint"
+    ),
+    spec!(
+        "connect.wd",
+        Float,
+        Connect,
+        "px",
+        0.0,
+        20.0,
+        0.25,
+        "environment half-width to each side"
+    ),
+    spec!(
+        "connect.max_angle_deg",
+        Float,
+        Connect,
+        "deg",
+        0.0,
+        45.0,
+        0.25,
+        "largest direction difference that still merges"
+    ),
+    spec!(
+        "connect.min_line_length",
+        Float,
+        Connect,
+        "px",
+        0.0,
+        1000.0,
+        1.0,
+        "merged segments shorter than this are dropped"
+    ),
+    spec!(
+        "connect.corner_radius",
+        Float,
+        Connect,
+        "px",
+        0.0,
+        50.0,
+        0.5,
+        "corner closing radius; 0 is off"
+    ),
 ];
 
 /// The spec of a dotted key, if it names a parameter.
@@ -329,7 +473,9 @@ impl Params {
 /// A parameter that cannot be set as asked.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamError {
-    #[error("unknown parameter `{0}` (known: edges.per_region, lines.max_gap, … — see `vss params list`)")]
+    #[error(
+        "unknown parameter `{0}` (known: edges.per_region, lines.max_gap, … — see `vss params list`)"
+    )]
     UnknownKey(String),
     #[error("parameter {key} = {value} is out of range: allowed {range}")]
     OutOfRange {
