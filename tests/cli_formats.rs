@@ -391,3 +391,23 @@ fn params_export_of_an_unknown_set_is_a_usage_error() {
     assert_eq!(o.code, 2);
     assert!(!d.path().join("x.par").exists());
 }
+
+#[test]
+fn info_on_a_session_manifest_and_a_bom() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(
+        d.path().join("cube.toml"),
+        "[session]\nname = \"cube\"\n[[image]]\nnumber = 1\n[[image]]\nnumber = 2\n",
+    )
+    .unwrap();
+    std::fs::write(d.path().join("cam.cdf"), "\u{feff}f=A\r\n12\r\n").unwrap();
+    let o = run(&["info", "cube.toml", "cam.cdf"], d.path());
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stdout
+            .contains("session manifest (TOML): image (2), session"),
+        "{}",
+        o.stdout
+    );
+    assert!(o.stdout.contains("f=A (calibrated)"), "{}", o.stdout);
+}
