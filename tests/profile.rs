@@ -203,3 +203,21 @@ fn toml_syntax_error_names_line() {
         "{e}"
     );
 }
+
+#[test]
+fn more_cdf_files_than_cameras_is_refused_fewer_is_allowed() {
+    let text = default_text();
+    let three = text.replacen("cameras = 4 ", "cameras = 3 ", 1);
+    let e = Profile::from_toml(&three, Path::new("cell.toml"))
+        .unwrap_err()
+        .to_string();
+    let line = line_of(&text, "cdf = [");
+    assert!(
+        e.starts_with(&format!("cell.toml:{line}: key `survey.cdf`")),
+        "{e}"
+    );
+    assert!(e.contains("4 .cdf files for 3 cameras"), "{e}");
+    let five = text.replacen("cameras = 4 ", "cameras = 5 ", 1);
+    let p = Profile::from_toml(&five, Path::new("cell.toml")).unwrap();
+    assert_eq!(p.cdf_path(5), None, "camera 5 has no calibration yet");
+}

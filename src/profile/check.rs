@@ -325,11 +325,13 @@ fn check_cell(p: &Profile, cx: &Ctx<'_, '_>) -> Result<(), ProfileError> {
         1,
         64,
     )?;
-    if !p.survey.cdf.is_empty() && p.survey.cdf.len() != p.survey.cameras as usize {
+    // Fewer files than cameras is allowed (cameras not yet calibrated get no
+    // lens correction); more cannot be meant.
+    if p.survey.cdf.len() > p.survey.cameras as usize {
         return Err(cx.at(
             &[K("survey"), K("cdf")],
             format!(
-                "{} .cdf files for {} cameras; give one per camera (or none)",
+                "{} .cdf files for {} cameras; give at most one per camera, camera 1 first",
                 p.survey.cdf.len(),
                 p.survey.cameras
             ),
