@@ -411,3 +411,33 @@ fn info_on_a_session_manifest_and_a_bom() {
     );
     assert!(o.stdout.contains("f=A (calibrated)"), "{}", o.stdout);
 }
+
+#[test]
+fn info_warns_about_the_dos_name_rule_and_hides_control_characters() {
+    let d = tempfile::tempdir().unwrap();
+    write_img(&d.path().join("longname7a.img"), &sample("a\u{0}b\u{7}c")).unwrap();
+    let o = run(&["convert", "longname7a.img", "x.png"], d.path());
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let o = run(&["info", "longname7a.img", "x.png"], d.path());
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stdout
+            .contains("session \"longname\", image 7, lighting a"),
+        "{}",
+        o.stdout
+    );
+    assert!(o.stdout.contains("at most 8"), "{}", o.stdout);
+    assert_eq!(
+        o.stdout.matches("comment: \"abc\"").count(),
+        2,
+        "{}",
+        o.stdout
+    );
+    // The comment with its control characters still travels exactly.
+    let o = run(&["convert", "x.png", "back.img"], d.path());
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert_eq!(
+        std::fs::read(d.path().join("back.img")).unwrap(),
+        std::fs::read(d.path().join("longname7a.img")).unwrap()
+    );
+}
