@@ -221,3 +221,15 @@ fn more_cdf_files_than_cameras_is_refused_fewer_is_allowed() {
     let p = Profile::from_toml(&five, Path::new("cell.toml")).unwrap();
     assert_eq!(p.cdf_path(5), None, "camera 5 has no calibration yet");
 }
+
+#[test]
+fn profiles_survive_to_toml_and_back() {
+    for name in ["default.toml", "real-cell.toml"] {
+        let mut p = Profile::load(profiles_dir().join(name).to_str().unwrap()).unwrap();
+        p.lights[0].position = None;
+        let text = p.to_toml().unwrap();
+        let mut q = Profile::from_toml(&text, Path::new("x.toml")).unwrap();
+        q.source = p.source.clone();
+        assert_eq!(q, p, "{name}");
+    }
+}
