@@ -149,7 +149,24 @@ fn wrong_types_name_line_key_and_range() {
         "llv.lens.enabled",
         &["true or false"],
     );
-    assert_names("baud = 921600", "baud = \"fast\"", "grabber.baud", &[]);
+    assert_names(
+        "baud = 921600",
+        "baud = \"fast\"",
+        "grabber.baud",
+        &["50 to 4000000"],
+    );
+    assert_names(
+        "relay = 2\n",
+        "relay = \"two\"\n",
+        "lights[2].relay",
+        &["0 to 15"],
+    );
+    assert_names(
+        "kind = \"simulated\"    # \"simulated\", \"numato\"",
+        "kind = \"usb\"    # \"simulated\", \"numato\"",
+        "relay.kind",
+        &["`numato`, `lcus`"],
+    );
 }
 
 #[test]
