@@ -16,7 +16,10 @@ pub mod lock;
 pub mod manifest;
 pub mod outputs;
 pub mod progress;
+pub mod reporting;
 pub mod stamp;
+#[doc(hidden)]
+pub mod torture;
 
 use std::fs;
 use std::path::{Path, PathBuf};
