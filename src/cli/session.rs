@@ -4,6 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use anyhow::Context as _;
+
 use super::Global;
 use crate::profile::Profile;
 use crate::session::{OutputState, Session};
@@ -257,6 +259,9 @@ fn redo(g: &Global, dir: &Path, k: u32, from: &str, take_over: bool) -> anyhow::
     } else {
         Session::open(dir)?
     };
-    let _ = (&mut s, stage, &profile.llv, k);
-    anyhow::bail!("redo needs the LLV pipeline, which this build does not have yet")
+    let summary = s
+        .redo(k, stage, &profile.llv)
+        .with_context(|| format!("redo image {k} of {}", dir.display()))?;
+    println!("{summary}");
+    Ok(ExitCode::SUCCESS)
 }
