@@ -133,7 +133,12 @@ impl Session {
             path: dir.clone(),
             source,
         })?;
-        let lock = Lock::acquire(&dir.join(format!("{name}.lock")), false)?;
+        // No manifest yet: a lock left by a creator that died can go.
+        let lock_path = dir.join(format!("{name}.lock"));
+        let lock = match Lock::acquire(&lock_path, false) {
+            Err(SessionError::Locked { stale: true, .. }) => Lock::acquire(&lock_path, true)?,
+            other => other?,
+        };
         let now = stamp::now_rfc3339();
         let mut lighting: Vec<LightingInfo> = profile
             .lighting

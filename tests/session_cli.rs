@@ -22,9 +22,15 @@ fn text(o: &Output) -> String {
 
 const PROFILE: &str = r#"
 name = "two lights"
+[[lights]]
+name = "left"
+relay = 0
+[[lights]]
+name = "right"
+relay = 1
 [survey]
 cameras = 2
-cdf = ["cam1.cdf"]
+cdf = ["cam1.cdf", "cam2.cdf"]
 [[lighting]]
 letter = "a"
 on = ["left"]
@@ -65,6 +71,7 @@ fn new_show_check_and_bad_names() {
         "camera 1's cdf copied for image 1"
     );
     assert!(!d.join("cube/cube2.cdf").exists());
+    assert!(text(&o).contains("cam2.cdf not found"), "{}", text(&o));
     assert_eq!(
         std::fs::read_to_string(d.join("cube/cube.ses")).unwrap(),
         "2\n2\n2\n"

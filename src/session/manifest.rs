@@ -86,7 +86,7 @@ pub struct ImageRecord {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub outputs: Option<OutputRecord>,
     /// Manual line edits since the outputs were made, oldest first.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub edit: Vec<EditRecord>,
 }
 
