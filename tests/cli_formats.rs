@@ -391,3 +391,53 @@ fn params_export_of_an_unknown_set_is_a_usage_error() {
     assert_eq!(o.code, 2);
     assert!(!d.path().join("x.par").exists());
 }
+
+#[test]
+fn info_on_a_session_manifest_and_a_bom() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(
+        d.path().join("cube.toml"),
+        "[session]\nname = \"cube\"\n[[image]]\nnumber = 1\n[[image]]\nnumber = 2\n",
+    )
+    .unwrap();
+    std::fs::write(d.path().join("cam.cdf"), "\u{feff}f=A\r\n12\r\n").unwrap();
+    let o = run(&["info", "cube.toml", "cam.cdf"], d.path());
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stdout
+            .contains("session manifest (TOML): image (2), session"),
+        "{}",
+        o.stdout
+    );
+    assert!(o.stdout.contains("f=A (calibrated)"), "{}", o.stdout);
+}
+
+#[test]
+fn info_warns_about_the_dos_name_rule_and_hides_control_characters() {
+    let d = tempfile::tempdir().unwrap();
+    write_img(&d.path().join("longname7a.img"), &sample("a\u{0}b\u{7}c")).unwrap();
+    let o = run(&["convert", "longname7a.img", "x.png"], d.path());
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let o = run(&["info", "longname7a.img", "x.png"], d.path());
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stdout
+            .contains("session \"longname\", image 7, lighting a"),
+        "{}",
+        o.stdout
+    );
+    assert!(o.stdout.contains("at most 8"), "{}", o.stdout);
+    assert_eq!(
+        o.stdout.matches("comment: \"abc\"").count(),
+        2,
+        "{}",
+        o.stdout
+    );
+    // The comment with its control characters still travels exactly.
+    let o = run(&["convert", "x.png", "back.img"], d.path());
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert_eq!(
+        std::fs::read(d.path().join("back.img")).unwrap(),
+        std::fs::read(d.path().join("longname7a.img")).unwrap()
+    );
+}

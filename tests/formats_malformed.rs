@@ -488,3 +488,101 @@ fn png_claiming_a_huge_image_is_refused_before_allocating() {
     let e = imageio::decode_any(&out, imageio::ImageKind::Png, Path::new("big.png")).unwrap_err();
     assert_eq!(e.kind, K::Range, "{e}");
 }
+
+mod never_panic {
+    //! Any bytes, and valid files with bytes changed, give a value or an
+    //! error — never a panic.
+    use super::*;
+    use proptest::prelude::*;
+
+    fn all_parsers(bytes: &[u8]) {
+        let p = Path::new("x");
+        let _ = img::parse_img(bytes, p);
+        let _ = edgefile::parse_edges(bytes, p);
+        for k in [
+            imageio::ImageKind::Png,
+            imageio::ImageKind::Pgm,
+            imageio::ImageKind::Tiff,
+            imageio::ImageKind::Bmp,
+        ] {
+            let _ = imageio::decode_any(bytes, k, p);
+        }
+        let text = String::from_utf8_lossy(bytes);
+        let _ = cdf::parse_cdf(&text, p);
+        let _ = lines::parse_lines(&text, p);
+        let _ = par::parse_par(&text, p);
+        let _ = par::import_params(&text, p, &vss::llv::Params::default());
+        let _ = ses::parse_ses(&text, p);
+        let _ = vss::profile::Profile::from_toml(&text, p);
+        let _ = vss::formats::names::VssFile::parse(&text);
+        let _ = vss::formats::names::SessionName::new(&text);
+    }
+
+    fn valid_files() -> Vec<Vec<u8>> {
+        let f = img::ImgFile {
+            image: vss::llv::GreyImage::new(6, 5, (0..30).collect()).unwrap(),
+            comment: "cube1a".into(),
+            x0: 1,
+            y0: 2,
+        };
+        let e = vss::llv::EdgePoints {
+            dir: Some(vss::llv::ScanDir::Vertical),
+            width: 6,
+            height: 5,
+            points: vec![
+                vss::llv::EdgePoint {
+                    x: 1.0,
+                    y: 2.0,
+                    response: 3.0
+                };
+                3
+            ],
+        };
+        let mut v = vec![
+            img::encode_img(&f).unwrap(),
+            edgefile::encode_edges(&e),
+            CDF_OK.as_bytes().to_vec(),
+            LEX_OK.as_bytes().to_vec(),
+            PAR_OK.as_bytes().to_vec(),
+            b"4\n2\n5\n".to_vec(),
+            std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/default.toml"))
+                .unwrap(),
+        ];
+        for k in [
+            imageio::ImageKind::Png,
+            imageio::ImageKind::Pgm,
+            imageio::ImageKind::Tiff,
+            imageio::ImageKind::Bmp,
+        ] {
+            v.push(imageio::encode_any(&f, k).unwrap());
+        }
+        v
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+
+        #[test]
+        fn any_bytes(bytes in proptest::collection::vec(any::<u8>(), 0..300)) {
+            all_parsers(&bytes);
+        }
+
+        #[test]
+        fn valid_files_with_bytes_changed(
+            which in 0usize..11,
+            edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..6),
+            cut in proptest::option::of(any::<prop::sample::Index>()),
+        ) {
+            let files = valid_files();
+            let mut b = files[which % files.len()].clone();
+            for (i, v) in edits {
+                let i = i.index(b.len());
+                b[i] = v;
+            }
+            if let Some(c) = cut {
+                b.truncate(c.index(b.len() + 1));
+            }
+            all_parsers(&b);
+        }
+    }
+}

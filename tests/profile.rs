@@ -149,7 +149,24 @@ fn wrong_types_name_line_key_and_range() {
         "llv.lens.enabled",
         &["true or false"],
     );
-    assert_names("baud = 921600", "baud = \"fast\"", "grabber.baud", &[]);
+    assert_names(
+        "baud = 921600",
+        "baud = \"fast\"",
+        "grabber.baud",
+        &["50 to 4000000"],
+    );
+    assert_names(
+        "relay = 2\n",
+        "relay = \"two\"\n",
+        "lights[2].relay",
+        &["0 to 15"],
+    );
+    assert_names(
+        "kind = \"simulated\"    # \"simulated\", \"numato\"",
+        "kind = \"usb\"    # \"simulated\", \"numato\"",
+        "relay.kind",
+        &["`numato`, `lcus`"],
+    );
 }
 
 #[test]
@@ -202,4 +219,34 @@ fn toml_syntax_error_names_line() {
         e.to_string().starts_with(&format!("cell.toml:{line}: ")),
         "{e}"
     );
+}
+
+#[test]
+fn more_cdf_files_than_cameras_is_refused_fewer_is_allowed() {
+    let text = default_text();
+    let three = text.replacen("cameras = 4 ", "cameras = 3 ", 1);
+    let e = Profile::from_toml(&three, Path::new("cell.toml"))
+        .unwrap_err()
+        .to_string();
+    let line = line_of(&text, "cdf = [");
+    assert!(
+        e.starts_with(&format!("cell.toml:{line}: key `survey.cdf`")),
+        "{e}"
+    );
+    assert!(e.contains("4 .cdf files for 3 cameras"), "{e}");
+    let five = text.replacen("cameras = 4 ", "cameras = 5 ", 1);
+    let p = Profile::from_toml(&five, Path::new("cell.toml")).unwrap();
+    assert_eq!(p.cdf_path(5), None, "camera 5 has no calibration yet");
+}
+
+#[test]
+fn profiles_survive_to_toml_and_back() {
+    for name in ["default.toml", "real-cell.toml"] {
+        let mut p = Profile::load(profiles_dir().join(name).to_str().unwrap()).unwrap();
+        p.lights[0].position = None;
+        let text = p.to_toml().unwrap();
+        let mut q = Profile::from_toml(&text, Path::new("x.toml")).unwrap();
+        q.source = p.source.clone();
+        assert_eq!(q, p, "{name}");
+    }
 }

@@ -220,8 +220,23 @@ pub fn describe(path: &Path) -> anyhow::Result<String> {
         "toml" => {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| anyhow::anyhow!("{shown}: cannot read: {e}"))?;
-            let p = Profile::from_toml(&text, path)?;
-            profile_lines(&mut s, &shown, &p)?;
+            match Profile::from_toml(&text, path) {
+                Ok(p) => profile_lines(&mut s, &shown, &p)?,
+                // A session's manifest is TOML too; describe its shape.
+                Err(e) => match toml::from_str::<toml::Table>(&text) {
+                    Ok(t) if t.contains_key("session") && !t.contains_key("llv") => {
+                        let parts: Vec<String> = t
+                            .iter()
+                            .map(|(k, v)| match v {
+                                toml::Value::Array(a) => format!("{k} ({})", a.len()),
+                                _ => k.clone(),
+                            })
+                            .collect();
+                        writeln!(s, "{shown}: session manifest (TOML): {}", parts.join(", "))?;
+                    }
+                    _ => return Err(e.into()),
+                },
+            }
         }
         _ => anyhow::bail!(
             "{shown}: unknown kind of file; vss describes .img .imc .png .pgm .tif .bmp .cdf .lex .ldr .hpo .vpo .par .ses .toml"

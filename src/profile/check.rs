@@ -150,6 +150,8 @@ pub(crate) fn parse_checked(text: &str, path: &Path) -> Result<Profile, ProfileE
                     unit(sp.unit),
                     sp.doc
                 ));
+            } else if let Some(h) = cell_hint(k) {
+                msg.push_str(&format!("; allowed {h}"));
             }
             msg = format!("key `{k}`: {msg}");
         }
@@ -159,6 +161,41 @@ pub(crate) fn parse_checked(text: &str, path: &Path) -> Result<Profile, ProfileE
     check_params(&prof, &cx)?;
     check_cell(&prof, &cx)?;
     Ok(prof)
+}
+
+/// What a cell key allows, for type errors (the ranges [`check_cell`]
+/// enforces).
+fn cell_hint(key: &str) -> Option<&'static str> {
+    // `lights[2].relay` → `lights.relay`
+    let mut k = String::with_capacity(key.len());
+    let mut skip = false;
+    for c in key.chars() {
+        match c {
+            '[' => skip = true,
+            ']' => skip = false,
+            _ if !skip => k.push(c),
+            _ => {}
+        }
+    }
+    Some(match k.as_str() {
+        "name" | "lights.name" | "lighting.note" | "grabber.port" | "relay.port" => "a string",
+        "grabber.baud" | "relay.baud" => "a whole number, 50 to 4000000 (bits/s)",
+        "grabber.timeout_ms" | "relay.timeout_ms" => "a whole number, 1 to 600000 (ms)",
+        "grabber.retries" => "a whole number, 0 to 100",
+        "grabber.block" => "a whole number, 1 to 65536 (bytes)",
+        "relay.settle_ms" => "a whole number, 0 to 60000 (ms)",
+        "lights.relay" => "a whole number, 0 to 15",
+        "lights.position" => "three numbers [x, y, z] (mm)",
+        "lighting.letter" => "one letter: a, b, c… in order",
+        "lighting.on" => "a list of light names, e.g. [\"left-front\"]",
+        "survey.dir" => "a folder name",
+        "survey.cameras" => "a whole number, 1 to 64",
+        "survey.cdf" => "a list of .cdf file names, camera 1 first",
+        "sim.seed" => "a whole number, 0 or more",
+        "sim.noise" => "a number, 0 to 100 (grey levels)",
+        "sim.width" | "sim.height" => "a whole number, 16 to 4096 (px)",
+        _ => return None,
+    })
 }
 
 fn unit(u: &str) -> String {
@@ -325,11 +362,13 @@ fn check_cell(p: &Profile, cx: &Ctx<'_, '_>) -> Result<(), ProfileError> {
         1,
         64,
     )?;
-    if !p.survey.cdf.is_empty() && p.survey.cdf.len() != p.survey.cameras as usize {
+    // Fewer files than cameras is allowed (cameras not yet calibrated get no
+    // lens correction); more cannot be meant.
+    if p.survey.cdf.len() > p.survey.cameras as usize {
         return Err(cx.at(
             &[K("survey"), K("cdf")],
             format!(
-                "{} .cdf files for {} cameras; give one per camera (or none)",
+                "{} .cdf files for {} cameras; give at most one per camera, camera 1 first",
                 p.survey.cdf.len(),
                 p.survey.cameras
             ),
