@@ -75,7 +75,11 @@ pub enum SessionError {
         /// The holder is on another host: can be taken over, with care.
         foreign: bool,
     },
-    #[error("{}:{line}: {message}; the manifest was left as it is: fix it by hand or restore it", path.display())]
+    #[error(
+        "{}{}: {message}; the manifest was left as it is: fix it by hand or restore it",
+        path.display(),
+        if *line > 0 { format!(":{line}") } else { String::new() }
+    )]
     Manifest {
         path: PathBuf,
         line: usize,
