@@ -145,3 +145,69 @@ fn nonsense_manifest_is_reported_and_not_overwritten() {
         );
     }
 }
+
+#[test]
+fn lock_names_a_live_holder_and_yields_only_when_it_is_gone() {
+    use std::io::{BufRead, BufReader};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("p.toml"), PROFILE).unwrap();
+    assert!(
+        vss(
+            &[
+                "session",
+                "new",
+                "held",
+                "--dir",
+                ".",
+                "--profile",
+                "p.toml"
+            ],
+            d
+        )
+        .status
+        .success()
+    );
+    // A console (here the saving test helper) holds the session.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_vss"))
+        .args(["session", "torture", "held", "--limit", "1000000"])
+        .current_dir(d)
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    out.read_line(&mut line).unwrap();
+    assert_eq!(line.trim(), "ready");
+    let pid = child.id();
+    for args in [
+        &["session", "redo", "held", "--image", "1"][..],
+        &["session", "redo", "held", "--image", "1", "--take-over"][..],
+    ] {
+        let o = vss(args, d);
+        assert!(!o.status.success(), "{args:?}");
+        let t = text(&o);
+        assert!(
+            t.contains("in use") && t.contains(&format!("process {pid}")),
+            "{args:?}: {t}"
+        );
+        assert!(t.contains("close that console"), "{t}");
+    }
+    // show works read-only and names the holder.
+    let t = text(&vss(&["session", "show", "held"], d));
+    assert!(t.contains(&format!("in use by process {pid}")), "{t}");
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let o = vss(&["session", "redo", "held", "--image", "1"], d);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("--take-over"), "{}", text(&o));
+    let t = text(&vss(&["session", "show", "held"], d));
+    assert!(t.contains("stale lock"), "{t}");
+    // Taken over: the redo itself then needs a captured image 1 (or says so).
+    let o = vss(
+        &["session", "redo", "held", "--image", "3", "--take-over"],
+        d,
+    );
+    assert!(!text(&o).contains("in use"), "{}", text(&o));
+    assert!(vss(&["session", "check", "held"], d).status.success());
+}
