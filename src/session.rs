@@ -224,7 +224,19 @@ impl Session {
     }
 
     fn open_with(dir: &Path, lock: Option<bool>) -> Result<Session, SessionError> {
-        let dir = dir.to_path_buf();
+        // Naming the manifest (or the .ses) means its folder.
+        let is_session_file =
+            dir.is_file() && dir.extension().is_some_and(|e| e == "toml" || e == "ses");
+        let dir = match dir.parent() {
+            Some(p) if is_session_file => {
+                if p.as_os_str().is_empty() {
+                    PathBuf::from(".")
+                } else {
+                    p.to_path_buf()
+                }
+            }
+            _ => dir.to_path_buf(),
+        };
         let dir_name = dir
             .canonicalize()
             .ok()

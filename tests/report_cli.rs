@@ -177,4 +177,8 @@ fn session_report_has_every_image() {
         return;
     }
     assert_eq!(gs::render(&dir.path().join("all.ps"), "a4", 36).len(), 4);
+    assert_eq!(
+        gs::render(&dir.path().join("cube.ps"), "letter", 36).len(),
+        4
+    );
 }

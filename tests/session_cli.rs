@@ -86,6 +86,12 @@ fn new_show_check_and_bad_names() {
 
     let o = vss(&["session", "check", "cube"], d);
     assert!(o.status.success(), "{}", text(&o));
+    let o = vss(&["session", "check", "cube/cube.toml"], d);
+    assert!(
+        o.status.success(),
+        "the manifest's path names its session: {}",
+        text(&o)
+    );
 
     // A file the manifest names goes missing: check fails and says which.
     std::fs::remove_file(d.join("cube/cube1.cdf")).unwrap();
