@@ -13,7 +13,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::connect::{ConnectScratch, connect_into};
-use super::edges::{PeakScratch, Response, peaks_into, response_into};
+use super::edges::{PeakScratch, Response, ResponseScratch, peaks_into, response_into};
 use super::image::GreyImage;
 use super::lens::{LensMap, correct_into};
 use super::lines::{LineScratch, extract_into};
@@ -81,7 +81,7 @@ impl<'a> Input<'a> {
 pub struct Workspace {
     out: StageOutputs,
     ambient_corrected: GreyImage,
-    mask_counts: Vec<u32>,
+    response: ResponseScratch,
     peaks: PeakScratch,
     lines: LineScratch,
     connect: ConnectScratch,
@@ -241,14 +241,14 @@ impl Workspace {
                 ScanDir::Horizontal,
                 a,
                 &mut self.out.response_h,
-                &mut self.mask_counts,
+                &mut self.response,
             )?;
             response_into(
                 img,
                 ScanDir::Vertical,
                 a,
                 &mut self.out.response_v,
-                &mut self.mask_counts,
+                &mut self.response,
             )?;
         } else {
             let ep = &self.out.params.edges;
