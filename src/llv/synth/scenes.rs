@@ -175,7 +175,7 @@ pub fn cell_lights() -> Vec<PointLight> {
     .iter()
     .map(|&(x, y)| PointLight {
         position: [x, y, 800.0],
-        intensity: 0.5,
+        intensity: 0.6,
     })
     .collect()
 }
