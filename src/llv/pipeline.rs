@@ -310,6 +310,37 @@ fn check_input(input: &Input) -> Result<(usize, usize), LlvError> {
     Ok(size)
 }
 
+/// Line extraction and CONNECT from saved edge points alone (`vss llv
+/// --from-edges`): the outputs have no images or responses.
+pub fn lines_from_edges(edges_h: EdgePoints, edges_v: EdgePoints, p: &Params) -> StageOutputs {
+    let mut ws = Workspace::new();
+    ws.out.edges_h = edges_h;
+    ws.out.edges_v = edges_v;
+    ws.out.params = p.clone();
+    let t = Instant::now();
+    extract_into(
+        &ws.out.edges_h,
+        &p.lines,
+        &mut ws.out.lines_raw,
+        &mut ws.lines,
+    );
+    extract_into(&ws.out.edges_v, &p.lines, &mut ws.tmp, &mut ws.lines);
+    ws.out.lines_raw.extend_from_slice(&ws.tmp);
+    ws.out.timings.lines_us = micros(t);
+    let t = Instant::now();
+    connect_into(
+        &ws.out.lines_raw,
+        &p.connect,
+        &mut ws.out.lines,
+        &mut ws.connect,
+    );
+    if p.connect.corner_radius > 0.0 {
+        crate::llv::corners::close_corners(&mut ws.out.lines, p.connect.corner_radius);
+    }
+    ws.out.timings.connect_us = micros(t);
+    ws.take_outputs()
+}
+
 /// Runs the whole pipeline once (a fresh [`Workspace`]).
 pub fn run(input: &Input, p: &Params) -> Result<StageOutputs, LlvError> {
     let mut ws = Workspace::new();
