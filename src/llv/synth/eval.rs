@@ -14,7 +14,9 @@ use super::straight::Straightness;
 use super::{Camera, PointLight, RenderOptions, Scene};
 use crate::llv::lens::LensMap;
 use crate::llv::pipeline::{self, Input};
-use crate::llv::{EdgePoints, GreyImage, LlvError, Params, Point, Segment, connect, lines};
+use crate::llv::{
+    EdgePoints, GreyImage, LlvError, Params, Point, Segment, connect, corners, lines,
+};
 
 /// What to evaluate.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -194,15 +196,21 @@ fn run_one(
 }
 
 /// Lines from edge points rounded to whole pixels: what the pipeline would
-/// give without the subpixel step (llv.md §2.4).
+/// give without the subpixel step (llv.md §2.4): extraction, CONNECT and
+/// corner closing as in `pipeline::run`.
 pub fn whole_pixel_lines(h: &EdgePoints, v: &EdgePoints, params: &Params) -> Vec<Segment> {
     let mut raw = lines::extract(&round_points(h), &params.lines);
     raw.extend(lines::extract(&round_points(v), &params.lines));
-    if params.connect.enabled {
+    // The same stages after the edges as `pipeline::run`.
+    let mut out = if params.connect.enabled {
         connect::connect(&raw, &params.connect)
     } else {
         raw
+    };
+    if params.connect.corner_radius > 0.0 {
+        corners::close_corners(&mut out, params.connect.corner_radius);
     }
+    out
 }
 
 /// The edge points with their positions rounded to whole pixels.
