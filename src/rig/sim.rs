@@ -78,6 +78,11 @@ pub struct SimOptions {
 }
 
 impl SimOptions {
+    /// The standard simulated cell at this image size, without faults.
+    pub fn new(width: u32, height: u32) -> SimOptions {
+        SimOptions::from_profile(&cell_profile(width, height))
+    }
+
     /// The simulated cell a profile describes: its image size, noise, seed
     /// and lights (a light without a position gets one of the default
     /// positions, so every profile has a lit scene).
