@@ -176,3 +176,47 @@ fn a_hopeless_line_ends_in_a_clear_error_not_a_hang() {
     }
     assert!(took < Duration::from_secs(45), "{took:?}");
 }
+
+#[test]
+fn reconnect_reopens_the_same_port_name_when_the_device_is_back() {
+    use vss::rig::grabber::{ClientConfig, FrameGrabber, VsgClient};
+    use vss::rig::sim::{SimCell, SimOptions};
+    let tmp = tempfile::tempdir().expect("tmp");
+    let link = tmp.path().join("ttyVSG0");
+    let mut o = SimOptions::new(64, 64);
+    o.faults = Faults::parse("unplug-after=3000").expect("spec");
+    let mut sim = SimCell::start(o).expect("sim");
+    sim.link_grabber(&link).expect("link");
+    let name = link.to_string_lossy().into_owned();
+    let cfg = ClientConfig {
+        timeout: std::time::Duration::from_millis(500),
+        retries: 2,
+        block: 1024,
+    };
+    let r = within(Duration::from_secs(30), move || {
+        let mut g = VsgClient::open(&name, 921_600, cfg).expect("open by link");
+        let f = g.freeze().expect("freeze");
+        let e = g
+            .transfer(&mut |_, _| true)
+            .expect_err("unplugged mid-frame");
+        assert!(e.is_vanished() && e.to_string().contains(&name), "{e}");
+        // Still gone (the name went with it): reconnect says so, naming it.
+        while sim.grabber_plugged() {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        assert!(
+            !std::path::Path::new(&name).exists(),
+            "the device name is gone"
+        );
+        let gone = g.reconnect().expect_err("device is away");
+        assert!(gone.to_string().contains(&name), "{gone}");
+        // Back (power-cycled) under the same name: reopen, freeze again.
+        sim.replug_grabber().expect("replug");
+        g.reconnect().expect("reconnect");
+        let f2 = g.freeze().expect("freeze");
+        let img = g.transfer(&mut |_, _| true).expect("transfer");
+        (f, f2, crc32(img.data()))
+    });
+    let (_, f2, crc) = r;
+    assert_eq!(crc, f2.crc);
+}
