@@ -17,7 +17,9 @@ fn profile() -> Profile {
     let mut p = cell_profile(128, 128);
     p.sim.noise = 0.0;
     p.relay.settle_ms = 0;
-    p.grabber.timeout_ms = 1000;
+    // Short enough that recovering from a dropped byte is quick, long
+    // enough for a loaded machine.
+    p.grabber.timeout_ms = 400;
     p.grabber.retries = 3;
     // Four blocks per frame, so faults can strike mid-frame.
     p.grabber.block = 4096;
@@ -60,12 +62,16 @@ fn try_faulty(spec: &str) -> (Result<(Capture, Cell), RigError>, Duration) {
 
 /// Like [`try_faulty`] for faults the cell must get through to a capture.
 fn faulty(spec: &str) -> (Result<Capture, RigError>, Duration, Cell) {
+    faulty_with(spec, profile())
+}
+
+fn faulty_with(spec: &str, p: Profile) -> (Result<Capture, RigError>, Duration, Cell) {
     let faults = Faults::parse(spec).expect("fault spec");
     let spec = spec.to_string();
     within(Duration::from_secs(60), move || {
         let t = Instant::now();
-        let mut cell = Cell::open_with_faults(&profile(), faults)
-            .unwrap_or_else(|e| panic!("{spec}: open: {e}"));
+        let mut cell =
+            Cell::open_with_faults(&p, faults).unwrap_or_else(|e| panic!("{spec}: open: {e}"));
         let r = capture(&mut cell);
         (r, t.elapsed(), cell)
     })
@@ -115,7 +121,11 @@ fn drops_and_corruption_together() {
 #[test]
 fn a_two_second_stall_is_ridden_out() {
     let want = reference();
-    let (r, took, cell) = faulty("stall=2s");
+    // The profile's default reply timeout: a 2 s stall outlasts one wait
+    // but not the retries.
+    let mut p = profile();
+    p.grabber.timeout_ms = 1000;
+    let (r, took, cell) = faulty_with("stall=2s", p);
     assert_good("stall", &r, &want);
     assert!(
         took >= Duration::from_secs(1),
