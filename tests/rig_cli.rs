@@ -272,3 +272,65 @@ fn grab_refuses_a_bad_session_name() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("session name"));
     assert!(!tmp.path().join("bad name!").exists());
 }
+
+#[test]
+fn ctrl_c_cancels_a_transfer_and_saves_nothing_of_it() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let mut p = base();
+    p.grabber.block = 4096;
+    let prof = write_profile(tmp.path(), "p.toml", &p);
+    let session = tmp.path().join("s/can");
+    // The stall holds the first frame mid-transfer long enough to press Ctrl-C.
+    let mut child = vss()
+        .arg("--profile")
+        .arg(&prof)
+        .args([
+            "grab",
+            "--camera",
+            "1",
+            "--lighting",
+            "a,b",
+            "--image",
+            "1",
+            "--session",
+        ])
+        .arg(&session)
+        .args(["--sim-faults", "stall=3s"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start grab");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !session.exists() && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(1200));
+    let pid = child.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args(["-INT", &pid])
+            .status()
+            .is_ok_and(|s| s.success())
+    );
+    let t = Instant::now();
+    let status = loop {
+        if let Ok(Some(st)) = child.try_wait() {
+            break st;
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(10),
+            "grab did not end after Ctrl-C"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = std::io::Read::read_to_string(&mut e, &mut err);
+    }
+    assert!(!status.success());
+    assert!(
+        err.contains("cancelled") && err.contains("nothing"),
+        "{err}"
+    );
+    assert!(imgs(&session).is_empty(), "{:?}", imgs(&session));
+}
