@@ -39,10 +39,15 @@ struct SimProcess {
 
 impl SimProcess {
     fn start(profile: &Path) -> SimProcess {
+        Self::start_with(profile, &[])
+    }
+
+    fn start_with(profile: &Path, args: &[&str]) -> SimProcess {
         let mut child = vss()
             .arg("--profile")
             .arg(profile)
             .arg("sim")
+            .args(args)
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
@@ -333,4 +338,67 @@ fn ctrl_c_cancels_a_transfer_and_saves_nothing_of_it() {
         "{err}"
     );
     assert!(imgs(&session).is_empty(), "{:?}", imgs(&session));
+}
+
+#[test]
+fn a_grabber_pulled_and_plugged_back_is_found_under_its_name() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let sim_profile = write_profile(tmp.path(), "sim.toml", &base());
+    let link = tmp.path().join("ttyVSG0");
+    let link_s = link.to_string_lossy().into_owned();
+    let sim = SimProcess::start_with(
+        &sim_profile,
+        &[
+            "--faults",
+            "unplug-after=20000",
+            "--link",
+            &link_s,
+            "--replug-after",
+            "0.3",
+        ],
+    );
+    let mut p = base();
+    p.grabber.kind = GrabberKind::Vsg;
+    p.grabber.port = link_s.clone();
+    p.relay.kind = RelayKind::Numato;
+    p.relay.port = sim.relay.clone();
+    let prof = write_profile(tmp.path(), "cell.toml", &p);
+    let session = tmp.path().join("s/plug");
+    let grab = |letters: &str| {
+        vss()
+            .arg("--profile")
+            .arg(&prof)
+            .args([
+                "grab",
+                "--camera",
+                "1",
+                "--lighting",
+                letters,
+                "--image",
+                "1",
+                "--session",
+            ])
+            .arg(&session)
+            .output()
+            .expect("run grab")
+    };
+    // The cable is pulled during the second frame: the first is kept.
+    let out = grab("a,b");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains(&link_s) && err.contains("vanished"), "{err}");
+    assert_eq!(imgs(&session), ["plug1a.img"]);
+    // Back under the same name: the same profile works again.
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !link.exists() && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let out = grab("b");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(imgs(&session), ["plug1a.img", "plug1b.img"]);
+    sim.stop();
 }
