@@ -269,6 +269,43 @@ fn faults_never_leave_a_corrupt_image_on_disk() {
 }
 
 #[test]
+fn grab_checks_camera_and_lightings_before_the_first_frame() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let prof = write_profile(tmp.path(), "p.toml", &base());
+    let session = tmp.path().join("s/chk");
+    let run = |camera: &str, lighting: &str| {
+        vss()
+            .arg("--profile")
+            .arg(&prof)
+            .args([
+                "grab",
+                "--camera",
+                camera,
+                "--lighting",
+                lighting,
+                "--image",
+                "2",
+                "--session",
+            ])
+            .arg(&session)
+            .output()
+            .expect("run grab")
+    };
+    let out = run("5", "a");
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cameras 1 to 4"));
+    let out = run("1", "a,q");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no lighting configuration `q`"), "{err}");
+    assert!(
+        imgs(&session).is_empty(),
+        "nothing captured: {:?}",
+        imgs(&session)
+    );
+}
+
+#[test]
 fn grab_refuses_a_bad_session_name() {
     let tmp = tempfile::tempdir().expect("tmp");
     let prof = write_profile(tmp.path(), "p.toml", &base());
