@@ -64,7 +64,6 @@ fn show(what: &str, m: &Metrics) -> String {
 }
 
 #[test]
-#[ignore = "fails on llv 752c0cf (extractor drift, floor 2, no corner closing); passes with the fix and defaults of /work/brief/notes-synth.md §6"]
 fn noise_2_recall_precision_endpoints_and_angles() {
     let m = &level(2.0).subpixel;
     let s = show("σ = 2", m);
@@ -75,7 +74,6 @@ fn noise_2_recall_precision_endpoints_and_angles() {
 }
 
 #[test]
-#[ignore = "fails on llv 752c0cf (extractor drift, floor 2, no corner closing); passes with the fix and defaults of /work/brief/notes-synth.md §6"]
 fn noise_5_recall_and_precision() {
     let m = &level(5.0).subpixel;
     let s = show("σ = 5", m);
@@ -84,7 +82,6 @@ fn noise_5_recall_and_precision() {
 }
 
 #[test]
-#[ignore = "fails on llv 752c0cf (extractor drift, floor 2, no corner closing); passes with the fix and defaults of /work/brief/notes-synth.md §6"]
 fn noise_10_recall_and_precision() {
     let m = &level(10.0).subpixel;
     let s = show("σ = 10", m);
@@ -135,7 +132,6 @@ fn lens_correction_restores_straightness() {
 }
 
 #[test]
-#[ignore = "fails on llv 752c0cf (extractor drift, floor 2, no corner closing); passes with the fix and defaults of /work/brief/notes-synth.md §6"]
 fn subpixel_positions_beat_whole_pixels() {
     // Lines average the rounding error of many points, so the gain shows
     // most in single edge points; for lines it is asked of the endpoint and

@@ -94,7 +94,15 @@ fn clean_drops_noise_lines_and_keeps_the_edges() {
         "base: {nb} lines, precision {:.3}, recall {:.3}; clean: {nc} lines, precision {:.3}, recall {:.3}",
         mb.precision, mb.recall, mc.precision, mc.recall
     );
-    assert!(nc * 2 <= nb, "{nc} lines vs {nb}");
+    // Fewer lines, and of the detected length that supports no true edge
+    // (noise lines) at most half is left.
+    assert!(nc < nb, "{nc} lines vs {nb}");
+    assert!(
+        (1.0 - mc.precision) * 2.0 <= 1.0 - mb.precision,
+        "noise fraction {:.3} vs {:.3}",
+        1.0 - mc.precision,
+        1.0 - mb.precision
+    );
     assert!(mc.precision >= mb.precision + 0.1);
     assert!(mc.recall >= mb.recall - 0.03);
 }

@@ -168,7 +168,6 @@ fn corner_closing_loses_no_precision_or_recall() {
 /// that ran through a shallow corner (the gain is 3 %: 3.03 → 2.93 px); with
 /// its stray-point check the gain is 17 % (2.63 → 2.19 px).
 #[test]
-#[ignore = "needs the line extractor to stop at corners (lines.rs stray-point check, see the issue6 report); run with --ignored"]
 fn corner_closing_brings_endpoints_to_the_corners() {
     let (off, on) = off_and_on();
     assert!(

@@ -127,7 +127,6 @@ fn lines(img: &GreyImage) -> Vec<Segment> {
 }
 
 #[test]
-#[ignore = "needs the line extractor to stop at corners (lines.rs stray-point check, see the issue6 report); run with --ignored"]
 fn shadow_outline_is_flagged_and_box_edges_are_not() {
     // Light a throws the shadow (30, 20) px; light b, close by, (34, 16).
     let (da, db) = ((30.0, 20.0), (34.0, 16.0));
@@ -167,7 +166,6 @@ fn shadow_outline_is_flagged_and_box_edges_are_not() {
 }
 
 #[test]
-#[ignore = "needs the line extractor to stop at corners (lines.rs stray-point check, see the issue6 report); run with --ignored"]
 fn the_same_light_twice_flags_no_outline() {
     // Both images under the same light (only the noise differs): every line
     // along the box or the shadow outline stays.

@@ -86,15 +86,3 @@ fn the_benchmark_scene_gives_its_polygon_edges() {
     let long = out.lines.iter().filter(|l| l.length() > 40.0).count();
     assert!((20..=40).contains(&long), "{long} long lines");
 }
-
-#[test]
-#[ignore]
-fn stage_times_on_the_benchmark_scene() {
-    use vss::llv::pipeline::Workspace;
-    let img = llv_scene::scene(512, 512, 2.0, 7);
-    let mut ws = Workspace::new();
-    for _ in 0..20 {
-        let o = ws.run(&Input::single(&img), &Params::default()).unwrap();
-        eprintln!("{:?}", o.timings);
-    }
-}

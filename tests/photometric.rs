@@ -225,7 +225,6 @@ fn four_lightings_plus_ambient_have_half_the_noise_and_no_worse_endpoints() {
 }
 
 #[test]
-#[ignore = "needs the line extractor to stop at corners (lines.rs stray-point check, see the issue6 report); run with --ignored"]
 fn four_lightings_plus_ambient_recall_at_least_the_best_single_image() {
     let f = figures();
     let (b, c) = (f.best.tally.metrics(), f.combined.tally.metrics());

@@ -7,11 +7,12 @@
 //!
 //! The search is a fixed grid (deterministic, no randomness), nested by
 //! stage so that the expensive stages run least often:
-//! `edges.per_region × edges.floor` (edge stage) → `lines.min_length` (line
-//! stage) → `connect.min_line_length` (CONNECT only). Each axis holds the
-//! base value and a ladder around it: with the default base, 21 edge runs,
-//! 42 line runs and 210 CONNECT runs (274 runs, ~1 s on a 320 × 320 noisy
-//! scene in the test build).
+//! `edges.per_region × edges.floor` (edge stage) → `lines.min_length ×
+//! lines.min_response` (line stage) → `connect.min_line_length` (CONNECT
+//! only). Each axis holds the base value and a ladder around it: with the
+//! default base, 21 edge runs, 168 line runs and 840 CONNECT runs (1030
+//! runs; CONNECT runs are cheap). With several lightings `edges.noise_factor`
+//! is a third edge-stage axis (three times the runs).
 //!
 //! **"clean", measurably.** The edges an operator must not lose are the
 //! *trusted* lines of the base result: those at least [`TRUSTED_FACTOR`] ×
@@ -143,16 +144,41 @@ pub fn search(input: &Input, base: &Params, target: &Target) -> Result<AutoResul
 
     // One workspace, nested by stage: each re-run starts from the stage its
     // parameter belongs to and reuses the enclosing loops' earlier stages.
-    for per_region in ladder(base.edges.per_region as f64, PER_REGION) {
-        for floor in ladder(base.edges.floor, FLOOR) {
+    // The noise factor only matters when several lightings are combined.
+    let photometric = input.images.len() > 1 || input.ambient.is_some();
+    let noise_factors = if photometric {
+        ladder(base.edges.noise_factor, NOISE_FACTOR)
+    } else {
+        vec![base.edges.noise_factor]
+    };
+    let edge_grid = noise_factors.into_iter().flat_map(|nf| {
+        ladder(base.edges.per_region as f64, PER_REGION)
+            .into_iter()
+            .flat_map(move |pr| {
+                ladder(base.edges.floor, FLOOR)
+                    .into_iter()
+                    .map(move |fl| (nf, pr, fl))
+            })
+    });
+    for (noise_factor, per_region, floor) in edge_grid {
+        {
             let mut p = base.clone();
+            p.edges.noise_factor = noise_factor;
             p.edges.per_region = per_region as u32;
             p.edges.floor = floor;
             ws.rerun(Stage::Edges, input, &p)?;
             runs += 1;
-            for min_len in ladder(base.lines.min_length, MIN_LENGTH) {
+            for (min_len, min_resp) in ladder(base.lines.min_length, MIN_LENGTH)
+                .into_iter()
+                .flat_map(|l| {
+                    ladder(base.lines.min_response, MIN_RESPONSE)
+                        .into_iter()
+                        .map(move |r| (l, r))
+                })
+            {
                 let mut q = p.clone();
                 q.lines.min_length = min_len;
+                q.lines.min_response = min_resp;
                 ws.rerun(Stage::Lines, input, &q)?;
                 runs += 1;
                 for mll in ladder(base.connect.min_line_length, MIN_LINE_LENGTH) {
@@ -183,7 +209,9 @@ pub fn search(input: &Input, base: &Params, target: &Target) -> Result<AutoResul
 /// The grid's ladders (module doc); the base value is always tried too.
 const PER_REGION: &[f64] = &[3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0];
 const FLOOR: &[f64] = &[2.0, 4.0, 8.0];
+const NOISE_FACTOR: &[f64] = &[2.0, 3.0, 5.0];
 const MIN_LENGTH: &[f64] = &[8.0, 12.0];
+const MIN_RESPONSE: &[f64] = &[0.0, 3.0, 6.0, 10.0];
 const MIN_LINE_LENGTH: &[f64] = &[12.0, 16.0, 20.0, 30.0, 40.0];
 
 struct Candidate {

@@ -22,6 +22,15 @@
 //!   the next `max_gap` scan lines (`for i in 1..=max_gap` of §3, so at most
 //!   `max_gap - 1` empty scan lines are bridged), nearest unused point first (ties: smaller
 //!   `u`);
+//! - once a track has two points, the next point is predicted from its
+//!   fitted line (not from the last point found), and only points of the
+//!   start point's polarity (sign of the response) are taken: a straight
+//!   edge keeps both, a track bending round a corner or a noise chain does
+//!   not;
+//! - once a track has 8 points, a next point more than 1.5 px from its
+//!   fitted line ends it (shallow corners, branching shadow edges);
+//! - a track whose mean |response| is below `min_response` is dropped as
+//!   noise (a parameter the original did not have; see `LineParams`);
 //! - the segment runs from the projection of its first point to that of its
 //!   last; `response` is the mean signed response of its points, `residual`
 //!   their RMS distance from the line.
@@ -32,6 +41,11 @@ use super::{EdgePoints, Point, ScanDir, Segment};
 
 /// Largest `|du/dv|` used for the prediction.
 const MAX_SLOPE: f64 = 8.0;
+
+/// Points a track needs before the stray-point test applies, and the
+/// distance (px) from its fitted line at which a next point ends it.
+const STRAY_AFTER: usize = 8;
+const STRAY_DISTANCE: f64 = 1.5;
 
 /// Templates of §3.1, `[template][j + 2][i + 2]` (rows down, columns right),
 /// in the order φ = 0, -π/4, -π/2, -3π/4.
@@ -236,7 +250,14 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
                 if r >= nrows {
                     break;
                 }
-                let pred = last.u as f64 + i as f64 * slope;
+                // Once two points are in, predict from the fitted line itself,
+                // not from the last point: a track predicted from its last
+                // point follows any chain that bends by less than the search
+                // width per scan line, round a corner and along the next edge.
+                let pred = match fit.mean() {
+                    Some(m) if fit.len() >= 2 => m.x + (r as f64 - m.y) * slope,
+                    _ => last.u as f64 + i as f64 * slope,
+                };
                 let (lo, hi) = (s.row_start[r] as usize, s.row_start[r + 1] as usize);
                 let row = &s.points[lo..hi];
                 let first = row.partition_point(|q| (q.u as f64) < pred - sw);
@@ -250,6 +271,11 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
                     if s.used[idx] {
                         continue;
                     }
+                    // A straight edge keeps its polarity along its length;
+                    // chains of noise points alternate.
+                    if (q.response > 0.0) != (sp.response > 0.0) {
+                        continue;
+                    }
                     if best.is_none_or(|(bd, _)| d.abs() < bd) {
                         best = Some((d.abs(), idx));
                     }
@@ -260,6 +286,17 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
                 }
             }
             let Some(idx) = found else { break };
+            // A track that is well established stops where the next point
+            // leaves its line: at a shallow corner (two edges at up to ~35°
+            // meet within the search window) or where a shadow edge branches.
+            if fit.len() >= STRAY_AFTER {
+                let q = s.points[idx];
+                if let Some(l) = fit.line() {
+                    if l.distance(Point::new(q.u as f64, q.v as f64)).abs() > STRAY_DISTANCE {
+                        break;
+                    }
+                }
+            }
             s.used[idx] = true;
             s.members.push(idx as u32);
             let q = s.points[idx];
@@ -273,6 +310,10 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
                     MAX_SLOPE * du.signum() * dv.signum()
                 };
             }
+        }
+        let response = resp_sum / fit.len() as f64;
+        if response.abs() < p.min_response {
+            continue;
         }
         let Some(line) = fit.line() else { continue };
         let a = line.project(Point::new(sp.u as f64, sp.v as f64));
@@ -289,7 +330,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
         out.push(Segment {
             a: swap(a),
             b: swap(b),
-            response: resp_sum / fit.len() as f64,
+            response,
             residual: fit.rms_residual(),
             shadow: false,
         });

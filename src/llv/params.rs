@@ -46,7 +46,7 @@ impl Default for EdgeParams {
             floor: 2.0,
             per_region: 8,
             region_lines: 1,
-            noise_factor: 3.0,
+            noise_factor: 5.0,
         }
     }
 }
@@ -63,6 +63,12 @@ pub struct LineParams {
     pub min_length: f64,
     /// Minimum angle between a line and the scan direction (degrees; π/8 = 22.5°).
     pub min_scan_angle_deg: f64,
+    /// Line significance (grey levels): a segment whose points' mean
+    /// |response| is below this is dropped as noise. Not in the original VSS:
+    /// with the floor `T` at its default 2 grey levels, `M` points per scan
+    /// line promote noise peaks in rows with few edges, and their chains make
+    /// short lines of mean |response| 3–4 at noise σ = 2. 0 switches it off.
+    pub min_response: f64,
 }
 
 impl Default for LineParams {
@@ -72,6 +78,7 @@ impl Default for LineParams {
             search_width: 2.0,
             min_length: 8.0,
             min_scan_angle_deg: 22.5,
+            min_response: 6.0,
         }
     }
 }
@@ -104,7 +111,7 @@ impl Default for ConnectParams {
             wd: 1.5,
             max_angle_deg: 3.0,
             min_line_length: 12.0,
-            corner_radius: 0.0,
+            corner_radius: 5.0,
         }
     }
 }
@@ -288,6 +295,16 @@ pub const PARAMS: &[ParamSpec] = &[
         "least angle between a line and the scan direction"
     ),
     spec!(
+        "lines.min_response",
+        Float,
+        Lines,
+        "grey levels",
+        0.0,
+        255.0,
+        0.5,
+        "lines whose mean |edge response| is below this are noise; 0 is off"
+    ),
+    spec!(
         "connect.enabled",
         Bool,
         Connect,
@@ -369,6 +386,7 @@ impl Params {
             "lines.search_width" => self.lines.search_width,
             "lines.min_length" => self.lines.min_length,
             "lines.min_scan_angle_deg" => self.lines.min_scan_angle_deg,
+            "lines.min_response" => self.lines.min_response,
             "connect.enabled" => b(self.connect.enabled),
             "connect.wl" => self.connect.wl,
             "connect.wd" => self.connect.wd,
@@ -408,6 +426,7 @@ impl Params {
             "lines.search_width" => self.lines.search_width = value,
             "lines.min_length" => self.lines.min_length = value,
             "lines.min_scan_angle_deg" => self.lines.min_scan_angle_deg = value,
+            "lines.min_response" => self.lines.min_response = value,
             "connect.enabled" => self.connect.enabled = on,
             "connect.wl" => self.connect.wl = value,
             "connect.wd" => self.connect.wd = value,
