@@ -1,0 +1,603 @@
+//! The one key table: (scope, key, action, description). Dispatch, the help
+//! overlay (`?`) and the status-bar hints all read it, so a key can never do
+//! one thing and be documented as another.
+
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+
+/// The screens of the console, in top-bar order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ScreenId {
+    Survey,
+    Capture,
+    Pipeline,
+    Edit,
+    Session,
+}
+
+impl ScreenId {
+    pub const ALL: [ScreenId; 5] = [
+        ScreenId::Survey,
+        ScreenId::Capture,
+        ScreenId::Pipeline,
+        ScreenId::Edit,
+        ScreenId::Session,
+    ];
+    pub fn title(self) -> &'static str {
+        match self {
+            ScreenId::Survey => "Survey",
+            ScreenId::Capture => "Capture",
+            ScreenId::Pipeline => "Pipeline",
+            ScreenId::Edit => "Edit",
+            ScreenId::Session => "Session/Report",
+        }
+    }
+}
+
+/// Where a binding applies. Modal scopes (help, prompt, confirm) take every
+/// key while they are open.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scope {
+    Global,
+    Screen(ScreenId),
+    /// A yes/no question is open.
+    Confirm,
+    /// A text field is open (other printable keys type into it).
+    Prompt,
+}
+
+/// Everything a key can ask for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Action {
+    Quit,
+    Help,
+    ToggleLog,
+    GoTo(ScreenId),
+    Cancel,
+    // Survey
+    NewSession,
+    SelectUp,
+    SelectDown,
+    OpenSelected,
+    NextStep,
+    Accept,
+    Redo,
+    CameraNext,
+    LocationNext,
+    // Capture
+    ToggleLive,
+    Grab,
+    LightPrev,
+    LightNext,
+    LightToggle,
+    LightsOff,
+    Lighting(u8),
+    // Pipeline and Edit previews
+    ParamPrev,
+    ParamNext,
+    ParamInc,
+    ParamDec,
+    ParamInc10,
+    ParamDec10,
+    ParamType,
+    SaveOutputs,
+    ViewNext,
+    ViewPrev,
+    SideBySide,
+    ZoomIn,
+    ZoomOut,
+    CursorLeft,
+    CursorRight,
+    CursorUp,
+    CursorDown,
+    PanLeft,
+    PanRight,
+    PanUp,
+    PanDown,
+    // Edit
+    LineNext,
+    LinePrev,
+    LineNearest,
+    Corner,
+    Mark,
+    Connect,
+    Extend,
+    Delete,
+    Undo,
+    RedoEdit,
+    // Session / report
+    Export,
+    Refresh,
+    // Modal
+    Yes,
+    No,
+    Submit,
+}
+
+/// A key: its code and whether Ctrl / Shift are held. For characters the
+/// case already tells Shift, so Shift is ignored there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Key {
+    pub code: KeyCode,
+    pub ctrl: bool,
+    pub shift: bool,
+}
+
+const fn ch(c: char) -> Key {
+    Key {
+        code: KeyCode::Char(c),
+        ctrl: false,
+        shift: false,
+    }
+}
+const fn k(code: KeyCode) -> Key {
+    Key {
+        code,
+        ctrl: false,
+        shift: false,
+    }
+}
+const fn shift(code: KeyCode) -> Key {
+    Key {
+        code,
+        ctrl: false,
+        shift: true,
+    }
+}
+const fn ctrl(c: char) -> Key {
+    Key {
+        code: KeyCode::Char(c),
+        ctrl: true,
+        shift: false,
+    }
+}
+
+impl Key {
+    /// Whether a key event from the terminal is this key.
+    pub fn matches(&self, ev: &KeyEvent) -> bool {
+        let ctrl = ev.modifiers.contains(KeyModifiers::CONTROL);
+        let shift = ev.modifiers.contains(KeyModifiers::SHIFT);
+        match (self.code, ev.code) {
+            (KeyCode::Char(a), KeyCode::Char(b)) => a == b && ctrl == self.ctrl,
+            (a, b) => a == b && ctrl == self.ctrl && shift == self.shift,
+        }
+    }
+
+    /// How the key is written in help and hints.
+    pub fn label(&self) -> String {
+        let base = match self.code {
+            KeyCode::Char(' ') => "Space".to_string(),
+            KeyCode::Char(c) => c.to_string(),
+            KeyCode::Up => "↑".into(),
+            KeyCode::Down => "↓".into(),
+            KeyCode::Left => "←".into(),
+            KeyCode::Right => "→".into(),
+            KeyCode::Enter => "Enter".into(),
+            KeyCode::Esc => "Esc".into(),
+            KeyCode::Tab => "Tab".into(),
+            KeyCode::BackTab => "S-Tab".into(),
+            KeyCode::Backspace => "Bksp".into(),
+            KeyCode::Delete => "Del".into(),
+            KeyCode::PageUp => "PgUp".into(),
+            KeyCode::PageDown => "PgDn".into(),
+            KeyCode::F(n) => format!("F{n}"),
+            other => format!("{other:?}"),
+        };
+        match (self.ctrl, self.shift) {
+            (true, _) => format!("C-{base}"),
+            (false, true) => format!("S-{base}"),
+            _ => base,
+        }
+    }
+}
+
+/// One row of the key table.
+#[derive(Clone, Copy, Debug)]
+pub struct Binding {
+    pub scope: Scope,
+    pub key: Key,
+    pub action: Action,
+    pub desc: &'static str,
+    /// Shown in the status bar of its screen.
+    pub hint: bool,
+}
+
+const fn b(scope: Scope, key: Key, action: Action, desc: &'static str, hint: bool) -> Binding {
+    Binding {
+        scope,
+        key,
+        action,
+        desc,
+        hint,
+    }
+}
+
+use Action as A;
+use KeyCode as K;
+use ScreenId as S;
+const G: Scope = Scope::Global;
+const SU: Scope = Scope::Screen(S::Survey);
+const CA: Scope = Scope::Screen(S::Capture);
+const PI: Scope = Scope::Screen(S::Pipeline);
+const ED: Scope = Scope::Screen(S::Edit);
+const SE: Scope = Scope::Screen(S::Session);
+
+/// The key table. Screen rows come before global rows so a screen may
+/// reuse a key; the first match wins.
+pub const KEYMAP: &[Binding] = &[
+    // Modal scopes.
+    b(Scope::Confirm, ch('y'), A::Yes, "yes, go ahead", true),
+    b(
+        Scope::Confirm,
+        ch('n'),
+        A::No,
+        "no, keep what is there",
+        true,
+    ),
+    b(Scope::Confirm, k(K::Esc), A::No, "no", false),
+    b(
+        Scope::Prompt,
+        k(K::Enter),
+        A::Submit,
+        "accept the typed text",
+        true,
+    ),
+    b(Scope::Prompt, k(K::Esc), A::Cancel, "cancel typing", true),
+    // Survey.
+    b(
+        SU,
+        ch('n'),
+        A::NewSession,
+        "new session (type its name)",
+        true,
+    ),
+    b(SU, k(K::Up), A::SelectUp, "choose a session above", false),
+    b(
+        SU,
+        k(K::Down),
+        A::SelectDown,
+        "choose a session below",
+        false,
+    ),
+    b(
+        SU,
+        ch('o'),
+        A::OpenSelected,
+        "open (resume) the chosen session",
+        true,
+    ),
+    b(
+        SU,
+        k(K::Enter),
+        A::NextStep,
+        "next step: capture all lightings / run",
+        true,
+    ),
+    b(
+        SU,
+        ch('a'),
+        A::Accept,
+        "accept this image, go to the next",
+        true,
+    ),
+    b(SU, ch('r'), A::Redo, "redo this image (asks first)", true),
+    b(SU, ch('c'), A::CameraNext, "next camera", true),
+    b(SU, ch('p'), A::LocationNext, "next camera location", false),
+    b(SU, k(K::Esc), A::Cancel, "cancel the transfer", false),
+    // Capture.
+    b(CA, ch('v'), A::ToggleLive, "live view on/off", true),
+    b(CA, ch('g'), A::Grab, "grab one frame", true),
+    b(CA, ch('c'), A::CameraNext, "next camera", true),
+    b(CA, k(K::Up), A::LightPrev, "previous light", false),
+    b(CA, k(K::Down), A::LightNext, "next light", false),
+    b(CA, ch(' '), A::LightToggle, "switch the chosen light", true),
+    b(CA, ch('o'), A::LightsOff, "all lights off", false),
+    b(
+        CA,
+        ch('A'),
+        A::Lighting(0),
+        "lighting configuration a",
+        false,
+    ),
+    b(
+        CA,
+        ch('B'),
+        A::Lighting(1),
+        "lighting configuration b",
+        false,
+    ),
+    b(
+        CA,
+        ch('C'),
+        A::Lighting(2),
+        "lighting configuration c",
+        false,
+    ),
+    b(
+        CA,
+        ch('D'),
+        A::Lighting(3),
+        "lighting configuration d",
+        false,
+    ),
+    b(
+        CA,
+        ch('E'),
+        A::Lighting(4),
+        "lighting configuration e",
+        false,
+    ),
+    b(
+        CA,
+        ch('F'),
+        A::Lighting(5),
+        "lighting configuration f",
+        false,
+    ),
+    b(CA, k(K::Esc), A::Cancel, "cancel the transfer", false),
+    // Pipeline.
+    b(PI, k(K::Up), A::ParamPrev, "previous parameter", false),
+    b(PI, k(K::Down), A::ParamNext, "next parameter", false),
+    b(PI, ch('+'), A::ParamInc, "increase by one step", true),
+    b(PI, ch('='), A::ParamInc, "increase by one step", false),
+    b(PI, k(K::Right), A::ParamInc, "increase by one step", false),
+    b(PI, ch('-'), A::ParamDec, "decrease by one step", true),
+    b(PI, k(K::Left), A::ParamDec, "decrease by one step", false),
+    b(PI, ch('>'), A::ParamInc10, "increase by ten steps", false),
+    b(
+        PI,
+        shift(K::Right),
+        A::ParamInc10,
+        "increase by ten steps",
+        false,
+    ),
+    b(PI, ch('<'), A::ParamDec10, "decrease by ten steps", false),
+    b(
+        PI,
+        shift(K::Left),
+        A::ParamDec10,
+        "decrease by ten steps",
+        false,
+    ),
+    b(PI, k(K::Enter), A::ParamType, "type a value", true),
+    b(PI, k(K::Tab), A::ViewNext, "next stage view", true),
+    b(PI, k(K::BackTab), A::ViewPrev, "previous stage view", false),
+    b(PI, ch('b'), A::SideBySide, "side by side / one view", false),
+    b(
+        PI,
+        ch('S'),
+        A::SaveOutputs,
+        "save these outputs to the session",
+        false,
+    ),
+    // Pipeline and Edit share the preview keys.
+    b(PI, ch('z'), A::ZoomIn, "zoom in", false),
+    b(PI, ch('x'), A::ZoomOut, "zoom out", false),
+    b(PI, ch('a'), A::CursorLeft, "cursor left", false),
+    b(PI, ch('d'), A::CursorRight, "cursor right", false),
+    b(PI, ch('w'), A::CursorUp, "cursor up", false),
+    b(PI, ch('s'), A::CursorDown, "cursor down", false),
+    b(PI, ch('A'), A::PanLeft, "pan left", false),
+    b(PI, ch('D'), A::PanRight, "pan right", false),
+    b(PI, ch('W'), A::PanUp, "pan up", false),
+    b(PI, ch('X'), A::PanDown, "pan down", false),
+    // Edit.
+    b(ED, ch('n'), A::LineNext, "select the next line", true),
+    b(ED, k(K::Tab), A::LineNext, "select the next line", false),
+    b(ED, ch('p'), A::LinePrev, "select the previous line", false),
+    b(
+        ED,
+        k(K::BackTab),
+        A::LinePrev,
+        "select the previous line",
+        false,
+    ),
+    b(
+        ED,
+        ch('.'),
+        A::LineNearest,
+        "select the line nearest the cursor",
+        true,
+    ),
+    b(
+        ED,
+        ch('k'),
+        A::Corner,
+        "select the two lines of the corner at the cursor",
+        true,
+    ),
+    b(
+        ED,
+        ch(' '),
+        A::Mark,
+        "add the line to / drop it from the selection",
+        false,
+    ),
+    b(
+        ED,
+        ch('c'),
+        A::Connect,
+        "connect the two selected lines",
+        true,
+    ),
+    b(
+        ED,
+        ch('e'),
+        A::Extend,
+        "extend the first line to the second",
+        true,
+    ),
+    b(ED, ch('x'), A::Delete, "delete the selected lines", true),
+    b(
+        ED,
+        k(K::Delete),
+        A::Delete,
+        "delete the selected lines",
+        false,
+    ),
+    b(ED, ch('u'), A::Undo, "undo", true),
+    b(ED, ch('r'), A::RedoEdit, "redo", true),
+    b(ED, k(K::Esc), A::Cancel, "clear the selection", false),
+    b(ED, ch('z'), A::ZoomIn, "zoom in", false),
+    b(ED, ch('Z'), A::ZoomOut, "zoom out", false),
+    b(ED, ch('a'), A::CursorLeft, "cursor left", false),
+    b(ED, ch('d'), A::CursorRight, "cursor right", false),
+    b(ED, ch('w'), A::CursorUp, "cursor up", false),
+    b(ED, ch('s'), A::CursorDown, "cursor down", false),
+    b(ED, k(K::Left), A::PanLeft, "pan left", false),
+    b(ED, k(K::Right), A::PanRight, "pan right", false),
+    b(ED, k(K::Up), A::PanUp, "pan up", false),
+    b(ED, k(K::Down), A::PanDown, "pan down", false),
+    // Session / report.
+    b(
+        SE,
+        ch('e'),
+        A::Export,
+        "export the PostScript and SVG reports",
+        true,
+    ),
+    b(SE, ch('r'), A::Refresh, "re-read the session's files", true),
+    // Everywhere.
+    b(G, ch('1'), A::GoTo(S::Survey), "Survey screen", false),
+    b(G, ch('2'), A::GoTo(S::Capture), "Capture screen", false),
+    b(G, ch('3'), A::GoTo(S::Pipeline), "Pipeline screen", false),
+    b(G, ch('4'), A::GoTo(S::Edit), "Edit screen", false),
+    b(
+        G,
+        ch('5'),
+        A::GoTo(S::Session),
+        "Session/Report screen",
+        false,
+    ),
+    b(G, ch('?'), A::Help, "help: every key", true),
+    b(
+        G,
+        ch('l'),
+        A::ToggleLog,
+        "log pane: hide / show / expand",
+        true,
+    ),
+    b(G, ch('q'), A::Quit, "quit", true),
+    b(G, ctrl('c'), A::Quit, "quit", false),
+];
+
+/// The action of a key in a scope (global rows are tried after the scope's
+/// own only for screen scopes; modal scopes take nothing else).
+pub fn lookup(scope: Scope, ev: &KeyEvent) -> Option<Action> {
+    let own = KEYMAP
+        .iter()
+        .find(|b| b.scope == scope && b.key.matches(ev))
+        .map(|b| b.action);
+    match scope {
+        Scope::Screen(_) => own.or_else(|| {
+            KEYMAP
+                .iter()
+                .find(|b| b.scope == Scope::Global && b.key.matches(ev))
+                .map(|b| b.action)
+        }),
+        _ => own,
+    }
+}
+
+/// The rows of a scope, with the keys of one action joined: `+ = →`.
+pub fn describe(scope: Scope) -> Vec<(String, &'static str)> {
+    let mut out: Vec<(String, Action, &'static str)> = Vec::new();
+    for bnd in KEYMAP.iter().filter(|b| b.scope == scope) {
+        if let Some(row) = out.iter_mut().find(|r| r.1 == bnd.action) {
+            row.0.push(' ');
+            row.0.push_str(&bnd.key.label());
+        } else {
+            out.push((bnd.key.label(), bnd.action, bnd.desc));
+        }
+    }
+    out.into_iter().map(|(k, _, d)| (k, d)).collect()
+}
+
+/// The status-bar hints of a scope: `key desc` pairs, shortest first words.
+pub fn hints(scope: Scope) -> Vec<(String, &'static str)> {
+    KEYMAP
+        .iter()
+        .filter(|b| b.hint && (b.scope == scope))
+        .map(|b| (b.key.label(), short(b.desc)))
+        .collect()
+}
+
+/// The first words of a description, for the status bar.
+fn short(desc: &'static str) -> &'static str {
+    let end = desc
+        .char_indices()
+        .filter(|(_, c)| *c == ' ' || *c == ':' || *c == '(' || *c == ',')
+        .nth(1)
+        .map_or(desc.len(), |(i, _)| i);
+    desc[..end].trim_end_matches([':', ' ', ','])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(code: KeyCode, m: KeyModifiers) -> KeyEvent {
+        KeyEvent::new(code, m)
+    }
+
+    #[test]
+    fn screen_keys_win_over_global_and_fall_back() {
+        let s = Scope::Screen(ScreenId::Pipeline);
+        assert_eq!(
+            lookup(s, &key(K::Char('+'), KeyModifiers::SHIFT)),
+            Some(A::ParamInc)
+        );
+        assert_eq!(
+            lookup(s, &key(K::Right, KeyModifiers::SHIFT)),
+            Some(A::ParamInc10)
+        );
+        assert_eq!(
+            lookup(s, &key(K::Right, KeyModifiers::NONE)),
+            Some(A::ParamInc)
+        );
+        assert_eq!(
+            lookup(s, &key(K::Char('q'), KeyModifiers::NONE)),
+            Some(A::Quit)
+        );
+        assert_eq!(
+            lookup(s, &key(K::Char('c'), KeyModifiers::CONTROL)),
+            Some(A::Quit)
+        );
+        assert_eq!(
+            lookup(Scope::Confirm, &key(K::Char('q'), KeyModifiers::NONE)),
+            None
+        );
+        assert_eq!(
+            lookup(
+                Scope::Screen(ScreenId::Capture),
+                &key(K::Char('B'), KeyModifiers::SHIFT)
+            ),
+            Some(A::Lighting(1))
+        );
+    }
+
+    #[test]
+    fn no_key_is_bound_twice_in_one_scope() {
+        for (i, a) in KEYMAP.iter().enumerate() {
+            for bnd in &KEYMAP[i + 1..] {
+                assert!(
+                    !(a.scope == bnd.scope && a.key == bnd.key),
+                    "{:?} {} bound twice",
+                    a.scope,
+                    a.key.label()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn help_joins_keys_and_hints_are_short() {
+        let rows = describe(Scope::Screen(ScreenId::Pipeline));
+        assert!(
+            rows.iter()
+                .any(|(k, d)| k == "+ = →" && d.starts_with("increase"))
+        );
+        let h = hints(Scope::Global);
+        assert!(h.iter().any(|(k, d)| k == "q" && *d == "quit"));
+        assert!(h.iter().all(|(_, d)| d.len() <= 16), "{h:?}");
+    }
+}
