@@ -1,1 +1,157 @@
-//! The cell's hardware: grabber and lights (to be written).
+//! The cell's hardware behind traits: the VSG/1 frame grabber
+//! ([`FrameGrabber`], [`grabber::VsgClient`]), the relay board that switches
+//! the lights ([`LightSwitch`], Numato and LCUS drivers), and the simulated
+//! cell that speaks both protocols over real pseudo-terminals ([`sim`]).
+//!
+//! [`Cell`] ties them to a profile: it opens the serial ports the profile
+//! names, or starts the embedded simulator and connects the very same drivers
+//! to its pseudo-terminals, and it always knows which lights are on.
+
+use std::io::{self, Read, Write};
+use std::time::Duration;
+
+pub mod cell;
+pub mod grabber;
+pub mod lights;
+pub mod protocol;
+pub mod sim;
+
+pub use cell::{Capture, Cell};
+pub use grabber::{FrameGrabber, VsgClient, WireStats};
+pub use lights::{LcusBoard, LightSwitch, NumatoBoard};
+pub use protocol::{ErrCode, FrameInfo, GrabberInfo, GrabberStatus};
+
+/// Everything that can go wrong with the cell's devices. Each variant names
+/// the port and says what to do.
+#[derive(Debug, thiserror::Error)]
+pub enum RigError {
+    #[error(
+        "{port}: cannot open the serial port: {source} — check the cable and the profile's port"
+    )]
+    Open {
+        port: String,
+        source: serialport::Error,
+    },
+    #[error(
+        "{port}: the device vanished ({source}); everything saved so far is kept — \
+         plug it back in and reconnect"
+    )]
+    Vanished { port: String, source: io::Error },
+    #[error(
+        "{port}: no reply to `{command}` within {timeout_ms} ms ({attempts} attempts) — \
+         is the device on, and is the baud rate right?"
+    )]
+    Timeout {
+        port: String,
+        command: String,
+        timeout_ms: u64,
+        attempts: u32,
+    },
+    #[error("{port}: `{command}` was refused: ERR {code} {text}")]
+    Device {
+        port: String,
+        command: String,
+        code: ErrCode,
+        text: String,
+    },
+    #[error(
+        "{port}: garbled reply to `{command}` ({detail}) after {attempts} attempts — check the cable and the baud rate"
+    )]
+    Garbled {
+        port: String,
+        command: String,
+        detail: String,
+        attempts: u32,
+    },
+    #[error(
+        "{port}: the block at byte {offset} failed its CRC {attempts} times — \
+         the line is too noisy; check the cable"
+    )]
+    BlockCrc {
+        port: String,
+        offset: usize,
+        attempts: u32,
+    },
+    #[error(
+        "{port}: the frame's CRC {got:08X} does not match FREEZE's {expected:08X}; \
+         nothing was saved — freeze again"
+    )]
+    FrameCrc {
+        port: String,
+        expected: u32,
+        got: u32,
+    },
+    #[error("{port}: the grabber has no frozen frame (it may have been reset) — freeze again")]
+    NoFrame { port: String },
+    #[error("{port}: transfer cancelled at byte {done} of {total}; nothing was saved")]
+    Cancelled {
+        port: String,
+        done: usize,
+        total: usize,
+    },
+    #[error(
+        "{port}: relay {relay} reads back {got}, expected {expected} — is the board's relay count right?"
+    )]
+    RelayMismatch {
+        port: String,
+        relay: String,
+        expected: String,
+        got: String,
+    },
+    #[error("{port}: {detail}")]
+    Board { port: String, detail: String },
+    #[error("{0}")]
+    Config(String),
+    #[error("simulator: {0}")]
+    Sim(String),
+}
+
+impl RigError {
+    /// Whether the device has gone away (unplugged, powered off).
+    pub fn is_vanished(&self) -> bool {
+        matches!(self, RigError::Vanished { .. })
+    }
+}
+
+/// A byte stream to a device with a settable read timeout: a serial port, a
+/// pseudo-terminal, or scripted bytes in tests.
+pub trait Link: Read + Write + Send {
+    fn set_timeout(&mut self, timeout: Duration) -> io::Result<()>;
+}
+
+impl Link for Box<dyn serialport::SerialPort> {
+    fn set_timeout(&mut self, timeout: Duration) -> io::Result<()> {
+        serialport::SerialPort::set_timeout(self.as_mut(), timeout).map_err(io::Error::from)
+    }
+}
+
+#[cfg(unix)]
+impl Link for serialport::TTYPort {
+    fn set_timeout(&mut self, timeout: Duration) -> io::Result<()> {
+        serialport::SerialPort::set_timeout(self, timeout).map_err(io::Error::from)
+    }
+}
+
+/// The serial port type the drivers use on real devices and ptys.
+pub type SerialLink = Box<dyn serialport::SerialPort>;
+
+/// Opens a serial device 8N1, no flow control.
+pub fn open_serial(path: &str, baud: u32, timeout: Duration) -> Result<SerialLink, RigError> {
+    if path.is_empty() {
+        return Err(RigError::Config(
+            "no serial port given: set `port` in the profile's [grabber] or [relay] section"
+                .to_string(),
+        ));
+    }
+    serialport::new(path, baud)
+        .timeout(timeout)
+        .data_bits(serialport::DataBits::Eight)
+        .parity(serialport::Parity::None)
+        .stop_bits(serialport::StopBits::One)
+        .flow_control(serialport::FlowControl::None)
+        .open()
+        .map_err(|source| RigError::Open {
+            port: path.to_string(),
+            source,
+        })
+}

@@ -1,0 +1,416 @@
+//! Camera description files `.cdf` (formats.md §4): parameters written as a
+//! line `NAME=STATUS` followed by their values, one number per line (for `T`,
+//! one matrix row of four per line).
+//!
+//! The known parameters (`S`, `C`, `f`, `D`, `T`) are checked for their
+//! number of values; unknown ones are kept, rows as they were, and written
+//! back in their place, so a newer calibration program's additions survive
+//! the console. A parameter with status `N` may carry its values or none.
+//! Numbers are written with six decimals when that is exact, else with the
+//! digits needed to read back the same value.
+
+use std::path::Path;
+
+use super::{
+    FormatError, FormatErrorKind as K, fmt_exact, numbered_lines, parse_f64, read_text, shorten,
+    write_bytes,
+};
+use crate::llv::lens::CameraModel;
+
+/// How a parameter's value was obtained.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Status {
+    /// `N`: not available.
+    NotAvailable,
+    /// `E`: estimated.
+    Estimated,
+    /// `A`: calibrated.
+    Calibrated,
+    /// `S`: stated (e.g. from the data sheet).
+    Stated,
+}
+
+impl Status {
+    pub fn letter(self) -> char {
+        match self {
+            Status::NotAvailable => 'N',
+            Status::Estimated => 'E',
+            Status::Calibrated => 'A',
+            Status::Stated => 'S',
+        }
+    }
+    pub fn from_letter(c: &str) -> Option<Status> {
+        Some(match c {
+            "N" => Status::NotAvailable,
+            "E" => Status::Estimated,
+            "A" => Status::Calibrated,
+            "S" => Status::Stated,
+            _ => return None,
+        })
+    }
+    /// What the letter means, for `vss info`.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Status::NotAvailable => "not available",
+            Status::Estimated => "estimated",
+            Status::Calibrated => "calibrated",
+            Status::Stated => "stated",
+        }
+    }
+}
+
+/// One parameter: name, status and value rows (one number per row, except
+/// `T` with four).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CdfParam {
+    pub name: String,
+    pub status: Status,
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl CdfParam {
+    /// All values, row after row.
+    pub fn values(&self) -> impl Iterator<Item = f64> + '_ {
+        self.rows.iter().flatten().copied()
+    }
+    /// Whether the values are usable (status not `N`).
+    pub fn available(&self) -> bool {
+        self.status != Status::NotAvailable
+    }
+}
+
+/// A camera description: its parameters in file order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Cdf {
+    pub params: Vec<CdfParam>,
+}
+
+/// `(rows, values per row)` of the parameters the spec defines.
+pub fn known_shape(name: &str) -> Option<(usize, usize)> {
+    Some(match name {
+        "S" | "C" => (2, 1),
+        "f" => (1, 1),
+        "D" => (5, 1),
+        "T" => (3, 4),
+        _ => return None,
+    })
+}
+
+impl Cdf {
+    /// The parameter named `name`.
+    pub fn get(&self, name: &str) -> Option<&CdfParam> {
+        self.params.iter().find(|p| p.name == name)
+    }
+
+    /// The values of an available parameter.
+    fn available(&self, name: &str) -> Option<Vec<f64>> {
+        let p = self.get(name).filter(|p| p.available())?;
+        let v: Vec<f64> = p.values().collect();
+        let (r, c) = known_shape(name)?;
+        (v.len() == r * c).then_some(v)
+    }
+
+    /// Replaces the parameter of that name, or appends it.
+    pub fn set(&mut self, p: CdfParam) {
+        match self.params.iter_mut().find(|q| q.name == p.name) {
+            Some(q) => *q = p,
+            None => self.params.push(p),
+        }
+    }
+
+    /// The intrinsic camera model: `None` if `S`, `C` or `f` is missing or
+    /// `N`. `D` missing or `N` gives no distortion.
+    pub fn camera_model(&self) -> Option<CameraModel> {
+        let s = self.available("S")?;
+        let c = self.available("C")?;
+        let f = self.available("f")?;
+        let d = self
+            .available("D")
+            .and_then(|d| <[f64; 5]>::try_from(d).ok());
+        Some(CameraModel {
+            cx: *c.first()?,
+            cy: *c.get(1)?,
+            sx: *s.first()?,
+            sy: *s.get(1)?,
+            f: *f.first()?,
+            distortion: d,
+        })
+    }
+
+    /// The extrinsic matrix `[R | t]` (world to camera, mm), if available.
+    pub fn extrinsic(&self) -> Option<[[f64; 4]; 3]> {
+        let v = self.available("T")?;
+        let mut t = [[0.0; 4]; 3];
+        for (i, x) in v.into_iter().enumerate() {
+            *t.get_mut(i / 4)?.get_mut(i % 4)? = x;
+        }
+        Some(t)
+    }
+
+    /// A calibrated (`A`) description of a camera model, with `T` when given
+    /// (else `T=N` with zeros). Distortion `None` is written `D=N`.
+    pub fn from_camera(m: &CameraModel, t: Option<[[f64; 4]; 3]>) -> Cdf {
+        let col = |v: &[f64]| v.iter().map(|&x| vec![x]).collect::<Vec<_>>();
+        let a = Status::Calibrated;
+        let (ds, d) = match m.distortion {
+            Some(d) => (a, d),
+            None => (Status::NotAvailable, [0.0; 5]),
+        };
+        let (ts, tm) = match t {
+            Some(t) => (a, t),
+            None => (Status::NotAvailable, [[0.0; 4]; 3]),
+        };
+        Cdf {
+            params: vec![
+                CdfParam {
+                    name: "S".into(),
+                    status: a,
+                    rows: col(&[m.sx, m.sy]),
+                },
+                CdfParam {
+                    name: "C".into(),
+                    status: a,
+                    rows: col(&[m.cx, m.cy]),
+                },
+                CdfParam {
+                    name: "f".into(),
+                    status: a,
+                    rows: col(&[m.f]),
+                },
+                CdfParam {
+                    name: "D".into(),
+                    status: ds,
+                    rows: col(&d),
+                },
+                CdfParam {
+                    name: "T".into(),
+                    status: ts,
+                    rows: tm.iter().map(|r| r.to_vec()).collect(),
+                },
+            ],
+        }
+    }
+}
+
+fn valid_name(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '.' || c == '-')
+}
+
+/// Parses `.cdf` text; `path` names the file in errors.
+pub fn parse_cdf(text: &str, path: &Path) -> Result<Cdf, FormatError> {
+    let mut cdf = Cdf::default();
+    // Line of each parameter's header, to name it when its values are short.
+    let mut starts: Vec<usize> = Vec::new();
+    let mut last_line = 0;
+    for (n, line) in numbered_lines(text) {
+        last_line = n;
+        let t = line.trim();
+        if t.is_empty() {
+            continue;
+        }
+        if let Some((name, status)) = t.split_once('=') {
+            let (name, status) = (name.trim(), status.trim());
+            if !valid_name(name) {
+                return Err(FormatError::at_line(
+                    path,
+                    n,
+                    K::Syntax,
+                    format!(
+                        "expected a parameter name (letters, digits, _ . -) before '=', found \"{}\"",
+                        shorten(name)
+                    ),
+                ));
+            }
+            let Some(status) = Status::from_letter(status) else {
+                return Err(FormatError::at_line(
+                    path,
+                    n,
+                    K::Syntax,
+                    format!(
+                        "{name}: expected status N, E, A or S after '=', found \"{}\"",
+                        shorten(status)
+                    ),
+                ));
+            };
+            if let Some(i) = cdf.params.iter().position(|p| p.name == name) {
+                let first = starts.get(i).copied().unwrap_or(0);
+                return Err(FormatError::at_line(
+                    path,
+                    n,
+                    K::Syntax,
+                    format!("parameter {name} given twice (first at line {first})"),
+                ));
+            }
+            if let Some(prev) = cdf.params.last() {
+                check_shape(prev, starts.last().copied().unwrap_or(0), path)?;
+            }
+            cdf.params.push(CdfParam {
+                name: name.to_string(),
+                status,
+                rows: Vec::new(),
+            });
+            starts.push(n);
+            continue;
+        }
+        let Some(cur) = cdf.params.last_mut() else {
+            return Err(FormatError::at_line(
+                path,
+                n,
+                K::Syntax,
+                format!(
+                    "expected NAME=STATUS (e.g. \"S=A\"), found \"{}\"",
+                    shorten(t)
+                ),
+            ));
+        };
+        let what = format!("a value of {}", cur.name);
+        let row = t
+            .split_whitespace()
+            .map(|tok| parse_f64(tok, path, n, &what))
+            .collect::<Result<Vec<_>, _>>()?;
+        if let Some((rows, cols)) = known_shape(&cur.name) {
+            if row.len() != cols {
+                return Err(FormatError::at_line(
+                    path,
+                    n,
+                    K::Syntax,
+                    format!(
+                        "{}: expected {cols} number(s) on this line, found {}",
+                        cur.name,
+                        row.len()
+                    ),
+                ));
+            }
+            if cur.rows.len() >= rows {
+                return Err(FormatError::at_line(
+                    path,
+                    n,
+                    K::Syntax,
+                    format!(
+                        "{} has {rows} value line(s); expected NAME=STATUS here, found \"{}\"",
+                        cur.name,
+                        shorten(t)
+                    ),
+                ));
+            }
+        }
+        cur.rows.push(row);
+    }
+    if let Some(prev) = cdf.params.last() {
+        check_shape(prev, starts.last().copied().unwrap_or(0), path)?;
+    }
+    if cdf.params.is_empty() {
+        return Err(FormatError::at_line(
+            path,
+            last_line.max(1),
+            K::Missing,
+            "no parameters: expected lines NAME=STATUS followed by values",
+        ));
+    }
+    Ok(cdf)
+}
+
+fn check_shape(p: &CdfParam, line: usize, path: &Path) -> Result<(), FormatError> {
+    let Some((rows, _)) = known_shape(&p.name) else {
+        return Ok(());
+    };
+    let ok = p.rows.len() == rows || (p.status == Status::NotAvailable && p.rows.is_empty());
+    if ok {
+        return Ok(());
+    }
+    Err(FormatError::at_line(
+        path,
+        line,
+        K::Missing,
+        format!(
+            "{} needs {rows} value line(s), found {}",
+            p.name,
+            p.rows.len()
+        ),
+    ))
+}
+
+/// The `.cdf` text of a description, exactly as formats.md §4 lays it out.
+pub fn format_cdf(c: &Cdf) -> String {
+    let mut s = String::new();
+    for p in &c.params {
+        s.push_str(&format!("{}={}\n", p.name, p.status.letter()));
+        for row in &p.rows {
+            let cells: Vec<String> = row.iter().map(|&v| fmt_exact(v)).collect();
+            s.push_str(&cells.join(" "));
+            s.push('\n');
+        }
+    }
+    s
+}
+
+/// Reads a `.cdf` file.
+pub fn read_cdf(path: &Path) -> Result<Cdf, FormatError> {
+    parse_cdf(&read_text(path)?, path)
+}
+
+/// Writes a `.cdf` file atomically. Refuses non-finite values, empty rows
+/// and names the reader would not accept.
+pub fn write_cdf(path: &Path, c: &Cdf) -> Result<(), FormatError> {
+    for p in &c.params {
+        let bad = |m: String| FormatError::new(path, super::Location::None, K::Range, m);
+        if !valid_name(&p.name) {
+            return Err(bad(format!(
+                "parameter name \"{}\" cannot be written",
+                shorten(&p.name)
+            )));
+        }
+        if p.rows.iter().any(|r| r.is_empty()) || p.values().any(|v| !v.is_finite()) {
+            return Err(bad(format!(
+                "parameter {} has an empty row or a non-finite value",
+                p.name
+            )));
+        }
+    }
+    write_bytes(path, format_cdf(c).as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SPEC: &str = "S=A\n0.011250\n0.007800\nC=E\n256.000000\n256.000000\nf=A\n11.892729\n\
+D=A\n-0.000527\n0.000379\n0.001330\n-0.000703\n-0.001406\nT=A\n\
+0.999943 -0.009549 -0.004720 -88.393677\n-0.010480 -0.961660 -0.274044 45.803197\n\
+-0.001920 0.274078 -0.961706 432.081189\n";
+
+    #[test]
+    fn spec_example_reads_and_writes_back_identically() {
+        let c = parse_cdf(SPEC, Path::new("cam1.cdf")).unwrap();
+        assert_eq!(format_cdf(&c), SPEC);
+        let m = c.camera_model().unwrap();
+        assert_eq!((m.sx, m.sy, m.cx, m.f), (0.01125, 0.0078, 256.0, 11.892729));
+        assert_eq!(m.distortion.unwrap()[0], -0.000527);
+        assert_eq!(c.extrinsic().unwrap()[2][3], 432.081189);
+        assert_eq!(c.get("C").unwrap().status, Status::Estimated);
+    }
+
+    #[test]
+    fn unknown_kept_and_d_n_means_no_distortion() {
+        let t = "S=A\r\n1\r\n1\r\nX=S\r\n1 2 3\r\n\r\nC=A\n0\n0\nf=A\n8\nD=N\n";
+        let c = parse_cdf(t, Path::new("a.cdf")).unwrap();
+        assert_eq!(c.params[1].name, "X");
+        assert_eq!(c.params[1].rows, vec![vec![1.0, 2.0, 3.0]]);
+        assert_eq!(c.camera_model().unwrap().distortion, None);
+        assert_eq!(c.extrinsic(), None);
+        let again = parse_cdf(&format_cdf(&c), Path::new("b.cdf")).unwrap();
+        assert_eq!(again, c);
+    }
+
+    #[test]
+    fn from_camera_round_trips() {
+        let c = parse_cdf(SPEC, Path::new("cam1.cdf")).unwrap();
+        let m = c.camera_model().unwrap();
+        let d = Cdf::from_camera(&m, c.extrinsic());
+        assert_eq!(d.camera_model(), Some(m));
+        assert_eq!(d.extrinsic(), c.extrinsic());
+    }
+}

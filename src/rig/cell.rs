@@ -1,0 +1,252 @@
+//! [`Cell`]: the grabber and the relay board a profile names, opened as real
+//! serial ports or as the embedded simulated cell on pseudo-terminals (the
+//! same drivers either way), plus the lighting configurations: switch to
+//! configuration `b`, read the relays back, wait the settle time, and always
+//! know which lights are on.
+
+use std::time::{Duration, Instant};
+
+use super::RigError;
+use super::grabber::{ClientConfig, FrameGrabber, VsgClient};
+use super::lights::{LcusBoard, LightSwitch, NumatoBoard};
+use super::protocol::FrameInfo;
+use super::sim::{Faults, SimCell};
+use crate::llv::GreyImage;
+use crate::profile::{GrabberKind, Profile, RelayKind};
+
+/// The cell's devices and what they are set to.
+pub struct Cell {
+    pub grabber: Box<dyn FrameGrabber>,
+    pub lights: Box<dyn LightSwitch>,
+    sim: Option<SimCell>,
+    profile: Profile,
+    /// The relays known to be on (read back from the board).
+    mask: u32,
+    lighting: Option<char>,
+}
+
+/// One captured frame and how it was taken.
+#[derive(Clone, Debug)]
+pub struct Capture {
+    pub image: GreyImage,
+    pub frame: FrameInfo,
+    pub camera: u32,
+    pub lighting: char,
+    pub lights_on: Vec<String>,
+    /// Switch + settle + freeze + transfer.
+    pub elapsed: Duration,
+}
+
+/// Channels of an LCUS board when the profile's lights do not say more.
+const LCUS_CHANNELS: u32 = 8;
+
+impl Cell {
+    /// Opens the cell a profile describes. `simulated` devices start the
+    /// embedded simulator on pseudo-terminals and the same drivers connect
+    /// to it; `vsg`/`numato`/`lcus` open the profile's serial ports.
+    pub fn open(profile: &Profile) -> Result<Cell, RigError> {
+        Cell::open_with_faults(profile, Faults::default())
+    }
+
+    /// Like [`Cell::open`], with faults injected into a simulated grabber.
+    pub fn open_with_faults(profile: &Profile, faults: Faults) -> Result<Cell, RigError> {
+        let needs_sim = profile.grabber.kind == GrabberKind::Simulated
+            || profile.relay.kind == RelayKind::Simulated;
+        let sim = if needs_sim {
+            Some(SimCell::from_profile(profile, faults)?)
+        } else {
+            None
+        };
+        let g = &profile.grabber;
+        let grabber_path = match (&g.kind, &sim) {
+            (GrabberKind::Simulated, Some(s)) => s.grabber_path().to_string(),
+            _ => g.port.clone(),
+        };
+        let grabber = VsgClient::open(&grabber_path, g.baud, ClientConfig::from_profile(g))?;
+        let r = &profile.relay;
+        let timeout = Duration::from_millis(r.timeout_ms.max(1));
+        let lights: Box<dyn LightSwitch> = match (&r.kind, &sim) {
+            (RelayKind::Simulated, Some(s)) => {
+                Box::new(NumatoBoard::open(s.relay_path(), r.baud, timeout)?)
+            }
+            (RelayKind::Lcus, _) => {
+                let channels = profile
+                    .lights
+                    .iter()
+                    .map(|l| l.relay + 1)
+                    .max()
+                    .unwrap_or(0)
+                    .max(LCUS_CHANNELS);
+                Box::new(LcusBoard::open(&r.port, channels, timeout)?)
+            }
+            _ => Box::new(NumatoBoard::open(&r.port, r.baud, timeout)?),
+        };
+        let mut cell = Cell {
+            grabber: Box::new(grabber),
+            lights,
+            sim,
+            profile: profile.clone(),
+            mask: 0,
+            lighting: None,
+        };
+        cell.mask = cell.lights.read_mask()?;
+        Ok(cell)
+    }
+
+    /// The embedded simulator, if the profile asked for one.
+    pub fn sim(&self) -> Option<&SimCell> {
+        self.sim.as_ref()
+    }
+
+    pub fn sim_mut(&mut self) -> Option<&mut SimCell> {
+        self.sim.as_mut()
+    }
+
+    pub fn profile(&self) -> &Profile {
+        &self.profile
+    }
+
+    /// The relay mask lighting configuration `letter` asks for.
+    pub fn mask_for(&self, letter: char) -> Result<u32, RigError> {
+        let Some(cfg) = self.profile.lighting.iter().find(|l| l.letter == letter) else {
+            let known: String = self.profile.lighting.iter().map(|l| l.letter).collect();
+            return Err(RigError::Config(format!(
+                "no lighting configuration `{letter}` in the profile (it has: {})",
+                if known.is_empty() {
+                    "none".into()
+                } else {
+                    known
+                }
+            )));
+        };
+        let mut mask = 0u32;
+        for name in &cfg.on {
+            let light = self
+                .profile
+                .lights
+                .iter()
+                .find(|l| &l.name == name)
+                .ok_or_else(|| {
+                    RigError::Config(format!(
+                        "lighting `{letter}` names light `{name}`, which is not in the profile's [[lights]]"
+                    ))
+                })?;
+            if light.relay >= 32 {
+                return Err(RigError::Config(format!(
+                    "light `{name}` is on relay {}; relays go from 0 to 31",
+                    light.relay
+                )));
+            }
+            mask |= 1 << light.relay;
+        }
+        Ok(mask)
+    }
+
+    /// Sets the relays to `mask`, reads them back, and remembers them.
+    pub fn set_lights(&mut self, mask: u32) -> Result<(), RigError> {
+        self.lighting = None;
+        let r = self.lights.set_mask(mask);
+        // Whatever happened, learn what is really on.
+        self.mask = self.lights.read_mask().unwrap_or(self.mask);
+        r?;
+        if self.mask != mask {
+            return Err(RigError::RelayMismatch {
+                port: self.lights.port_name().to_string(),
+                relay: "mask".into(),
+                expected: format!("{mask:04x}"),
+                got: format!("{:04x}", self.mask),
+            });
+        }
+        Ok(())
+    }
+
+    /// Switches to lighting configuration `letter` and waits the settle
+    /// time, so a freeze right after sees the new light.
+    pub fn switch_lighting(&mut self, letter: char) -> Result<(), RigError> {
+        let mask = self.mask_for(letter)?;
+        self.set_lights(mask)?;
+        self.lighting = Some(letter);
+        std::thread::sleep(Duration::from_millis(self.profile.relay.settle_ms));
+        Ok(())
+    }
+
+    /// The lighting configuration last switched to (`None` after a manual
+    /// change).
+    pub fn lighting(&self) -> Option<char> {
+        self.lighting
+    }
+
+    /// The relays known to be on.
+    pub fn mask(&self) -> u32 {
+        self.mask
+    }
+
+    /// Names of the lights that are on (relays without a light show as
+    /// `relay N`).
+    pub fn lights_on(&self) -> Vec<String> {
+        let mut names = Vec::new();
+        for bit in 0..32 {
+            if self.mask & (1 << bit) == 0 {
+                continue;
+            }
+            match self.profile.lights.iter().find(|l| l.relay == bit) {
+                Some(l) => names.push(l.name.clone()),
+                None => names.push(format!("relay {bit}")),
+            }
+        }
+        names
+    }
+
+    /// Selects `camera`, switches to `letter`, freezes and transfers.
+    /// A grabber that lost its frame on the way (a reset) is asked once
+    /// more; the frame returned has passed every CRC check.
+    pub fn capture(
+        &mut self,
+        camera: u32,
+        letter: char,
+        progress: &mut dyn FnMut(usize, usize) -> bool,
+    ) -> Result<Capture, RigError> {
+        let start = Instant::now();
+        self.switch_lighting(letter)?;
+        let mut again = true;
+        loop {
+            self.grabber.select_camera(camera)?;
+            let frame = self.grabber.freeze()?;
+            match self.grabber.transfer(progress) {
+                Ok(image) => {
+                    return Ok(Capture {
+                        image,
+                        frame,
+                        camera,
+                        lighting: letter,
+                        lights_on: self.lights_on(),
+                        elapsed: start.elapsed(),
+                    });
+                }
+                Err(RigError::NoFrame { .. }) if again => again = false,
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
+    /// After the grabber vanished: plug the simulated one back in, or
+    /// reopen the real port.
+    pub fn reconnect_grabber(&mut self) -> Result<(), RigError> {
+        if let (Some(sim), GrabberKind::Simulated) = (self.sim.as_mut(), self.profile.grabber.kind)
+        {
+            let path = if sim.grabber_plugged() {
+                sim.grabber_path().to_string()
+            } else {
+                sim.replug_grabber()?.to_string()
+            };
+            let g = &self.profile.grabber;
+            self.grabber = Box::new(VsgClient::open(
+                &path,
+                g.baud,
+                ClientConfig::from_profile(g),
+            )?);
+            return Ok(());
+        }
+        self.grabber.reconnect()
+    }
+}

@@ -1,0 +1,696 @@
+//! The frame grabber: [`FrameGrabber`] (the six basic operations of the
+//! original access program, plus STATUS) and [`VsgClient`], the VSG/1 client
+//! over any [`Link`] (serial port, pseudo-terminal, scripted bytes).
+//!
+//! What the shop floor needs from it (hardware.md §1): a timeout on every
+//! reply, bounded retries of commands that are safe to repeat, a re-sync
+//! after garbage, CRC checks per block and per frame with bad blocks re-read
+//! (in smaller blocks while the line is noisy), progress with cancel, and a
+//! clear error naming the port when the device vanishes.
+
+use std::io::{self, ErrorKind};
+use std::time::{Duration, Instant};
+
+use super::protocol::{
+    Command, ErrCode, FrameInfo, GrabberInfo, GrabberStatus, Reply, crc32, decode_line,
+};
+use super::{Link, RigError, SerialLink, open_serial};
+use crate::llv::GreyImage;
+
+/// The operations every grabber offers.
+pub trait FrameGrabber: Send {
+    /// Identifies the grabber (model, frame size, cameras, largest block).
+    fn hello(&mut self) -> Result<GrabberInfo, RigError>;
+    /// 0: initialise.
+    fn init(&mut self) -> Result<(), RigError>;
+    /// 1: live picture from camera `cam` (1-based) on the grabber's monitor.
+    fn live(&mut self, cam: u32) -> Result<(), RigError>;
+    /// 2: digitise into the grabber's memory.
+    fn freeze(&mut self) -> Result<FrameInfo, RigError>;
+    /// 3: select camera `cam` (1-based).
+    fn select_camera(&mut self, cam: u32) -> Result<(), RigError>;
+    /// 4: load an image into the grabber's memory.
+    fn load(&mut self, img: &GreyImage) -> Result<(), RigError>;
+    /// 5: transfer the frozen frame to the PC. `progress(done, total)` is
+    /// called after every block; returning `false` cancels.
+    fn transfer(
+        &mut self,
+        progress: &mut dyn FnMut(usize, usize) -> bool,
+    ) -> Result<GreyImage, RigError>;
+    fn status(&mut self) -> Result<GrabberStatus, RigError>;
+    /// The device path, for messages.
+    fn port_name(&self) -> &str;
+    /// Reopens the port after the device came back.
+    fn reconnect(&mut self) -> Result<(), RigError>;
+    /// Bytes moved so far.
+    fn wire_stats(&self) -> WireStats;
+}
+
+/// Counters of what went over the wire.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WireStats {
+    /// Bytes sent to the device.
+    pub tx: u64,
+    /// Bytes received from the device.
+    pub rx: u64,
+    /// Frame bytes delivered (good blocks only).
+    pub payload: u64,
+    /// Commands sent again after a timeout or garbage.
+    pub retries: u64,
+    /// Blocks that failed their CRC or came short.
+    pub bad_blocks: u64,
+    pub resyncs: u64,
+}
+
+impl WireStats {
+    /// Bytes on the wire (both ways) per payload byte.
+    pub fn overhead(&self) -> f64 {
+        if self.payload == 0 {
+            return f64::NAN;
+        }
+        (self.tx + self.rx) as f64 / self.payload as f64
+    }
+}
+
+/// Settings of a [`VsgClient`].
+#[derive(Clone, Debug)]
+pub struct ClientConfig {
+    /// Wait for the first byte of a reply.
+    pub timeout: Duration,
+    /// Retries of a command that is safe to repeat.
+    pub retries: u32,
+    /// Bytes per READ (capped by the grabber's maxblock).
+    pub block: u32,
+}
+
+impl ClientConfig {
+    pub fn from_profile(g: &crate::profile::GrabberConfig) -> ClientConfig {
+        ClientConfig {
+            timeout: Duration::from_millis(g.timeout_ms.max(1)),
+            retries: g.retries,
+            block: g.block.max(1),
+        }
+    }
+}
+
+/// The smallest block a noisy line shrinks READs to.
+const MIN_BLOCK: u32 = 128;
+/// Good blocks in a row before the block size doubles again.
+const GROW_AFTER: u32 = 4;
+/// A reply line longer than this is garbage.
+const MAX_LINE: usize = 256;
+/// Quiet time that ends a re-sync.
+const QUIET: Duration = Duration::from_millis(40);
+/// The largest frame a reply may announce (guards allocations).
+const MAX_FRAME: usize = 1 << 28;
+
+/// Why reading a reply failed, before it becomes a [`RigError`].
+enum ReadFail {
+    Timeout,
+    Vanished(io::Error),
+    Garbage(String),
+}
+
+type Reopen<P> = Box<dyn FnMut() -> Result<P, RigError> + Send>;
+
+/// A VSG/1 client over a byte stream.
+pub struct VsgClient<P: Link> {
+    port: P,
+    name: String,
+    cfg: ClientConfig,
+    /// Longest silence inside a reply once it has started.
+    gap: Duration,
+    info: Option<GrabberInfo>,
+    frame: Option<FrameInfo>,
+    /// Received, not yet consumed bytes.
+    rx: Vec<u8>,
+    buf: Vec<u8>,
+    stats: WireStats,
+    reopen: Option<Reopen<P>>,
+}
+
+impl VsgClient<SerialLink> {
+    /// Opens the grabber on a serial device (or a pseudo-terminal) and says
+    /// HELLO. The client remembers the path for [`FrameGrabber::reconnect`].
+    pub fn open(path: &str, baud: u32, cfg: ClientConfig) -> Result<Self, RigError> {
+        let port = open_serial(path, baud, cfg.timeout)?;
+        let (p, t) = (path.to_string(), cfg.timeout);
+        let mut c = VsgClient::new(port, path, cfg);
+        c.reopen = Some(Box::new(move || open_serial(&p, baud, t)));
+        c.connect()?;
+        Ok(c)
+    }
+}
+
+impl<P: Link> VsgClient<P> {
+    /// Wraps a stream; call [`VsgClient::connect`] before use.
+    pub fn new(port: P, name: &str, cfg: ClientConfig) -> Self {
+        let gap = (cfg.timeout / 5).clamp(Duration::from_millis(50), Duration::from_millis(500));
+        VsgClient {
+            port,
+            name: name.to_string(),
+            cfg,
+            gap,
+            info: None,
+            frame: None,
+            rx: Vec::new(),
+            buf: vec![0; 65536],
+            stats: WireStats::default(),
+            reopen: None,
+        }
+    }
+
+    /// Discards whatever the line holds (garbage on connect), then HELLO.
+    pub fn connect(&mut self) -> Result<GrabberInfo, RigError> {
+        self.resync()?;
+        self.hello()
+    }
+
+    /// The grabber as HELLO described it.
+    pub fn info(&self) -> Option<&GrabberInfo> {
+        self.info.as_ref()
+    }
+
+    /// The frame the last FREEZE reported.
+    pub fn frame(&self) -> Option<FrameInfo> {
+        self.frame
+    }
+
+    /// The stream (tests inspect what was sent).
+    pub fn port_mut(&mut self) -> &mut P {
+        &mut self.port
+    }
+
+    fn vanished(&self, source: io::Error) -> RigError {
+        RigError::Vanished {
+            port: self.name.clone(),
+            source,
+        }
+    }
+
+    /// Reads whatever arrives within `wait` into `rx`.
+    fn fill(&mut self, wait: Duration) -> Result<(), ReadFail> {
+        self.port
+            .set_timeout(wait.max(Duration::from_millis(1)))
+            .map_err(ReadFail::Vanished)?;
+        loop {
+            match self.port.read(&mut self.buf) {
+                Ok(0) => {
+                    return Err(ReadFail::Vanished(io::Error::new(
+                        ErrorKind::UnexpectedEof,
+                        "end of file",
+                    )));
+                }
+                Ok(n) => {
+                    self.stats.rx += n as u64;
+                    self.rx
+                        .extend_from_slice(self.buf.get(..n).unwrap_or_default());
+                    return Ok(());
+                }
+                Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock) => {
+                    return Err(ReadFail::Timeout);
+                }
+                Err(e) => return Err(ReadFail::Vanished(e)),
+            }
+        }
+    }
+
+    /// One line (without `\r\n`): the first byte may take `timeout`, the
+    /// rest must follow without a gap.
+    fn read_line(&mut self) -> Result<Vec<u8>, ReadFail> {
+        let deadline = Instant::now() + self.cfg.timeout;
+        loop {
+            if let Some(i) = self.rx.iter().position(|&b| b == b'\n') {
+                let mut line: Vec<u8> = self.rx.drain(..=i).collect();
+                line.pop();
+                if line.last() == Some(&b'\r') {
+                    line.pop();
+                }
+                // Stray bytes before a line (a dropped `\n` earlier) make it
+                // garbage; the checksum catches them.
+                return Ok(line);
+            }
+            if self.rx.len() > MAX_LINE {
+                return Err(ReadFail::Garbage(format!(
+                    "{} bytes without a line end",
+                    self.rx.len()
+                )));
+            }
+            let wait = if self.rx.is_empty() {
+                deadline.saturating_duration_since(Instant::now())
+            } else {
+                self.gap
+            };
+            if wait.is_zero() {
+                return Err(ReadFail::Timeout);
+            }
+            match self.fill(wait) {
+                Err(ReadFail::Timeout) if !self.rx.is_empty() => {
+                    return Err(ReadFail::Garbage(format!(
+                        "a line stopped after {} bytes",
+                        self.rx.len()
+                    )));
+                }
+                r => r?,
+            }
+        }
+    }
+
+    /// Exactly `n` raw bytes following a DATA line, without a gap.
+    fn read_exact(&mut self, n: usize) -> Result<Vec<u8>, ReadFail> {
+        while self.rx.len() < n {
+            match self.fill(self.gap) {
+                Err(ReadFail::Timeout) => {
+                    return Err(ReadFail::Garbage(format!(
+                        "a block stopped after {} of {n} bytes",
+                        self.rx.len()
+                    )));
+                }
+                r => r?,
+            }
+        }
+        Ok(self.rx.drain(..n).collect())
+    }
+
+    fn read_reply(&mut self) -> Result<Reply, ReadFail> {
+        let line = self.read_line()?;
+        let text = decode_line(&line).map_err(|e| {
+            ReadFail::Garbage(format!("{e} in {:?}", String::from_utf8_lossy(&line)))
+        })?;
+        Reply::parse(text).ok_or_else(|| ReadFail::Garbage(format!("unknown reply {text:?}")))
+    }
+
+    fn send_raw(&mut self, bytes: &[u8]) -> Result<(), RigError> {
+        let r = self
+            .port
+            .set_timeout(self.cfg.timeout)
+            .and_then(|()| self.port.write_all(bytes))
+            .and_then(|()| self.port.flush());
+        match r {
+            Ok(()) => {
+                self.stats.tx += bytes.len() as u64;
+                Ok(())
+            }
+            Err(e) => Err(self.vanished(e)),
+        }
+    }
+
+    fn send(&mut self, cmd: &Command) -> Result<(), RigError> {
+        self.send_raw(&cmd.encode())
+    }
+
+    /// Re-sync after garbage: an empty line ends whatever the device was
+    /// receiving, then everything is discarded until the line is quiet.
+    pub fn resync(&mut self) -> Result<(), RigError> {
+        self.stats.resyncs += 1;
+        self.send_raw(b"\r\n")?;
+        self.rx.clear();
+        // A device that never stops talking is not waited on for ever.
+        let give_up = Instant::now() + self.cfg.timeout.max(Duration::from_secs(2));
+        while Instant::now() < give_up {
+            match self.fill(QUIET) {
+                Ok(()) => self.rx.clear(),
+                Err(ReadFail::Timeout) => return Ok(()),
+                Err(ReadFail::Vanished(e)) => return Err(self.vanished(e)),
+                Err(ReadFail::Garbage(_)) => self.rx.clear(),
+            }
+        }
+        self.rx.clear();
+        Ok(())
+    }
+
+    /// Skips the payload of a DATA reply that answered an earlier command
+    /// (it arrived late, after a stall).
+    fn skip_stale(&mut self, len: u32) -> Result<(), ReadFail> {
+        self.read_exact(len as usize).map(|_| ())
+    }
+
+    /// Sends `cmd` and returns the first reply `accept` takes (ERR replies
+    /// are always taken). Retries commands safe to repeat after a timeout,
+    /// garbage, or `ERR CHECKSUM` (the command was garbled on its way).
+    fn exchange(
+        &mut self,
+        cmd: Command,
+        accept: impl Fn(&Reply) -> bool,
+    ) -> Result<Reply, RigError> {
+        let attempts = if cmd.is_idempotent() {
+            self.cfg.retries + 1
+        } else {
+            1
+        };
+        let mut last = None;
+        for attempt in 1..=attempts {
+            if attempt > 1 {
+                self.stats.retries += 1;
+            }
+            self.send(&cmd)?;
+            let fail = loop {
+                match self.read_reply() {
+                    Ok(Reply::Data { len, .. }) => {
+                        if let Err(f) = self.skip_stale(len) {
+                            break f;
+                        }
+                    }
+                    Ok(Reply::Err {
+                        code: ErrCode::Checksum,
+                        text,
+                    }) => break ReadFail::Garbage(format!("device saw a bad checksum {text}")),
+                    Ok(r @ Reply::Err { .. }) => return self.device_err(&cmd, r),
+                    Ok(r) if accept(&r) => return Ok(r),
+                    // A late OK to an earlier command: keep listening.
+                    Ok(_) => {}
+                    Err(f) => break f,
+                }
+            };
+            match fail {
+                ReadFail::Vanished(e) => return Err(self.vanished(e)),
+                ReadFail::Timeout => last = None,
+                ReadFail::Garbage(d) => last = Some(d),
+            }
+            self.resync()?;
+        }
+        Err(match last {
+            None => RigError::Timeout {
+                port: self.name.clone(),
+                command: cmd.to_string(),
+                timeout_ms: self.cfg.timeout.as_millis() as u64,
+                attempts,
+            },
+            Some(detail) => RigError::Garbled {
+                port: self.name.clone(),
+                command: cmd.to_string(),
+                detail,
+                attempts,
+            },
+        })
+    }
+
+    fn device_err<T>(&self, cmd: &Command, r: Reply) -> Result<T, RigError> {
+        match r {
+            Reply::Err {
+                code: ErrCode::NoFrame,
+                ..
+            } => Err(RigError::NoFrame {
+                port: self.name.clone(),
+            }),
+            Reply::Err { code, text } => Err(RigError::Device {
+                port: self.name.clone(),
+                command: cmd.to_string(),
+                code,
+                text,
+            }),
+            other => Err(RigError::Garbled {
+                port: self.name.clone(),
+                command: cmd.to_string(),
+                detail: format!("unexpected reply `{other}`"),
+                attempts: 1,
+            }),
+        }
+    }
+
+    fn ok_plain(&mut self, cmd: Command) -> Result<(), RigError> {
+        self.exchange(cmd, |r| matches!(r, Reply::Ok(s) if s.is_empty()))
+            .map(|_| ())
+    }
+
+    /// One READ of `len` bytes at `off`, with its CRC checked.
+    /// `Ok(None)` means the block came bad (short, garbled, wrong CRC).
+    fn read_block(&mut self, off: u32, len: u32) -> Result<Option<Vec<u8>>, RigError> {
+        let cmd = Command::Read { off, len };
+        self.send(&cmd)?;
+        let fail = loop {
+            match self.read_reply() {
+                Ok(Reply::Data {
+                    off: o,
+                    len: l,
+                    crc,
+                }) if o == off && l == len => match self.read_exact(len as usize) {
+                    Ok(data) if crc32(&data) == crc => return Ok(Some(data)),
+                    Ok(_) => break None,
+                    Err(f) => break Some(f),
+                },
+                Ok(Reply::Data { len: l, .. }) => {
+                    if let Err(f) = self.skip_stale(l) {
+                        break Some(f);
+                    }
+                }
+                Ok(Reply::Err {
+                    code: ErrCode::Checksum,
+                    ..
+                }) => break None,
+                Ok(r @ Reply::Err { .. }) => return self.device_err(&cmd, r),
+                Ok(_) => {}
+                Err(f) => break Some(f),
+            }
+        };
+        if let Some(ReadFail::Vanished(e)) = fail {
+            return Err(self.vanished(e));
+        }
+        self.stats.bad_blocks += 1;
+        self.resync()?;
+        Ok(None)
+    }
+
+    /// The whole frozen frame, block by block.
+    fn read_frame(
+        &mut self,
+        frame: FrameInfo,
+        progress: &mut dyn FnMut(usize, usize) -> bool,
+    ) -> Result<GreyImage, RigError> {
+        let total = frame.len();
+        if total == 0 || total > MAX_FRAME {
+            return Err(RigError::Garbled {
+                port: self.name.clone(),
+                command: "FREEZE".into(),
+                detail: format!("frame size {} x {}", frame.width, frame.height),
+                attempts: 1,
+            });
+        }
+        let maxblock = self.info.as_ref().map_or(u32::MAX, |i| i.maxblock.max(1));
+        let full = self.cfg.block.min(maxblock).max(1);
+        let mut block = full;
+        let mut good_run = 0;
+        let mut data = Vec::with_capacity(total);
+        let budget = 2 + 2 * self.cfg.retries;
+        let mut failures = 0;
+        while data.len() < total {
+            let off = data.len();
+            let len = block.min((total - off) as u32);
+            match self.read_block(off as u32, len)? {
+                Some(bytes) => {
+                    data.extend_from_slice(&bytes);
+                    self.stats.payload += u64::from(len);
+                    failures = 0;
+                    good_run += 1;
+                    if good_run >= GROW_AFTER && block < full {
+                        block = (block * 2).min(full);
+                        good_run = 0;
+                    }
+                    if !progress(data.len(), total) {
+                        return Err(RigError::Cancelled {
+                            port: self.name.clone(),
+                            done: data.len(),
+                            total,
+                        });
+                    }
+                }
+                None => {
+                    good_run = 0;
+                    if block > MIN_BLOCK {
+                        // A noisy line: smaller blocks get through.
+                        block = (block / 2).max(MIN_BLOCK);
+                    } else {
+                        failures += 1;
+                        if failures >= budget {
+                            return Err(RigError::BlockCrc {
+                                port: self.name.clone(),
+                                offset: off,
+                                attempts: failures,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        let got = crc32(&data);
+        if got != frame.crc {
+            return Err(RigError::FrameCrc {
+                port: self.name.clone(),
+                expected: frame.crc,
+                got,
+            });
+        }
+        GreyImage::new(frame.width as usize, frame.height as usize, data)
+            .map_err(|e| RigError::Config(e.to_string()))
+    }
+
+    fn garbled(&self, cmd: &str, r: &Reply) -> RigError {
+        RigError::Garbled {
+            port: self.name.clone(),
+            command: cmd.to_string(),
+            detail: format!("unexpected reply `{r}`"),
+            attempts: 1,
+        }
+    }
+}
+
+impl<P: Link> FrameGrabber for VsgClient<P> {
+    fn hello(&mut self) -> Result<GrabberInfo, RigError> {
+        let r = self.exchange(
+            Command::Hello,
+            |r| matches!(r, Reply::Ok(s) if GrabberInfo::parse(s).is_some()),
+        )?;
+        let info = match &r {
+            Reply::Ok(s) => GrabberInfo::parse(s),
+            _ => None,
+        }
+        .ok_or_else(|| self.garbled("HELLO", &r))?;
+        self.info = Some(info.clone());
+        Ok(info)
+    }
+
+    fn init(&mut self) -> Result<(), RigError> {
+        self.frame = None;
+        self.ok_plain(Command::Init)
+    }
+
+    fn live(&mut self, cam: u32) -> Result<(), RigError> {
+        self.ok_plain(Command::Live(cam))
+    }
+
+    fn freeze(&mut self) -> Result<FrameInfo, RigError> {
+        self.frame = None;
+        let r = self.exchange(
+            Command::Freeze,
+            |r| matches!(r, Reply::Ok(s) if FrameInfo::parse(s).is_some()),
+        )?;
+        let f = match &r {
+            Reply::Ok(s) => FrameInfo::parse(s),
+            _ => None,
+        }
+        .ok_or_else(|| self.garbled("FREEZE", &r))?;
+        self.frame = Some(f);
+        Ok(f)
+    }
+
+    fn select_camera(&mut self, cam: u32) -> Result<(), RigError> {
+        self.ok_plain(Command::Camera(cam))
+    }
+
+    fn load(&mut self, img: &GreyImage) -> Result<(), RigError> {
+        let (w, h) = img.size();
+        let data = img.data();
+        let crc = crc32(data);
+        let cmd = Command::Load {
+            width: w as u32,
+            height: h as u32,
+            crc,
+        };
+        self.ok_plain(cmd)?;
+        let maxblock = self.info.as_ref().map_or(u32::MAX, |i| i.maxblock.max(1));
+        let block = self.cfg.block.min(maxblock).max(1) as usize;
+        let mut off = 0;
+        while off < data.len() {
+            let chunk = data
+                .get(off..(off + block).min(data.len()))
+                .unwrap_or_default();
+            let wcmd = Command::Write {
+                off: off as u32,
+                len: chunk.len() as u32,
+                crc: crc32(chunk),
+            };
+            let mut bytes = wcmd.encode();
+            bytes.extend_from_slice(chunk);
+            self.send_raw(&bytes)?;
+            match self.read_reply() {
+                Ok(Reply::Ok(_)) => off += chunk.len(),
+                Ok(r @ Reply::Err { .. }) => return self.device_err(&wcmd, r),
+                Ok(r) => return Err(self.garbled(&wcmd.to_string(), &r)),
+                Err(ReadFail::Vanished(e)) => return Err(self.vanished(e)),
+                Err(ReadFail::Timeout) => {
+                    return Err(RigError::Timeout {
+                        port: self.name.clone(),
+                        command: wcmd.to_string(),
+                        timeout_ms: self.cfg.timeout.as_millis() as u64,
+                        attempts: 1,
+                    });
+                }
+                Err(ReadFail::Garbage(detail)) => {
+                    return Err(RigError::Garbled {
+                        port: self.name.clone(),
+                        command: wcmd.to_string(),
+                        detail,
+                        attempts: 1,
+                    });
+                }
+            }
+        }
+        self.frame = Some(FrameInfo {
+            width: w as u32,
+            height: h as u32,
+            crc,
+        });
+        Ok(())
+    }
+
+    fn transfer(
+        &mut self,
+        progress: &mut dyn FnMut(usize, usize) -> bool,
+    ) -> Result<GreyImage, RigError> {
+        let frame = match self.frame {
+            Some(f) => f,
+            None => {
+                // Someone else froze (a second console, the front panel):
+                // the grabber knows the CRC, HELLO the size.
+                let st = self.status()?;
+                let info = match &self.info {
+                    Some(i) => i.clone(),
+                    None => self.hello()?,
+                };
+                let crc = st.frame.ok_or_else(|| RigError::NoFrame {
+                    port: self.name.clone(),
+                })?;
+                FrameInfo {
+                    width: info.width,
+                    height: info.height,
+                    crc,
+                }
+            }
+        };
+        self.read_frame(frame, progress)
+    }
+
+    fn status(&mut self) -> Result<GrabberStatus, RigError> {
+        let r = self.exchange(
+            Command::Status,
+            |r| matches!(r, Reply::Ok(s) if GrabberStatus::parse(s).is_some()),
+        )?;
+        match &r {
+            Reply::Ok(s) => GrabberStatus::parse(s),
+            _ => None,
+        }
+        .ok_or_else(|| self.garbled("STATUS", &r))
+    }
+
+    fn port_name(&self) -> &str {
+        &self.name
+    }
+
+    fn reconnect(&mut self) -> Result<(), RigError> {
+        let Some(reopen) = self.reopen.as_mut() else {
+            return Err(RigError::Config(format!(
+                "{}: this grabber connection cannot be reopened",
+                self.name
+            )));
+        };
+        self.port = reopen()?;
+        self.rx.clear();
+        self.frame = None;
+        self.connect().map(|_| ())
+    }
+
+    fn wire_stats(&self) -> WireStats {
+        self.stats
+    }
+}

@@ -1,0 +1,667 @@
+//! Pure encode/decode of the cell's wire protocols (hardware.md §1–2): VSG/1
+//! command and reply lines (`TEXT*HH\r\n`, XOR checksum in uppercase hex),
+//! CRC-32, Numato relay commands and replies, and LCUS/CH340 frames.
+//!
+//! Nothing here touches a port, so the drivers and the simulator share one
+//! definition of every byte, and the unit tests below feed scripted bytes.
+
+use std::fmt;
+
+/// The XOR of all bytes of `text` (NMEA 0183 convention).
+pub fn checksum(text: &[u8]) -> u8 {
+    text.iter().fold(0, |acc, b| acc ^ b)
+}
+
+/// `TEXT*HH\r\n`.
+pub fn encode_line(text: &str) -> Vec<u8> {
+    let mut out = Vec::with_capacity(text.len() + 5);
+    out.extend_from_slice(text.as_bytes());
+    out.extend_from_slice(format!("*{:02X}\r\n", checksum(text.as_bytes())).as_bytes());
+    out
+}
+
+/// Why a received line is not a valid `TEXT*HH` line.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum LineError {
+    #[error("no `*HH` checksum at the end of the line")]
+    NoChecksum,
+    #[error("checksum field `{0}` is not two hex digits")]
+    BadHex(String),
+    #[error("checksum {found:02X} does not match the line's {computed:02X}")]
+    Mismatch { found: u8, computed: u8 },
+    #[error("the line holds non-ASCII or control bytes")]
+    NotAscii,
+}
+
+/// Checks a line (without its `\r\n`) and returns its `TEXT`.
+pub fn decode_line(line: &[u8]) -> Result<&str, LineError> {
+    let star = line
+        .iter()
+        .rposition(|&b| b == b'*')
+        .ok_or(LineError::NoChecksum)?;
+    let (text, tail) = line.split_at(star);
+    let hex = tail.get(1..).unwrap_or_default();
+    let hex_str = String::from_utf8_lossy(hex).into_owned();
+    if hex.len() != 2 || !hex.iter().all(u8::is_ascii_hexdigit) {
+        return Err(LineError::BadHex(hex_str));
+    }
+    let found = u8::from_str_radix(&hex_str, 16).map_err(|_| LineError::BadHex(hex_str))?;
+    let computed = checksum(text);
+    if found != computed {
+        return Err(LineError::Mismatch { found, computed });
+    }
+    if !text.iter().all(|&b| (0x20..0x7f).contains(&b)) {
+        return Err(LineError::NotAscii);
+    }
+    std::str::from_utf8(text).map_err(|_| LineError::NotAscii)
+}
+
+/// CRC-32 (IEEE, as in zlib).
+pub fn crc32(bytes: &[u8]) -> u32 {
+    crc32fast::hash(bytes)
+}
+
+fn parse_crc(s: &str) -> Option<u32> {
+    (s.len() == 8)
+        .then(|| u32::from_str_radix(s, 16).ok())
+        .flatten()
+}
+
+/// A VSG/1 command.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Command {
+    Hello,
+    Init,
+    Live(u32),
+    Freeze,
+    Camera(u32),
+    Load { width: u32, height: u32, crc: u32 },
+    Write { off: u32, len: u32, crc: u32 },
+    Read { off: u32, len: u32 },
+    Status,
+}
+
+impl fmt::Display for Command {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Command::Hello => write!(f, "HELLO"),
+            Command::Init => write!(f, "INIT"),
+            Command::Live(n) => write!(f, "LIVE {n}"),
+            Command::Freeze => write!(f, "FREEZE"),
+            Command::Camera(n) => write!(f, "CAMERA {n}"),
+            Command::Load { width, height, crc } => write!(f, "LOAD {width} {height} {crc:08X}"),
+            Command::Write { off, len, crc } => write!(f, "WRITE {off} {len} {crc:08X}"),
+            Command::Read { off, len } => write!(f, "READ {off} {len}"),
+            Command::Status => write!(f, "STATUS"),
+        }
+    }
+}
+
+impl Command {
+    /// The line that goes on the wire.
+    pub fn encode(&self) -> Vec<u8> {
+        encode_line(&self.to_string())
+    }
+
+    /// Whether sending it twice does no harm, so a lost reply may be retried.
+    /// FREEZE qualifies: a second freeze replaces a frame nobody has read,
+    /// and the CRC of the reply we accept is the CRC of the frame in memory.
+    pub fn is_idempotent(&self) -> bool {
+        matches!(
+            self,
+            Command::Hello
+                | Command::Read { .. }
+                | Command::Status
+                | Command::Camera(_)
+                | Command::Freeze
+                | Command::Init
+                | Command::Live(_)
+        )
+    }
+
+    /// Parses a command's `TEXT`; `None` for anything not a VSG/1 command
+    /// (answered `ERR BADCMD`).
+    pub fn parse(text: &str) -> Option<Command> {
+        let mut words = text.split(' ');
+        let verb = words.next()?;
+        let nums: Vec<&str> = words.collect();
+        let num = |i: usize| nums.get(i).and_then(|s| s.parse::<u32>().ok());
+        let crc = |i: usize| nums.get(i).and_then(|s| parse_crc(s));
+        let cmd = match (verb, nums.len()) {
+            ("HELLO", 0) => Command::Hello,
+            ("INIT", 0) => Command::Init,
+            ("LIVE", 1) => Command::Live(num(0)?),
+            ("FREEZE", 0) => Command::Freeze,
+            ("CAMERA", 1) => Command::Camera(num(0)?),
+            ("LOAD", 3) => Command::Load {
+                width: num(0)?,
+                height: num(1)?,
+                crc: crc(2)?,
+            },
+            ("WRITE", 3) => Command::Write {
+                off: num(0)?,
+                len: num(1)?,
+                crc: crc(2)?,
+            },
+            ("READ", 2) => Command::Read {
+                off: num(0)?,
+                len: num(1)?,
+            },
+            ("STATUS", 0) => Command::Status,
+            _ => return None,
+        };
+        Some(cmd)
+    }
+}
+
+/// Error codes of `ERR CODE text`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ErrCode {
+    BadCmd,
+    Checksum,
+    Range,
+    NoFrame,
+    Busy,
+    Crc,
+    Other(String),
+}
+
+impl ErrCode {
+    pub fn parse(s: &str) -> ErrCode {
+        match s {
+            "BADCMD" => ErrCode::BadCmd,
+            "CHECKSUM" => ErrCode::Checksum,
+            "RANGE" => ErrCode::Range,
+            "NOFRAME" => ErrCode::NoFrame,
+            "BUSY" => ErrCode::Busy,
+            "CRC" => ErrCode::Crc,
+            other => ErrCode::Other(other.to_string()),
+        }
+    }
+}
+
+impl fmt::Display for ErrCode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = match self {
+            ErrCode::BadCmd => "BADCMD",
+            ErrCode::Checksum => "CHECKSUM",
+            ErrCode::Range => "RANGE",
+            ErrCode::NoFrame => "NOFRAME",
+            ErrCode::Busy => "BUSY",
+            ErrCode::Crc => "CRC",
+            ErrCode::Other(s) => s,
+        };
+        f.write_str(s)
+    }
+}
+
+/// A VSG/1 reply line.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Reply {
+    /// `OK …`: the words after `OK` (possibly empty).
+    Ok(String),
+    /// `ERR CODE free text`.
+    Err { code: ErrCode, text: String },
+    /// `DATA off len CRC`, followed on the wire by `len` raw bytes.
+    Data { off: u32, len: u32, crc: u32 },
+}
+
+impl fmt::Display for Reply {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Reply::Ok(rest) if rest.is_empty() => write!(f, "OK"),
+            Reply::Ok(rest) => write!(f, "OK {rest}"),
+            Reply::Err { code, text } if text.is_empty() => write!(f, "ERR {code}"),
+            Reply::Err { code, text } => write!(f, "ERR {code} {text}"),
+            Reply::Data { off, len, crc } => write!(f, "DATA {off} {len} {crc:08X}"),
+        }
+    }
+}
+
+impl Reply {
+    pub fn encode(&self) -> Vec<u8> {
+        encode_line(&self.to_string())
+    }
+
+    pub fn err(code: ErrCode, text: &str) -> Reply {
+        Reply::Err {
+            code,
+            text: text.to_string(),
+        }
+    }
+
+    /// Parses a reply's `TEXT`; `None` if it is neither OK, ERR nor DATA.
+    pub fn parse(text: &str) -> Option<Reply> {
+        if text == "OK" {
+            return Some(Reply::Ok(String::new()));
+        }
+        if let Some(rest) = text.strip_prefix("OK ") {
+            return Some(Reply::Ok(rest.to_string()));
+        }
+        if let Some(rest) = text.strip_prefix("ERR ") {
+            let (code, msg) = rest.split_once(' ').unwrap_or((rest, ""));
+            return Some(Reply::Err {
+                code: ErrCode::parse(code),
+                text: msg.to_string(),
+            });
+        }
+        if let Some(rest) = text.strip_prefix("DATA ") {
+            let w: Vec<&str> = rest.split(' ').collect();
+            if let [off, len, crc] = w.as_slice() {
+                return Some(Reply::Data {
+                    off: off.parse().ok()?,
+                    len: len.parse().ok()?,
+                    crc: parse_crc(crc)?,
+                });
+            }
+        }
+        None
+    }
+}
+
+/// Finds `key=value` in the words of an OK reply.
+fn field<'a>(words: &'a str, key: &str) -> Option<&'a str> {
+    words
+        .split(' ')
+        .find_map(|w| w.strip_prefix(key).and_then(|r| r.strip_prefix('=')))
+}
+
+/// What `HELLO` says about the grabber.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GrabberInfo {
+    pub model: String,
+    pub width: u32,
+    pub height: u32,
+    pub depth: u32,
+    pub cameras: u32,
+    pub maxblock: u32,
+}
+
+impl GrabberInfo {
+    /// The words after `OK` of a HELLO reply.
+    pub fn format(&self) -> String {
+        format!(
+            "VSG/1 model={} width={} height={} depth={} cameras={} maxblock={}",
+            self.model, self.width, self.height, self.depth, self.cameras, self.maxblock
+        )
+    }
+
+    pub fn parse(words: &str) -> Option<GrabberInfo> {
+        if !words.starts_with("VSG/1") {
+            return None;
+        }
+        let n = |k: &str| field(words, k).and_then(|v| v.parse::<u32>().ok());
+        Some(GrabberInfo {
+            model: field(words, "model")?.to_string(),
+            width: n("width")?,
+            height: n("height")?,
+            depth: n("depth")?,
+            cameras: n("cameras")?,
+            maxblock: n("maxblock")?,
+        })
+    }
+}
+
+/// The frozen frame as `FREEZE` reports it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameInfo {
+    pub width: u32,
+    pub height: u32,
+    pub crc: u32,
+}
+
+impl FrameInfo {
+    pub fn format(&self) -> String {
+        format!("FRAME {} {} {:08X}", self.width, self.height, self.crc)
+    }
+
+    pub fn parse(words: &str) -> Option<FrameInfo> {
+        let w: Vec<&str> = words.split(' ').collect();
+        match w.as_slice() {
+            ["FRAME", wd, ht, crc] => Some(FrameInfo {
+                width: wd.parse().ok()?,
+                height: ht.parse().ok()?,
+                crc: parse_crc(crc)?,
+            }),
+            _ => None,
+        }
+    }
+
+    /// Bytes of the frame (8-bit pixels).
+    pub fn len(&self) -> usize {
+        (self.width as usize).saturating_mul(self.height as usize)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// What `STATUS` says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GrabberStatus {
+    pub camera: u32,
+    pub live: bool,
+    /// CRC of the frame in memory, `None` before any FREEZE/LOAD.
+    pub frame: Option<u32>,
+}
+
+impl GrabberStatus {
+    pub fn format(&self) -> String {
+        let frame = match self.frame {
+            Some(c) => format!("{c:08X}"),
+            None => "none".to_string(),
+        };
+        format!(
+            "camera={} live={} frame={frame}",
+            self.camera,
+            u8::from(self.live)
+        )
+    }
+
+    pub fn parse(words: &str) -> Option<GrabberStatus> {
+        let frame = match field(words, "frame")? {
+            "none" => None,
+            c => Some(parse_crc(c)?),
+        };
+        Some(GrabberStatus {
+            camera: field(words, "camera")?.parse().ok()?,
+            live: match field(words, "live")? {
+                "0" => false,
+                "1" => true,
+                _ => return None,
+            },
+            frame,
+        })
+    }
+}
+
+// ---------------------------------------------------------------- Numato
+
+/// The character naming relay `n` on a Numato board: `0`–`9`, then `A`…`V`.
+pub fn numato_relay_char(n: u32) -> Option<char> {
+    match n {
+        0..=9 => char::from_digit(n, 10),
+        10..=31 => char::from_u32('A' as u32 + n - 10),
+        _ => None,
+    }
+}
+
+/// The inverse of [`numato_relay_char`] (either case).
+pub fn numato_relay_index(c: &str) -> Option<u32> {
+    let mut chars = c.chars();
+    let ch = chars.next()?.to_ascii_uppercase();
+    if chars.next().is_some() {
+        return None;
+    }
+    match ch {
+        '0'..='9' => ch.to_digit(10),
+        'A'..='V' => Some(ch as u32 - 'A' as u32 + 10),
+        _ => None,
+    }
+}
+
+/// A Numato command.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum NumatoCommand {
+    Ver,
+    On(u32),
+    Off(u32),
+    Read(u32),
+    ReadAll,
+    WriteAll(u32),
+}
+
+impl NumatoCommand {
+    /// The text typed to the board (without the trailing `\r`); `None` if
+    /// the relay number has no Numato character.
+    pub fn text(&self) -> Option<String> {
+        Some(match self {
+            NumatoCommand::Ver => "ver".to_string(),
+            NumatoCommand::On(n) => format!("relay on {}", numato_relay_char(*n)?),
+            NumatoCommand::Off(n) => format!("relay off {}", numato_relay_char(*n)?),
+            NumatoCommand::Read(n) => format!("relay read {}", numato_relay_char(*n)?),
+            NumatoCommand::ReadAll => "relay readall".to_string(),
+            NumatoCommand::WriteAll(m) => format!("relay writeall {m:04x}"),
+        })
+    }
+
+    pub fn parse(text: &str) -> Option<NumatoCommand> {
+        let w: Vec<&str> = text.split_whitespace().collect();
+        Some(match w.as_slice() {
+            ["ver"] => NumatoCommand::Ver,
+            ["relay", "on", n] => NumatoCommand::On(numato_relay_index(n)?),
+            ["relay", "off", n] => NumatoCommand::Off(numato_relay_index(n)?),
+            ["relay", "read", n] => NumatoCommand::Read(numato_relay_index(n)?),
+            ["relay", "readall"] => NumatoCommand::ReadAll,
+            ["relay", "writeall", m] if m.len() <= 8 => {
+                NumatoCommand::WriteAll(u32::from_str_radix(m, 16).ok()?)
+            }
+            _ => return None,
+        })
+    }
+}
+
+/// Why a Numato reply is not what the command expects.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum NumatoReplyError {
+    #[error("the board echoed {echo:?} instead of {sent:?}")]
+    Echo { sent: String, echo: String },
+    #[error("unexpected reply {0:?}")]
+    Unexpected(String),
+}
+
+/// Splits what the board sent up to (not including) the `>` prompt into the
+/// echo check and the reply lines. The board echoes the command as typed,
+/// possibly with its `\r`, then sends `\n\r`-separated lines.
+pub fn numato_split(sent: &str, raw: &[u8]) -> Result<Vec<String>, NumatoReplyError> {
+    let text = String::from_utf8_lossy(raw);
+    // The echo ends at the first line break the board adds after it.
+    let end = text.find(['\r', '\n']).unwrap_or(text.len());
+    let (echo, rest) = text.split_at(end);
+    if echo != sent {
+        return Err(NumatoReplyError::Echo {
+            sent: sent.to_string(),
+            echo: echo.to_string(),
+        });
+    }
+    Ok(rest
+        .split(['\r', '\n'])
+        .filter(|s| !s.trim().is_empty())
+        .map(|s| s.trim().to_string())
+        .collect())
+}
+
+/// The state `relay read N` reports.
+pub fn numato_parse_state(lines: &[String]) -> Result<bool, NumatoReplyError> {
+    match lines {
+        [s] if s == "on" => Ok(true),
+        [s] if s == "off" => Ok(false),
+        _ => Err(NumatoReplyError::Unexpected(lines.join("|"))),
+    }
+}
+
+/// The mask `relay readall` reports.
+pub fn numato_parse_mask(lines: &[String]) -> Result<u32, NumatoReplyError> {
+    match lines {
+        [s] if !s.is_empty() && s.len() <= 8 => {
+            u32::from_str_radix(s, 16).map_err(|_| NumatoReplyError::Unexpected(s.clone()))
+        }
+        _ => Err(NumatoReplyError::Unexpected(lines.join("|"))),
+    }
+}
+
+// ---------------------------------------------------------------- LCUS
+
+/// The LCUS frame switching `relay` (0-based; channel `relay + 1` on the
+/// wire) on or off: `A0 ch state sum`.
+pub fn lcus_frame(relay: u32, on: bool) -> Option<[u8; 4]> {
+    let ch = u8::try_from(relay.checked_add(1)?).ok()?;
+    let state = u8::from(on);
+    Some([0xA0, ch, state, 0xA0u8.wrapping_add(ch).wrapping_add(state)])
+}
+
+/// Decodes an LCUS frame into (relay, on); `None` if it is malformed.
+pub fn lcus_parse(frame: &[u8]) -> Option<(u32, bool)> {
+    match *frame {
+        [0xA0, ch, state @ (0 | 1), sum]
+            if ch >= 1 && sum == 0xA0u8.wrapping_add(ch).wrapping_add(state) =>
+        {
+            Some((u32::from(ch) - 1, state == 1))
+        }
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_round_trip_and_checksum_is_nmea_xor() {
+        // NMEA's classic example sentence body.
+        assert_eq!(checksum(b"GPGLL,5300.97914,N,00259.98174,E,125926,A"), 0x28);
+        assert_eq!(encode_line("HELLO"), b"HELLO*02\r\n".to_vec());
+        assert_eq!(decode_line(b"HELLO*02"), Ok("HELLO"));
+        assert_eq!(
+            decode_line(b"HELLO*03"),
+            Err(LineError::Mismatch {
+                found: 3,
+                computed: 2
+            })
+        );
+        assert_eq!(decode_line(b"HELLO"), Err(LineError::NoChecksum));
+        assert!(matches!(decode_line(b"HELLO*2"), Err(LineError::BadHex(_))));
+        assert!(matches!(
+            decode_line(b"HELLO*zz"),
+            Err(LineError::BadHex(_))
+        ));
+        let mut bad = b"HE\x01LO".to_vec();
+        let c = checksum(&bad);
+        bad.extend_from_slice(format!("*{c:02X}").as_bytes());
+        assert_eq!(decode_line(&bad), Err(LineError::NotAscii));
+    }
+
+    #[test]
+    fn commands_round_trip() {
+        let all = [
+            Command::Hello,
+            Command::Init,
+            Command::Live(2),
+            Command::Freeze,
+            Command::Camera(4),
+            Command::Load {
+                width: 512,
+                height: 256,
+                crc: 0xDEADBEEF,
+            },
+            Command::Write {
+                off: 16384,
+                len: 100,
+                crc: 0x0000_00FF,
+            },
+            Command::Read { off: 0, len: 16384 },
+            Command::Status,
+        ];
+        for c in all {
+            let line = c.encode();
+            let text = decode_line(line.strip_suffix(b"\r\n").unwrap_or(&line));
+            assert_eq!(text.map(Command::parse), Ok(Some(c)), "{c}");
+        }
+        for bad in [
+            "",
+            "HELLO 1",
+            "READ 1",
+            "READ -1 5",
+            "CAMERA x",
+            "LOAD 1 2 xyz",
+            "hello",
+        ] {
+            assert_eq!(Command::parse(bad), None, "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn replies_parse() {
+        assert_eq!(Reply::parse("OK"), Some(Reply::Ok(String::new())));
+        assert_eq!(
+            Reply::parse("ERR RANGE camera 7 of 4"),
+            Some(Reply::err(ErrCode::Range, "camera 7 of 4"))
+        );
+        assert_eq!(
+            Reply::parse("DATA 0 10 0000ABCD"),
+            Some(Reply::Data {
+                off: 0,
+                len: 10,
+                crc: 0xABCD
+            })
+        );
+        assert_eq!(Reply::parse("DATA 0 10"), None);
+        assert_eq!(Reply::parse("NOPE"), None);
+        let info = GrabberInfo {
+            model: "SIM".into(),
+            width: 512,
+            height: 512,
+            depth: 8,
+            cameras: 4,
+            maxblock: 65536,
+        };
+        assert_eq!(GrabberInfo::parse(&info.format()), Some(info));
+        let st = GrabberStatus {
+            camera: 2,
+            live: true,
+            frame: Some(0x1234_5678),
+        };
+        assert_eq!(GrabberStatus::parse(&st.format()), Some(st));
+        assert_eq!(
+            GrabberStatus::parse("camera=1 live=0 frame=none").map(|s| s.frame),
+            Some(None)
+        );
+        let f = FrameInfo {
+            width: 3,
+            height: 2,
+            crc: 7,
+        };
+        assert_eq!(FrameInfo::parse(&f.format()), Some(f));
+    }
+
+    #[test]
+    fn crc_is_zlib_crc32() {
+        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+    }
+
+    #[test]
+    fn numato_commands_and_replies() {
+        assert_eq!(NumatoCommand::On(10).text().as_deref(), Some("relay on A"));
+        assert_eq!(
+            NumatoCommand::parse("relay off a"),
+            Some(NumatoCommand::Off(10))
+        );
+        assert_eq!(NumatoCommand::Read(32).text(), None);
+        assert_eq!(
+            NumatoCommand::parse("relay writeall 00ff"),
+            Some(NumatoCommand::WriteAll(0xff))
+        );
+        let lines = numato_split("relay read 3", b"relay read 3\r\n\ron\n\r");
+        assert_eq!(lines.as_deref().map(numato_parse_state), Ok(Ok(true)));
+        let lines = numato_split("relay readall", b"relay readall\n\r0005\n\r");
+        assert_eq!(lines.as_deref().map(numato_parse_mask), Ok(Ok(5)));
+        assert!(matches!(
+            numato_split("relay on 1", b"relay on 2\n\r"),
+            Err(NumatoReplyError::Echo { .. })
+        ));
+        assert_eq!(
+            numato_split("ver", b"ver\r\n\r00000008\n\r"),
+            Ok(vec!["00000008".to_string()])
+        );
+    }
+
+    #[test]
+    fn lcus_frames_match_the_spec_examples() {
+        assert_eq!(lcus_frame(0, true), Some([0xA0, 0x01, 0x01, 0xA2]));
+        assert_eq!(lcus_frame(0, false), Some([0xA0, 0x01, 0x00, 0xA1]));
+        assert_eq!(lcus_parse(&[0xA0, 0x02, 0x01, 0xA3]), Some((1, true)));
+        assert_eq!(lcus_parse(&[0xA0, 0x02, 0x01, 0xA4]), None);
+        assert_eq!(lcus_frame(255, true), None);
+    }
+}

@@ -1,0 +1,330 @@
+//! The simulated cell: a VSG/1 grabber and a Numato relay board served on
+//! real pseudo-terminals by device threads, sharing one scene. What the
+//! simulated camera digitises depends on the relays the simulated board has
+//! switched on, on the selected camera, and on seeded sensor noise.
+//!
+//! The device side of each pty pair stays here; clients open the other side
+//! by its path, exactly as they would open `/dev/ttyUSB0`. The sim also keeps
+//! that other side open itself, so a client may come and go without the
+//! device seeing a hang-up.
+
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::thread::JoinHandle;
+
+use serialport::TTYPort;
+
+use super::RigError;
+use crate::profile::Profile;
+
+mod board;
+pub mod faults;
+pub mod render;
+mod vsg;
+
+pub use faults::{Faults, FaultsError};
+
+/// A tiny seeded generator (SplitMix64): the simulator must repeat a run.
+#[derive(Clone, Debug)]
+pub struct SplitMix64(u64);
+
+impl SplitMix64 {
+    pub fn new(seed: u64) -> Self {
+        SplitMix64(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1).
+    pub fn next_f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Standard normal (Box–Muller).
+    pub fn gauss(&mut self) -> f64 {
+        let u1 = self.next_f64().max(1e-300);
+        let u2 = self.next_f64();
+        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    }
+}
+
+/// One light of the simulated cell.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimLight {
+    pub relay: u32,
+    /// Position in the world frame (mm).
+    pub position: [f64; 3],
+}
+
+/// Everything the simulated cell needs to know.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimOptions {
+    pub width: u32,
+    pub height: u32,
+    pub seed: u64,
+    /// Sensor noise σ in grey levels.
+    pub noise: f64,
+    pub cameras: u32,
+    pub lights: Vec<SimLight>,
+    /// Relays on the simulated board.
+    pub relays: u32,
+    /// Largest READ block the grabber serves.
+    pub maxblock: u32,
+    pub faults: Faults,
+}
+
+impl SimOptions {
+    /// The simulated cell a profile describes: its image size, noise, seed
+    /// and lights (a light without a position gets one of the default
+    /// positions, so every profile has a lit scene).
+    pub fn from_profile(p: &Profile) -> SimOptions {
+        let defaults = render::default_light_positions();
+        let lights = p
+            .lights
+            .iter()
+            .enumerate()
+            .map(|(i, l)| SimLight {
+                relay: l.relay,
+                position: l.position.unwrap_or_else(|| {
+                    defaults
+                        .get(i % defaults.len().max(1))
+                        .copied()
+                        .unwrap_or([0.0, 0.0, 1000.0])
+                }),
+            })
+            .collect();
+        SimOptions {
+            width: p.sim.width.clamp(16, 8192),
+            height: p.sim.height.clamp(16, 8192),
+            seed: p.sim.seed,
+            noise: p.sim.noise.max(0.0),
+            cameras: 4,
+            lights,
+            relays: 16,
+            maxblock: 65536,
+            faults: Faults::default(),
+        }
+    }
+}
+
+/// Noise-free frames by (camera, relay mask).
+type FrameCache = HashMap<(u32, u32), Arc<Vec<f32>>>;
+
+/// The state both simulated devices share.
+pub struct Scene {
+    pub opts: SimOptions,
+    relays: Mutex<u32>,
+    /// Noise-free frames per (camera, relay mask): rendering is costly,
+    /// noise is cheap and drawn anew at every FREEZE.
+    cache: Mutex<FrameCache>,
+}
+
+impl Scene {
+    pub fn new(opts: SimOptions) -> Scene {
+        Scene {
+            opts,
+            relays: Mutex::new(0),
+            cache: Mutex::new(HashMap::new()),
+        }
+    }
+
+    pub fn relays(&self) -> u32 {
+        *self.relays.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    pub fn set_relays(&self, mask: u32) {
+        *self.relays.lock().unwrap_or_else(PoisonError::into_inner) = mask;
+    }
+
+    /// The noise-free image camera `cam` (1-based) sees under `mask`.
+    pub fn clean(&self, cam: u32, mask: u32) -> Arc<Vec<f32>> {
+        let key = (cam, mask & self.lit_mask());
+        if let Some(img) = self
+            .cache
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .get(&key)
+        {
+            return Arc::clone(img);
+        }
+        let img = Arc::new(render::render_clean(&self.opts, cam, key.1));
+        self.cache
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .insert(key, Arc::clone(&img));
+        img
+    }
+
+    /// Relays that have a light on them (others do not change the image).
+    fn lit_mask(&self) -> u32 {
+        self.opts
+            .lights
+            .iter()
+            .filter(|l| l.relay < 32)
+            .fold(0, |m, l| m | (1 << l.relay))
+    }
+
+    /// A digitised frame: the clean image plus seeded noise, as 8 bits.
+    pub fn frame(&self, cam: u32, mask: u32, shot: u64) -> Vec<u8> {
+        let clean = self.clean(cam, mask);
+        let mut rng = SplitMix64::new(
+            self.opts.seed ^ shot.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ u64::from(cam) << 56,
+        );
+        let sigma = self.opts.noise;
+        clean
+            .iter()
+            .map(|&v| {
+                let n = if sigma > 0.0 {
+                    rng.gauss() * sigma
+                } else {
+                    0.0
+                };
+                (f64::from(v) + n).round().clamp(0.0, 255.0) as u8
+            })
+            .collect()
+    }
+}
+
+/// A device thread serving one pty.
+struct Device {
+    path: String,
+    stop: Arc<AtomicBool>,
+    alive: Arc<AtomicBool>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl Device {
+    fn start(
+        name: &str,
+        serve: impl FnOnce(TTYPort, Arc<AtomicBool>) + Send + 'static,
+    ) -> Result<Device, RigError> {
+        let (master, slave) = TTYPort::pair().map_err(|e| {
+            RigError::Sim(format!("cannot make a pseudo-terminal for the {name}: {e}"))
+        })?;
+        let path = serialport::SerialPort::name(&slave)
+            .ok_or_else(|| RigError::Sim(format!("the {name}'s pseudo-terminal has no name")))?;
+        let stop = Arc::new(AtomicBool::new(false));
+        let alive = Arc::new(AtomicBool::new(true));
+        let (s, a) = (Arc::clone(&stop), Arc::clone(&alive));
+        let thread = std::thread::Builder::new()
+            .name(format!("sim-{name}"))
+            .spawn(move || {
+                // The slave side lives as long as the device: a client that
+                // closes its end must not hang the line up.
+                let _keep = slave;
+                serve(master, s);
+                a.store(false, Ordering::SeqCst);
+            })
+            .map_err(|e| RigError::Sim(format!("cannot start the {name} thread: {e}")))?;
+        Ok(Device {
+            path,
+            stop,
+            alive,
+            thread: Some(thread),
+        })
+    }
+
+    fn shutdown(&mut self) {
+        self.stop.store(true, Ordering::SeqCst);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+impl Drop for Device {
+    fn drop(&mut self) {
+        self.shutdown();
+    }
+}
+
+/// The simulated cell: both devices and their scene.
+pub struct SimCell {
+    scene: Arc<Scene>,
+    grabber: Device,
+    board: Device,
+}
+
+impl SimCell {
+    /// Starts the simulated grabber and relay board on fresh ptys.
+    pub fn start(opts: SimOptions) -> Result<SimCell, RigError> {
+        let scene = Arc::new(Scene::new(opts));
+        let grabber = Self::start_grabber(&scene, scene.opts.faults.clone())?;
+        let sc = Arc::clone(&scene);
+        let board = Device::start("relay board", move |port, stop| {
+            board::serve(port, &sc, &stop)
+        })?;
+        Ok(SimCell {
+            scene,
+            grabber,
+            board,
+        })
+    }
+
+    /// The simulated cell of a profile, with `faults` on the grabber.
+    pub fn from_profile(p: &Profile, faults: Faults) -> Result<SimCell, RigError> {
+        let mut o = SimOptions::from_profile(p);
+        o.faults = faults;
+        SimCell::start(o)
+    }
+
+    fn start_grabber(scene: &Arc<Scene>, faults: Faults) -> Result<Device, RigError> {
+        let sc = Arc::clone(scene);
+        Device::start("grabber", move |port, stop| {
+            vsg::serve(port, &sc, faults, &stop)
+        })
+    }
+
+    pub fn grabber_path(&self) -> &str {
+        &self.grabber.path
+    }
+
+    pub fn relay_path(&self) -> &str {
+        &self.board.path
+    }
+
+    pub fn scene(&self) -> &Arc<Scene> {
+        &self.scene
+    }
+
+    /// Whether the grabber is still plugged in (an `unplug-after` fault
+    /// pulls it).
+    pub fn grabber_plugged(&self) -> bool {
+        self.grabber.alive.load(Ordering::SeqCst)
+    }
+
+    /// Plugs the grabber back in, power-cycled (no frame, camera 1) and
+    /// without faults, on a new pseudo-terminal; returns its path.
+    pub fn replug_grabber(&mut self) -> Result<&str, RigError> {
+        self.grabber.shutdown();
+        self.grabber = Self::start_grabber(&self.scene, Faults::default())?;
+        Ok(&self.grabber.path)
+    }
+
+    /// One line for people.
+    pub fn summary(&self) -> String {
+        let o = &self.scene.opts;
+        format!(
+            "simulated cell: grabber {} ({}x{}, {} cameras, {}), relay board {} (Numato, {} relays, {} lights), seed {}, noise {}",
+            self.grabber.path,
+            o.width,
+            o.height,
+            o.cameras,
+            o.faults.summary(),
+            self.board.path,
+            o.relays,
+            o.lights.len(),
+            o.seed,
+            o.noise
+        )
+    }
+
+    pub fn stop(mut self) {
+        self.grabber.shutdown();
+        self.board.shutdown();
+    }
+}
