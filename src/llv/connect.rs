@@ -1,1 +1,299 @@
-//! (to be written)
+//! CONNECT, the automatic post-processing of extracted lines (llv.md §4):
+//! merges segments whose environments (oriented rectangles around them)
+//! intersect and whose directions agree, until nothing merges any more, then
+//! drops short segments.
+//!
+//! Order (so the result does not depend on the input order): segments are
+//! sorted by length, longest first, ties by their endpoint coordinates. Each
+//! pass takes the segments in that order; a segment absorbs every later one
+//! it can merge with (re-checking the later ones after each merge, since it
+//! grew), and passes repeat until one merges nothing. [`merge`] itself is
+//! symmetric: `merge(a, b) == merge(b, a)` exactly.
+
+use super::fit::LineFit;
+use super::params::ConnectParams;
+use super::{Point, Segment};
+
+/// An oriented rectangle: centre, unit direction, half-length, half-width.
+#[derive(Clone, Copy, Debug)]
+struct Rect {
+    c: Point,
+    d: (f64, f64),
+    hl: f64,
+    hw: f64,
+}
+
+/// Unit direction of a segment (`(1, 0)` for a degenerate one).
+fn unit_dir(s: &Segment) -> (f64, f64) {
+    let (dx, dy) = (s.b.x - s.a.x, s.b.y - s.a.y);
+    let len = dx.hypot(dy);
+    if len > 0.0 && len.is_finite() {
+        (dx / len, dy / len)
+    } else {
+        (1.0, 0.0)
+    }
+}
+
+/// The environment of a segment: `wl` beyond each end, `wd` to each side.
+fn environment(s: &Segment, wl: f64, wd: f64) -> Rect {
+    Rect {
+        c: Point::new(0.5 * (s.a.x + s.b.x), 0.5 * (s.a.y + s.b.y)),
+        d: unit_dir(s),
+        hl: 0.5 * s.length() + wl,
+        hw: wd,
+    }
+}
+
+/// Separating-axis test of two oriented rectangles (touching counts).
+fn rects_intersect(r1: &Rect, r2: &Rect) -> bool {
+    let (dx, dy) = (r2.c.x - r1.c.x, r2.c.y - r1.c.y);
+    let axes = [r1.d, (-r1.d.1, r1.d.0), r2.d, (-r2.d.1, r2.d.0)];
+    axes.iter().all(|&(ax, ay)| {
+        let radius = |r: &Rect| {
+            r.hl * (r.d.0 * ax + r.d.1 * ay).abs() + r.hw * (-r.d.1 * ax + r.d.0 * ay).abs()
+        };
+        (dx * ax + dy * ay).abs() <= radius(r1) + radius(r2)
+    })
+}
+
+/// Difference of the undirected directions of two segments, in [0, π/2].
+pub fn angle_between(s1: &Segment, s2: &Segment) -> f64 {
+    let (a1, a2) = (unit_dir(s1), unit_dir(s2));
+    let cross = (a1.0 * a2.1 - a1.1 * a2.0).abs();
+    let dot = (a1.0 * a2.0 + a1.1 * a2.1).abs();
+    cross.atan2(dot)
+}
+
+/// Whether CONNECT merges two segments under `p`.
+pub fn mergeable(s1: &Segment, s2: &Segment, p: &ConnectParams) -> bool {
+    angle_between(s1, s2) <= p.max_angle_deg.to_radians()
+        && rects_intersect(&environment(s1, p.wl, p.wd), &environment(s2, p.wl, p.wd))
+}
+
+/// The canonical order of segments: longer first, then by coordinates.
+fn order(s1: &Segment, s2: &Segment) -> std::cmp::Ordering {
+    s2.length()
+        .total_cmp(&s1.length())
+        .then(s1.a.x.total_cmp(&s2.a.x))
+        .then(s1.a.y.total_cmp(&s2.a.y))
+        .then(s1.b.x.total_cmp(&s2.b.x))
+        .then(s1.b.y.total_cmp(&s2.b.y))
+        .then(s1.response.total_cmp(&s2.response))
+}
+
+/// The length-weighted merge of two segments (§4): the total-least-squares
+/// line of the four endpoints, each weighted by its segment's length, and
+/// the segment between the outermost projections of the endpoints onto it.
+/// It keeps the orientation of the longer segment. `response` is the
+/// length-weighted mean magnitude with the longer segment's sign (the two
+/// may come from different scan directions, whose signs need not agree);
+/// `residual` adds the endpoints' spread about the merged line to the
+/// length-weighted mean square residual; `shadow` only if both are.
+pub fn merge(s1: &Segment, s2: &Segment) -> Segment {
+    // Symmetry: always combine in the canonical order.
+    let (l, m) = if order(s1, s2).is_le() {
+        (s1, s2)
+    } else {
+        (s2, s1)
+    };
+    let (wl, wm) = (l.length(), m.length());
+    let mut fit = LineFit::new();
+    for (s, w) in [(l, wl), (m, wm)] {
+        fit.add_weighted(s.a, w);
+        fit.add_weighted(s.b, w);
+    }
+    let Some(line) = fit.line() else {
+        return *l;
+    };
+    let mut d = line.direction();
+    let ld = unit_dir(l);
+    if d.0 * ld.0 + d.1 * ld.1 < 0.0 {
+        d = (-d.0, -d.1);
+    }
+    let origin = fit.mean().unwrap_or(l.a);
+    let t = |p: Point| (p.x - origin.x) * d.0 + (p.y - origin.y) * d.1;
+    let ends = [l.a, l.b, m.a, m.b];
+    let mut lo = ends[0];
+    let mut hi = ends[0];
+    for &p in &ends[1..] {
+        if t(p) < t(lo) {
+            lo = p;
+        }
+        if t(p) > t(hi) {
+            hi = p;
+        }
+    }
+    let wsum = wl + wm;
+    let (response, residual) = if wsum > 0.0 {
+        let mag = (wl * l.response.abs() + wm * m.response.abs()) / wsum;
+        let sign = if l.response < 0.0 { -1.0 } else { 1.0 };
+        let ms = (wl * l.residual * l.residual + wm * m.residual * m.residual) / wsum;
+        (sign * mag, (ms + fit.mean_square_residual()).sqrt())
+    } else {
+        (l.response, l.residual)
+    };
+    Segment {
+        a: line.project(lo),
+        b: line.project(hi),
+        response,
+        residual,
+        shadow: l.shadow && m.shadow,
+    }
+}
+
+/// Reusable buffers of CONNECT.
+#[derive(Clone, Debug, Default)]
+pub struct ConnectScratch {
+    segs: Vec<Segment>,
+    alive: Vec<bool>,
+}
+
+/// CONNECT (§4) of a line set; the result is sorted longest first.
+/// With `p.enabled == false` the lines are returned unchanged.
+pub fn connect(lines: &[Segment], p: &ConnectParams) -> Vec<Segment> {
+    let mut out = Vec::new();
+    connect_into(lines, p, &mut out, &mut ConnectScratch::default());
+    out
+}
+
+/// [`connect`] into reusable buffers.
+pub fn connect_into(
+    lines: &[Segment],
+    p: &ConnectParams,
+    out: &mut Vec<Segment>,
+    s: &mut ConnectScratch,
+) {
+    out.clear();
+    if !p.enabled {
+        out.extend_from_slice(lines);
+        return;
+    }
+    s.segs.clear();
+    s.segs.extend(lines.iter().filter(|l| {
+        l.a.x.is_finite() && l.a.y.is_finite() && l.b.x.is_finite() && l.b.y.is_finite()
+    }));
+    s.segs.sort_unstable_by(order);
+    s.alive.clear();
+    s.alive.resize(s.segs.len(), true);
+    let n = s.segs.len();
+    loop {
+        let mut merged_any = false;
+        for i in 0..n {
+            if !s.alive[i] {
+                continue;
+            }
+            let mut j = i + 1;
+            while j < n {
+                if s.alive[j] && mergeable(&s.segs[i], &s.segs[j], p) {
+                    s.segs[i] = merge(&s.segs[i], &s.segs[j]);
+                    s.alive[j] = false;
+                    merged_any = true;
+                    j = i + 1;
+                } else {
+                    j += 1;
+                }
+            }
+        }
+        if !merged_any {
+            break;
+        }
+    }
+    out.extend(
+        s.segs
+            .iter()
+            .zip(&s.alive)
+            .filter(|&(l, &alive)| alive && l.length() >= p.min_line_length)
+            .map(|(l, _)| *l),
+    );
+    out.sort_unstable_by(order);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn seg(ax: f64, ay: f64, bx: f64, by: f64) -> Segment {
+        Segment {
+            response: 20.0,
+            residual: 0.1,
+            ..Segment::new(Point::new(ax, ay), Point::new(bx, by))
+        }
+    }
+
+    #[test]
+    fn joins_a_split_line() {
+        let p = ConnectParams::default();
+        let out = connect(
+            &[seg(10.0, 10.0, 10.2, 60.0), seg(10.25, 65.0, 10.4, 100.0)],
+            &p,
+        );
+        assert_eq!(out.len(), 1, "{out:?}");
+        assert!(out[0].a.dist(Point::new(10.0, 10.0)) < 0.2);
+        assert!(out[0].b.dist(Point::new(10.4, 100.0)) < 0.2);
+        // Too far apart along the line (gap 13 > 2 wl): not merged.
+        let out = connect(
+            &[seg(10.0, 10.0, 10.0, 60.0), seg(10.0, 73.0, 10.0, 100.0)],
+            &p,
+        );
+        assert_eq!(out.len(), 2);
+        // Parallel but 4 px to the side: not merged.
+        let out = connect(
+            &[seg(10.0, 10.0, 10.0, 60.0), seg(14.0, 20.0, 14.0, 100.0)],
+            &p,
+        );
+        assert_eq!(out.len(), 2);
+    }
+
+    #[test]
+    fn joins_the_near_45_degree_duplicate_of_both_scans() {
+        // The same diagonal found by EdgeH and EdgeV, offset by a fraction of
+        // a pixel and overlapping.
+        let h = Segment {
+            response: 30.0,
+            ..seg(20.0, 20.0, 80.0, 80.5)
+        };
+        let v = Segment {
+            response: -28.0,
+            ..seg(25.3, 24.9, 90.0, 90.2)
+        };
+        let out = connect(&[h, v], &ConnectParams::default());
+        assert_eq!(out.len(), 1);
+        assert!(out[0].length() > 95.0);
+        assert!(out[0].response.abs() > 28.0 && out[0].response.abs() < 30.0);
+    }
+
+    #[test]
+    fn merge_is_symmetric_and_order_does_not_matter() {
+        let a = seg(0.0, 0.0, 50.0, 1.0);
+        let b = seg(52.0, 1.1, 70.0, 1.5);
+        assert_eq!(merge(&a, &b), merge(&b, &a));
+        let lines = vec![
+            a,
+            b,
+            seg(100.0, 100.0, 100.0, 140.0),
+            seg(100.3, 144.0, 100.1, 170.0),
+            seg(0.0, 100.0, 5.0, 100.0),
+        ];
+        let p = ConnectParams::default();
+        let out1 = connect(&lines, &p);
+        let mut rev = lines.clone();
+        rev.reverse();
+        assert_eq!(out1, connect(&rev, &p));
+        // 2 merged lines; the 5 px segment falls to the length filter.
+        assert_eq!(out1.len(), 2);
+        assert!(connect(&[], &p).is_empty());
+    }
+
+    #[test]
+    fn angle_test_and_rectangles() {
+        let p = ConnectParams::default();
+        let a = seg(0.0, 0.0, 50.0, 0.0);
+        // Crossing at 10°: environments intersect, angle too large.
+        let b = seg(20.0, -4.0, 60.0, 3.0);
+        assert!(!mergeable(&a, &b, &p));
+        // Reversed orientation is the same direction.
+        let c = seg(90.0, 0.5, 54.0, 0.3);
+        assert!(mergeable(&a, &c, &p));
+        assert!((angle_between(&a, &c) - (0.2f64 / 36.0).atan()).abs() < 1e-9);
+    }
+}
