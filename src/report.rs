@@ -1,1 +1,125 @@
-//! PostScript and SVG reports (to be written).
+//! PostScript and SVG reports of a survey (spec/formats.md §7): the grey-image
+//! page of the original `img2ps`, the line page of `ldr2ps`, and a multi-page
+//! survey report per image (grey images, edge images, raw and connected
+//! lines, parameters, counts, timings). The writers build text in memory from
+//! plain data ([`GreyImage`], [`Segment`], [`EdgePoints`]); saving goes
+//! through [`crate::fsutil::write_atomic`].
+
+pub mod encode;
+pub mod ps;
+pub mod svg;
+
+use crate::llv::{EdgePoints, GreyImage, Segment};
+
+/// Everything the report shows about one image number of a survey.
+#[derive(Clone, Debug, Default)]
+pub struct ImageReport {
+    /// Heading, e.g. `cube1`.
+    pub title: String,
+    /// Image size in pixels (the lines' coordinate frame).
+    pub width: usize,
+    pub height: usize,
+    /// Grey images with their captions (file names), one per lighting.
+    pub greys: Vec<(String, GreyImage)>,
+    pub edges_h: Option<EdgePoints>,
+    pub edges_v: Option<EdgePoints>,
+    /// Lines as extracted (`.lex`) and after post-processing (`.ldr`).
+    pub lines_raw: Option<Vec<Segment>>,
+    pub lines: Option<Vec<Segment>>,
+    /// Free text lines: parameters used, counts, timings.
+    pub notes: Vec<String>,
+}
+
+/// Renders edge points as a grey image the size of the picture: white paper,
+/// each point a dark pixel (darker for a stronger response), so the edge
+/// image prints with the same `image` operator as a grey image.
+pub fn edge_image(e: &EdgePoints, width: usize, height: usize) -> Option<GreyImage> {
+    let (w, h) = if e.width > 0 && e.height > 0 {
+        (e.width, e.height)
+    } else {
+        (width, height)
+    };
+    let mut img = GreyImage::filled(w, h, 255).ok()?;
+    let max = e
+        .points
+        .iter()
+        .map(|p| p.response.abs())
+        .filter(|r| r.is_finite())
+        .fold(0.0f32, f32::max);
+    let data = img.data_mut();
+    for p in &e.points {
+        if !(p.x.is_finite() && p.y.is_finite()) {
+            continue;
+        }
+        let (x, y) = (p.x.round(), p.y.round());
+        if x < 0.0 || y < 0.0 || x >= w as f32 || y >= h as f32 {
+            continue;
+        }
+        // Even the weakest kept point must be clearly visible on paper.
+        let strength = if max > 0.0 && p.response.is_finite() {
+            (p.response.abs() / max).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let v = 160.0 - 160.0 * strength;
+        if let Some(px) = data.get_mut(y as usize * w + x as usize) {
+            *px = v as u8;
+        }
+    }
+    Some(img)
+}
+
+/// Text safe for a PostScript string or an XML attribute: printable ASCII
+/// only (the comment of an `.img` may hold anything).
+pub(crate) fn printable(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_ascii_graphic() || c == ' ' {
+                c
+            } else {
+                '?'
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::llv::{EdgePoint, ScanDir};
+
+    #[test]
+    fn edge_image_marks_points_and_ignores_outsiders() {
+        let e = EdgePoints {
+            dir: Some(ScanDir::Horizontal),
+            width: 20,
+            height: 10,
+            points: vec![
+                EdgePoint {
+                    x: 3.2,
+                    y: 4.0,
+                    response: -40.0,
+                },
+                EdgePoint {
+                    x: 30.0,
+                    y: 4.0,
+                    response: 10.0,
+                },
+                EdgePoint {
+                    x: f32::NAN,
+                    y: 1.0,
+                    response: 10.0,
+                },
+            ],
+        };
+        let img = edge_image(&e, 0, 0).unwrap();
+        assert_eq!(img.size(), (20, 10));
+        assert_eq!(img.get(3, 4), Some(0));
+        assert_eq!(img.data().iter().filter(|&&v| v < 255).count(), 1);
+    }
+
+    #[test]
+    fn printable_strips_control_and_unicode() {
+        assert_eq!(printable("a\u{1b}[2Jb µ"), "a?[2Jb ?");
+    }
+}

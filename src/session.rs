@@ -1,1 +1,540 @@
-//! A survey on disk (to be written).
+//! A survey on disk. A session is a folder `DIR/NAME/` holding every file of
+//! one workpiece survey under VSS names (`cube7b.img`, `cube7.ldr`, …), the
+//! three-number `NAME.ses` for older tools, the manifest `NAME.toml` that the
+//! console owns ([`manifest`]), and while a console writes it the lock
+//! `NAME.lock` ([`lock`]).
+//!
+//! Every file is written atomically (temporary file, fsync, rename), data
+//! files first and the manifest last, so a crash at any moment leaves every
+//! file either the previous or the new complete version and a manifest that
+//! names only complete files. Resuming reads the manifest and continues at
+//! [`Progress::next_step`]; nothing saved is redone unless asked
+//! ([`Session::redo`]).
+
+pub mod check;
+pub mod lock;
+pub mod manifest;
+pub mod outputs;
+pub mod progress;
+pub mod stamp;
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use crate::formats::names::{NameError, SessionName, VssFile};
+use crate::formats::{self, FormatError, img::ImgFile, ses::Ses};
+use crate::fsutil::write_atomic;
+use crate::llv::{LlvError, Segment};
+use crate::profile::Profile;
+
+pub use check::CheckReport;
+pub use lock::{Lock, LockInfo};
+pub use manifest::Manifest;
+pub use outputs::OutputSet;
+pub use progress::{ImageProgress, OutputState, Progress, Step};
+
+use manifest::{EditRecord, FileRecord, GreyRecord, ImageRecord, LightingInfo, SessionInfo};
+
+/// What can go wrong with a session; every message names the file or folder
+/// and says what to do.
+#[derive(Debug, thiserror::Error)]
+pub enum SessionError {
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{0}")]
+    Name(#[from] NameError),
+    #[error("{0}")]
+    Format(#[from] FormatError),
+    #[error("{0}")]
+    Llv(#[from] LlvError),
+    #[error(
+        "session {} already exists; open it instead (`vss session show {}`)",
+        dir.display(),
+        dir.display()
+    )]
+    Exists { dir: PathBuf },
+    #[error(
+        "{} is not a session folder: no manifest {manifest} in it (make one with `vss session new NAME`)",
+        dir.display()
+    )]
+    NotASession { dir: PathBuf, manifest: String },
+    #[error("{}", locked_message(path, holder, *stale, *foreign))]
+    Locked {
+        path: PathBuf,
+        holder: String,
+        /// The holder is certainly gone: the lock can be taken over.
+        stale: bool,
+        /// The holder is on another host: can be taken over, with care.
+        foreign: bool,
+    },
+    #[error("{}:{line}: {message}; the manifest was left as it is: fix it by hand or restore it", path.display())]
+    Manifest {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error("session {} was opened read-only; open it for writing to change it", dir.display())]
+    ReadOnly { dir: PathBuf },
+    #[error("lighting {letter:?} is not one of this session's lightings ({known})")]
+    UnknownLighting { letter: char, known: String },
+    #[error("image number {0} is out of range: image numbers start at 1")]
+    BadImage(u32),
+    #[error("image {image} of session {session}: {what}")]
+    Missing {
+        session: String,
+        image: u32,
+        what: String,
+    },
+}
+
+fn locked_message(path: &Path, holder: &str, stale: bool, foreign: bool) -> String {
+    let what = if stale {
+        "that process is gone: take the session over with --take-over".to_string()
+    } else if foreign {
+        "close the console there; if it is gone, take the session over with --take-over".to_string()
+    } else {
+        "close that console first".to_string()
+    };
+    format!(
+        "session is in use: {} is held by {holder}; {what}",
+        path.display()
+    )
+}
+
+/// An open session. Opened for writing it holds the lock until dropped;
+/// opened read-only ([`Session::inspect`]) it refuses every write.
+#[derive(Debug)]
+pub struct Session {
+    dir: PathBuf,
+    name: SessionName,
+    manifest: Manifest,
+    lock: Option<Lock>,
+}
+
+impl Session {
+    /// Makes a new session `parent/name/` for the survey `profile`
+    /// describes: its lightings, its cameras, one location per camera.
+    pub fn create(parent: &Path, name: &str, profile: &Profile) -> Result<Session, SessionError> {
+        let name = SessionName::new(name)?;
+        let dir = parent.join(name.as_str());
+        let manifest_path = dir.join(format!("{name}.toml"));
+        if manifest_path.exists() {
+            return Err(SessionError::Exists { dir });
+        }
+        fs::create_dir_all(&dir).map_err(|source| SessionError::Io {
+            path: dir.clone(),
+            source,
+        })?;
+        let lock = Lock::acquire(&dir.join(format!("{name}.lock")), false)?;
+        let now = stamp::now_rfc3339();
+        let mut lighting: Vec<LightingInfo> = profile
+            .lighting
+            .iter()
+            .map(|l| LightingInfo {
+                letter: l.letter,
+                on: l.on.clone(),
+                note: l.note.clone(),
+            })
+            .collect();
+        if lighting.is_empty() {
+            lighting.push(LightingInfo {
+                letter: 'a',
+                on: profile.lights.iter().map(|l| l.name.clone()).collect(),
+                note: "the lights as they are (the profile defines no lightings)".into(),
+            });
+        }
+        let cameras = profile.survey.cameras.max(1);
+        let manifest = Manifest {
+            format: manifest::FORMAT,
+            session: SessionInfo {
+                name: name.to_string(),
+                created: now.clone(),
+                modified: now,
+                version: env!("CARGO_PKG_VERSION").to_string(),
+                profile: profile.name.clone(),
+                planned_images: cameras,
+                cameras,
+            },
+            lighting,
+            image: Vec::new(),
+        };
+        // Check the manifest would load back before anything depends on it.
+        let text = manifest.to_toml().map_err(|e| SessionError::Manifest {
+            path: manifest_path.clone(),
+            line: 0,
+            message: e.to_string(),
+        })?;
+        Manifest::parse(&text, &manifest_path)?;
+        let mut s = Session {
+            dir,
+            name,
+            manifest,
+            lock: Some(lock),
+        };
+        s.commit()?;
+        Ok(s)
+    }
+
+    /// Opens a session folder for writing; fails if another console holds it.
+    pub fn open(dir: &Path) -> Result<Session, SessionError> {
+        Self::open_with(dir, Some(false))
+    }
+
+    /// Opens for writing, taking over a lock whose holder is gone (or is on
+    /// another host). A live holder on this host is never displaced.
+    pub fn open_take_over(dir: &Path) -> Result<Session, SessionError> {
+        Self::open_with(dir, Some(true))
+    }
+
+    /// Opens `parent/name` if it is a session, else creates it.
+    pub fn open_or_create(
+        parent: &Path,
+        name: &str,
+        profile: &Profile,
+    ) -> Result<Session, SessionError> {
+        let n = SessionName::new(name)?;
+        let dir = parent.join(n.as_str());
+        if dir.join(format!("{n}.toml")).exists() {
+            Self::open(&dir)
+        } else {
+            Self::create(parent, name, profile)
+        }
+    }
+
+    /// Opens read-only, without the lock: for show, check and reports.
+    pub fn inspect(dir: &Path) -> Result<Session, SessionError> {
+        Self::open_with(dir, None)
+    }
+
+    fn open_with(dir: &Path, lock: Option<bool>) -> Result<Session, SessionError> {
+        let dir = dir.to_path_buf();
+        let dir_name = dir
+            .canonicalize()
+            .ok()
+            .and_then(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .unwrap_or_default();
+        let name = SessionName::new(&dir_name).map_err(|_| SessionError::NotASession {
+            dir: dir.clone(),
+            manifest: "NAME.toml".into(),
+        })?;
+        let manifest_path = dir.join(format!("{name}.toml"));
+        if !manifest_path.is_file() {
+            return Err(SessionError::NotASession {
+                dir,
+                manifest: format!("{name}.toml"),
+            });
+        }
+        // Lock before reading, so nobody rewrites the manifest under us.
+        let lock = match lock {
+            Some(take_over) => Some(Lock::acquire(&dir.join(format!("{name}.lock")), take_over)?),
+            None => None,
+        };
+        let text = fs::read_to_string(&manifest_path).map_err(|source| SessionError::Io {
+            path: manifest_path.clone(),
+            source,
+        })?;
+        let manifest = Manifest::parse(&text, &manifest_path)?;
+        if manifest.session.name != name.as_str() {
+            return Err(SessionError::Manifest {
+                path: manifest_path,
+                line: text
+                    .lines()
+                    .position(|l| l.trim_start().starts_with("name"))
+                    .map_or(0, |i| i + 1),
+                message: format!(
+                    "the manifest names session {:?} but the folder is {:?}",
+                    manifest.session.name,
+                    name.as_str()
+                ),
+            });
+        }
+        let s = Session {
+            dir,
+            name,
+            manifest,
+            lock,
+        };
+        if s.lock.is_some() {
+            s.remove_leftovers();
+        }
+        Ok(s)
+    }
+
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+    pub fn name(&self) -> &SessionName {
+        &self.name
+    }
+    pub fn manifest(&self) -> &Manifest {
+        &self.manifest
+    }
+    pub fn is_read_only(&self) -> bool {
+        self.lock.is_none()
+    }
+    /// Who holds the lock of this session right now, if anyone.
+    pub fn lock_holder(&self) -> Option<LockInfo> {
+        lock::read_holder(&self.dir.join(format!("{}.lock", self.name)))
+    }
+    /// The lighting letters, in order.
+    pub fn letters(&self) -> Vec<char> {
+        self.manifest.lighting.iter().map(|l| l.letter).collect()
+    }
+    /// The full path of a file of the session.
+    pub fn path(&self, file: &str) -> PathBuf {
+        self.dir.join(file)
+    }
+    /// The VSS file name of image `k` (with lighting letter for grey images).
+    pub fn file_name(&self, k: u32, letter: Option<char>, ext: &str) -> String {
+        VssFile {
+            session: self.name.clone(),
+            image: k,
+            lighting: letter,
+            ext: ext.to_string(),
+        }
+        .file_name()
+    }
+
+    /// Sets how many images the survey plans.
+    pub fn set_planned_images(&mut self, n: u32) -> Result<(), SessionError> {
+        self.writable()?;
+        self.manifest.session.planned_images = n.max(1);
+        self.commit()
+    }
+
+    /// Records which camera at which location took image `k`, and copies
+    /// its camera description into the session as `NAMEk.cdf` (checked by
+    /// parsing it first).
+    pub fn set_image_info(
+        &mut self,
+        k: u32,
+        camera: u32,
+        location: u32,
+        cdf: Option<&Path>,
+    ) -> Result<(), SessionError> {
+        self.writable()?;
+        let cdf_record = match cdf {
+            Some(src) => {
+                let parsed = formats::cdf::read_cdf(src)?;
+                let file = self.file_name(k, None, "cdf");
+                let bytes = formats::cdf::format_cdf(&parsed).into_bytes();
+                self.write_file(&file, &bytes)?;
+                Some(FileRecord {
+                    hash: stamp::hash(&bytes),
+                    file,
+                })
+            }
+            None => None,
+        };
+        let rec = self.record_mut(k)?;
+        rec.camera = camera.max(1);
+        rec.location = location.max(1);
+        if cdf_record.is_some() {
+            rec.cdf = cdf_record;
+        }
+        self.commit()
+    }
+
+    /// Saves grey image `k` under lighting `letter` as `NAMEkL.img`, then
+    /// records it. Returns the file's path.
+    pub fn save_image(
+        &mut self,
+        k: u32,
+        letter: char,
+        img: &ImgFile,
+    ) -> Result<PathBuf, SessionError> {
+        self.writable()?;
+        if !self.letters().contains(&letter) {
+            return Err(SessionError::UnknownLighting {
+                letter,
+                known: self.letters().iter().collect(),
+            });
+        }
+        let file = self.file_name(k, Some(letter), "img");
+        let bytes = formats::img::encode_img(img)?;
+        self.write_file(&file, &bytes)?;
+        let rec = GreyRecord {
+            letter,
+            file: file.clone(),
+            hash: stamp::hash(&bytes),
+            width: u32::try_from(img.image.width()).unwrap_or(u32::MAX),
+            height: u32::try_from(img.image.height()).unwrap_or(u32::MAX),
+            saved: stamp::now_rfc3339(),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+        };
+        let r = self.record_mut(k)?;
+        r.grey.retain(|g| g.letter != letter);
+        r.grey.push(rec);
+        r.grey.sort_by_key(|g| g.letter);
+        if k > self.manifest.session.planned_images {
+            self.manifest.session.planned_images = k;
+        }
+        self.commit()?;
+        Ok(self.path(&file))
+    }
+
+    /// Reads back the grey images of `k`, in letter order.
+    pub fn load_images(&self, k: u32) -> Result<Vec<(char, ImgFile)>, SessionError> {
+        let rec = self.manifest.image(k);
+        rec.map_or(&[][..], |r| r.grey.as_slice())
+            .iter()
+            .map(|g| Ok((g.letter, formats::img::read_img(&self.path(&g.file))?)))
+            .collect()
+    }
+
+    /// Records a manual edit of the lines of `k`: writes the resulting lines
+    /// as the new `NAMEk.ldr`, then appends `op` to the edit log.
+    pub fn record_edit(&mut self, k: u32, op: &str, lines: &[Segment]) -> Result<(), SessionError> {
+        self.writable()?;
+        let file = self.file_name(k, None, "ldr");
+        let bytes = formats::lines::format_lines(lines).into_bytes();
+        self.write_file(&file, &bytes)?;
+        let r = self.record_mut(k)?;
+        r.edit.push(EditRecord {
+            at: stamp::now_rfc3339(),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            op: formats::sanitize(op),
+            lines: lines.len() as u64,
+            hash: stamp::hash(&bytes),
+        });
+        self.commit()
+    }
+
+    /// The current lines of `k` (`.ldr`), with their attributes when no
+    /// manual edit changed them since the outputs were made.
+    pub fn load_lines(&self, k: u32) -> Result<Vec<Segment>, SessionError> {
+        let file = self.file_name(k, None, "ldr");
+        let mut lines = formats::lines::read_lines(&self.path(&file))?;
+        if let Some(r) = self.manifest.image(k)
+            && r.edit.is_empty()
+            && let Some(a) = r.outputs.as_ref().and_then(|o| o.ldr_attributes.as_ref())
+        {
+            a.apply(&mut lines);
+        }
+        Ok(lines)
+    }
+
+    /// What is done and what is left: the checklist and the resume point.
+    pub fn progress(&self) -> Progress {
+        progress::progress(&self.manifest)
+    }
+
+    /// Checks every file the manifest names (exists, parses, unchanged) and
+    /// lists stale outputs.
+    pub fn check(&self) -> CheckReport {
+        check::check(self)
+    }
+
+    // ----- internals -----
+
+    fn writable(&self) -> Result<(), SessionError> {
+        if self.lock.is_none() {
+            return Err(SessionError::ReadOnly {
+                dir: self.dir.clone(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The record of image `k`, made with the default camera and location
+    /// (images go round the cameras, then to the next location).
+    fn record_mut(&mut self, k: u32) -> Result<&mut ImageRecord, SessionError> {
+        if k == 0 {
+            return Err(SessionError::BadImage(k));
+        }
+        let cams = self.manifest.session.cameras.max(1);
+        let pos = match self.manifest.image.binary_search_by_key(&k, |r| r.number) {
+            Ok(i) => i,
+            Err(i) => {
+                self.manifest.image.insert(
+                    i,
+                    ImageRecord {
+                        number: k,
+                        camera: (k - 1) % cams + 1,
+                        location: (k - 1) / cams + 1,
+                        cdf: None,
+                        grey: Vec::new(),
+                        outputs: None,
+                        edit: Vec::new(),
+                    },
+                );
+                i
+            }
+        };
+        self.manifest
+            .image
+            .get_mut(pos)
+            .ok_or(SessionError::BadImage(k))
+    }
+
+    fn write_file(&self, file: &str, bytes: &[u8]) -> Result<(), SessionError> {
+        let path = self.path(file);
+        write_atomic(&path, bytes).map_err(|source| SessionError::Io { path, source })
+    }
+
+    /// Writes `.ses` (if its numbers changed) and then the manifest: always
+    /// after the data files they describe.
+    fn commit(&mut self) -> Result<(), SessionError> {
+        self.writable()?;
+        let m = &mut self.manifest;
+        m.session.modified = stamp::now_rfc3339();
+        m.session.version = env!("CARGO_PKG_VERSION").to_string();
+        let images = m
+            .image
+            .iter()
+            .map(|r| r.number)
+            .max()
+            .unwrap_or(0)
+            .max(m.session.planned_images)
+            .max(1);
+        let ses = Ses {
+            images,
+            cameras: m.session.cameras.max(1),
+            lightings: u32::try_from(m.lighting.len()).unwrap_or(u32::MAX).max(1),
+        };
+        let ses_file = format!("{}.ses", self.name);
+        let ses_text = formats::ses::format_ses(&ses);
+        if fs::read_to_string(self.path(&ses_file)).ok().as_deref() != Some(ses_text.as_str()) {
+            self.write_file(&ses_file, ses_text.as_bytes())?;
+        }
+        let manifest_file = format!("{}.toml", self.name);
+        let text = self
+            .manifest
+            .to_toml()
+            .map_err(|e| SessionError::Manifest {
+                path: self.path(&manifest_file),
+                line: 0,
+                message: format!("cannot write the manifest: {e}"),
+            })?;
+        self.write_file(&manifest_file, text.as_bytes())
+    }
+
+    /// Removes temporary files an interrupted save left behind (we hold the
+    /// lock, so no other writer owns them).
+    fn remove_leftovers(&self) {
+        for p in self.leftovers() {
+            let _ = fs::remove_file(p);
+        }
+    }
+
+    /// Temporary files of interrupted atomic writes.
+    pub fn leftovers(&self) -> Vec<PathBuf> {
+        let Ok(rd) = fs::read_dir(&self.dir) else {
+            return Vec::new();
+        };
+        let mut v: Vec<PathBuf> = rd
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .filter(|p| {
+                p.file_name()
+                    .map(|n| n.to_string_lossy())
+                    .is_some_and(|n| n.starts_with('.') && n.contains(".tmp."))
+            })
+            .collect();
+        v.sort();
+        v
+    }
+}

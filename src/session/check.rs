@@ -1,0 +1,132 @@
+//! `vss session check`: every file the manifest names exists and parses with
+//! the format readers; files changed since they were recorded, stale
+//! outputs, a `.ses` that disagrees and leftovers of interrupted saves are
+//! listed. Problems (missing or unreadable files) make the check fail;
+//! the rest are warnings a person should read.
+
+use std::path::Path;
+
+use super::progress::{OutputState, output_state};
+use super::{Session, stamp};
+use crate::formats;
+
+/// What `check` found.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct CheckReport {
+    /// Files the manifest names that are missing or do not parse.
+    pub problems: Vec<String>,
+    /// Files changed since recorded, `.ses` disagreements, leftovers.
+    pub warnings: Vec<String>,
+    /// Images whose outputs are stale, with why.
+    pub stale: Vec<(u32, String)>,
+    /// Files read and parsed.
+    pub checked: usize,
+}
+
+impl CheckReport {
+    /// No problems (warnings and stale outputs allowed).
+    pub fn is_ok(&self) -> bool {
+        self.problems.is_empty()
+    }
+}
+
+pub fn check(s: &Session) -> CheckReport {
+    let mut r = CheckReport::default();
+    let m = s.manifest();
+    for rec in &m.image {
+        let mut expected: Vec<(String, &str)> = Vec::new();
+        expected.extend(rec.cdf.iter().map(|f| (f.file.clone(), f.hash.as_str())));
+        expected.extend(rec.grey.iter().map(|g| (g.file.clone(), g.hash.as_str())));
+        if let Some(o) = &rec.outputs {
+            for f in &o.files {
+                // After manual edits the `.ldr` is the last edit's.
+                let hash = match rec.edit.last() {
+                    Some(e) if f.file.ends_with(".ldr") => e.hash.as_str(),
+                    _ => f.hash.as_str(),
+                };
+                expected.push((f.file.clone(), hash));
+            }
+        } else if let Some(e) = rec.edit.last() {
+            let ldr = s.file_name(rec.number, None, "ldr");
+            expected.push((ldr, e.hash.as_str()));
+        }
+        for (file, hash) in expected {
+            check_file(&s.path(&file), &file, hash, &mut r);
+        }
+        if let OutputState::Stale(why) = output_state(rec) {
+            r.stale.push((rec.number, why));
+        }
+    }
+    let ses_file = format!("{}.ses", s.name());
+    match formats::ses::read_ses(&s.path(&ses_file)) {
+        Err(e) => r.problems.push(e.to_string()),
+        Ok(ses) => {
+            r.checked += 1;
+            let lightings = m.lighting.len() as u32;
+            if ses.cameras != m.session.cameras || ses.lightings != lightings {
+                r.warnings.push(format!(
+                    "{ses_file} says {} cameras and {} lightings; the manifest {} and {lightings}",
+                    ses.cameras, ses.lightings, m.session.cameras
+                ));
+            }
+            let last = m.image.iter().map(|i| i.number).max().unwrap_or(0);
+            if ses.images < last {
+                r.warnings.push(format!(
+                    "{ses_file} says {} images but the manifest records image {last}",
+                    ses.images
+                ));
+            }
+        }
+    }
+    for p in s.leftovers() {
+        r.warnings.push(format!(
+            "{}: left over from an interrupted save; opening the session for writing removes it",
+            p.display()
+        ));
+    }
+    r
+}
+
+fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) {
+    let bytes = match std::fs::read(path) {
+        Ok(b) => b,
+        Err(e) => {
+            r.problems.push(format!("{}: {e}", path.display()));
+            return;
+        }
+    };
+    let ext = file.rsplit_once('.').map_or("", |(_, e)| e);
+    let parsed = match ext {
+        "img" | "imc" => formats::img::parse_img(&bytes, path).map(|_| ()),
+        "hpo" | "vpo" => formats::edgefile::parse_edges(&bytes, path).map(|_| ()),
+        "lex" | "ldr" => match std::str::from_utf8(&bytes) {
+            Ok(t) => formats::lines::parse_lines(t, path).map(|_| ()),
+            Err(e) => {
+                r.problems
+                    .push(format!("{}: not text: {e}", path.display()));
+                return;
+            }
+        },
+        "cdf" => match std::str::from_utf8(&bytes) {
+            Ok(t) => formats::cdf::parse_cdf(t, path).map(|_| ()),
+            Err(e) => {
+                r.problems
+                    .push(format!("{}: not text: {e}", path.display()));
+                return;
+            }
+        },
+        _ => Ok(()),
+    };
+    match parsed {
+        Err(e) => r.problems.push(e.to_string()),
+        Ok(()) => {
+            r.checked += 1;
+            if stamp::hash(&bytes) != hash {
+                r.warnings.push(format!(
+                    "{}: changed since the manifest recorded it (outputs made from it may be stale)",
+                    path.display()
+                ));
+            }
+        }
+    }
+}

@@ -1,0 +1,366 @@
+//! The session manifest `NAME.toml`: everything about a survey that the
+//! three-number `.ses` file cannot hold — the lighting configurations, the
+//! camera, location and `.cdf` of every image number, and for every saved
+//! file its content hash; for the stage outputs the parameters, counts and
+//! timings, when and by which version they were made and from which inputs;
+//! the log of manual line edits.
+//!
+//! It is plain serde + TOML, readable and editable by a person. Loading is
+//! strict (unknown keys are errors) and then checked for sense (unique image
+//! numbers and letters, file names that stay inside the session folder), so
+//! a manifest edited into nonsense is reported with its file and line and
+//! never silently rewritten.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::SessionError;
+use crate::llv::{Params, Segment};
+
+/// Version of the manifest schema this console writes.
+pub const FORMAT: u32 = 1;
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    /// Schema version ([`FORMAT`]).
+    pub format: u32,
+    pub session: SessionInfo,
+    /// Lighting configurations, lettered a, b, …
+    #[serde(default)]
+    pub lighting: Vec<LightingInfo>,
+    /// Image numbers with anything recorded, in ascending order.
+    #[serde(default)]
+    pub image: Vec<ImageRecord>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SessionInfo {
+    pub name: String,
+    /// UTC, RFC 3339.
+    pub created: String,
+    pub modified: String,
+    /// Version of `vss` that last wrote the manifest.
+    pub version: String,
+    /// Name of the profile the session was made with.
+    #[serde(default)]
+    pub profile: String,
+    /// Images the survey plans (the checklist's length).
+    pub planned_images: u32,
+    pub cameras: u32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightingInfo {
+    pub letter: char,
+    /// Names of the lights that are on.
+    #[serde(default)]
+    pub on: Vec<String>,
+    #[serde(default)]
+    pub note: String,
+}
+
+/// A file of the session and the hash of its content when it was written.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FileRecord {
+    pub file: String,
+    pub hash: String,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageRecord {
+    pub number: u32,
+    pub camera: u32,
+    pub location: u32,
+    /// The camera description copied into the session (`cube7.cdf`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cdf: Option<FileRecord>,
+    /// Grey images, one per lighting letter captured.
+    #[serde(default)]
+    pub grey: Vec<GreyRecord>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outputs: Option<OutputRecord>,
+    /// Manual line edits since the outputs were made, oldest first.
+    #[serde(default)]
+    pub edit: Vec<EditRecord>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GreyRecord {
+    pub letter: char,
+    pub file: String,
+    pub hash: String,
+    pub width: u32,
+    pub height: u32,
+    pub saved: String,
+    pub version: String,
+}
+
+/// The stage outputs of one image number.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputRecord {
+    pub made: String,
+    pub version: String,
+    /// The inputs the outputs were made from, with their hashes then: the
+    /// grey images (and the `.cdf`). Differences make the outputs stale.
+    pub inputs: Vec<FileRecord>,
+    /// The files written: `.imc`, `.hpo`, `.vpo`, `.lex`, `.ldr`.
+    pub files: Vec<FileRecord>,
+    pub counts: Counts,
+    pub timings: TimingsRecord,
+    /// Attributes of the extracted and of the post-processed lines, which
+    /// the line files cannot carry.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lex_attributes: Option<LineAttributes>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ldr_attributes: Option<LineAttributes>,
+    /// The parameters used (last: TOML wants tables after plain values).
+    pub params: Params,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Counts {
+    pub edges_h: u64,
+    pub edges_v: u64,
+    pub lines_raw: u64,
+    pub lines: u64,
+}
+
+/// Stage timings (µs), as the pipeline measured them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimingsRecord {
+    pub lens_us: u64,
+    pub edges_us: u64,
+    pub lines_us: u64,
+    pub connect_us: u64,
+}
+
+/// Per-line attributes in file order: mean response, RMS residual, and the
+/// indices (0-based) of the lines flagged as shadows.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LineAttributes {
+    pub response: Vec<f64>,
+    pub residual: Vec<f64>,
+    #[serde(default)]
+    pub shadow: Vec<u32>,
+}
+
+impl LineAttributes {
+    /// `None` when no line carries an attribute (e.g. lines read from a
+    /// `.lex`): nothing worth recording.
+    pub fn of(lines: &[Segment]) -> Option<LineAttributes> {
+        let any = lines
+            .iter()
+            .any(|s| s.response != 0.0 || s.residual != 0.0 || s.shadow);
+        any.then(|| LineAttributes {
+            // TOML has no way to say "no value" in an array: write 0.
+            response: lines.iter().map(|s| finite(s.response)).collect(),
+            residual: lines.iter().map(|s| finite(s.residual)).collect(),
+            shadow: lines
+                .iter()
+                .enumerate()
+                .filter(|(_, s)| s.shadow)
+                .filter_map(|(i, _)| u32::try_from(i).ok())
+                .collect(),
+        })
+    }
+
+    /// Puts the attributes back on lines read from a line file (when the
+    /// counts agree).
+    pub fn apply(&self, lines: &mut [Segment]) {
+        if self.response.len() != lines.len() || self.residual.len() != lines.len() {
+            return;
+        }
+        for (i, s) in lines.iter_mut().enumerate() {
+            s.response = self.response.get(i).copied().unwrap_or(0.0);
+            s.residual = self.residual.get(i).copied().unwrap_or(0.0);
+        }
+        for &i in &self.shadow {
+            if let Some(s) = lines.get_mut(i as usize) {
+                s.shadow = true;
+            }
+        }
+    }
+}
+
+fn finite(v: f64) -> f64 {
+    if v.is_finite() { v } else { 0.0 }
+}
+
+/// One manual edit of the lines of an image.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EditRecord {
+    pub at: String,
+    pub version: String,
+    /// What was done, as the editor describes it: `connect 3 7`.
+    pub op: String,
+    /// Lines after the edit.
+    pub lines: u64,
+    /// Hash of the `.ldr` written after the edit.
+    pub hash: String,
+}
+
+impl Manifest {
+    pub fn image(&self, k: u32) -> Option<&ImageRecord> {
+        self.image.iter().find(|r| r.number == k)
+    }
+
+    /// Every file the manifest names: (image number, file, recorded hash).
+    pub fn files(&self) -> Vec<(u32, &str, &str)> {
+        let mut out = Vec::new();
+        for r in &self.image {
+            let k = r.number;
+            out.extend(r.cdf.iter().map(|f| (k, f.file.as_str(), f.hash.as_str())));
+            out.extend(r.grey.iter().map(|g| (k, g.file.as_str(), g.hash.as_str())));
+            if let Some(o) = &r.outputs {
+                out.extend(
+                    o.files
+                        .iter()
+                        .map(|f| (k, f.file.as_str(), f.hash.as_str())),
+                );
+            }
+        }
+        out
+    }
+
+    /// Parses manifest text; errors name `path` and the line.
+    pub fn parse(text: &str, path: &Path) -> Result<Manifest, SessionError> {
+        let m: Manifest = toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| {
+                    let end = s.start.min(text.len());
+                    text.get(..end).map_or(0, |t| t.matches('\n').count() + 1)
+                })
+                .unwrap_or(0);
+            SessionError::Manifest {
+                path: path.to_path_buf(),
+                line,
+                message: e.message().trim().to_string(),
+            }
+        })?;
+        m.validate()
+            .map_err(|(needle, message)| SessionError::Manifest {
+                path: path.to_path_buf(),
+                line: needle.map_or(0, |n| find_line(text, &n)),
+                message,
+            })?;
+        Ok(m)
+    }
+
+    /// The manifest as TOML text.
+    pub fn to_toml(&self) -> Result<String, toml::ser::Error> {
+        let body = toml::to_string(self)?;
+        Ok(format!(
+            "# Session manifest written by vss {}. The console owns this file: edit with care;\n\
+             # `vss session check DIR` tells whether it still makes sense.\n{body}",
+            env!("CARGO_PKG_VERSION")
+        ))
+    }
+
+    /// Sense checks after parsing. On failure: text to look for (to find
+    /// the line) and the message.
+    fn validate(&self) -> Result<(), (Option<String>, String)> {
+        if self.format != FORMAT {
+            return Err((
+                Some("format".into()),
+                format!(
+                    "manifest format {} is not one this console reads (it reads {FORMAT})",
+                    self.format
+                ),
+            ));
+        }
+        if let Err(e) = crate::formats::names::SessionName::new(&self.session.name) {
+            return Err((Some("name".into()), e.to_string()));
+        }
+        if self.session.cameras == 0 {
+            return Err((Some("cameras".into()), "cameras must be at least 1".into()));
+        }
+        let mut letters = Vec::new();
+        for l in &self.lighting {
+            if !l.letter.is_ascii_lowercase() {
+                return Err((
+                    Some(format!("{:?}", l.letter.to_string())),
+                    format!("lighting letter {:?} is not one of a–z", l.letter),
+                ));
+            }
+            if letters.contains(&l.letter) {
+                return Err((
+                    Some(format!("letter = \"{}\"", l.letter)),
+                    format!("lighting letter {:?} appears twice", l.letter),
+                ));
+            }
+            letters.push(l.letter);
+        }
+        let mut numbers = Vec::new();
+        for r in &self.image {
+            let at = Some(format!("number = {}", r.number));
+            if r.number == 0 || numbers.contains(&r.number) {
+                return Err((
+                    at,
+                    format!("image number {} is 0 or appears twice", r.number),
+                ));
+            }
+            numbers.push(r.number);
+            for g in &r.grey {
+                if !letters.contains(&g.letter) {
+                    return Err((
+                        Some(g.file.clone()),
+                        format!(
+                            "grey image {} has lighting {:?}, which the [[lighting]] list does not define",
+                            g.file, g.letter
+                        ),
+                    ));
+                }
+            }
+            let names = r
+                .cdf
+                .iter()
+                .map(|f| f.file.as_str())
+                .chain(r.grey.iter().map(|g| g.file.as_str()))
+                .chain(
+                    r.outputs
+                        .iter()
+                        .flat_map(|o| o.files.iter().chain(&o.inputs))
+                        .map(|f| f.file.as_str()),
+                );
+            for name in names {
+                if !plain_file_name(name) {
+                    return Err((
+                        Some(name.to_string()),
+                        format!(
+                            "file name {name:?} is not a plain file name inside the session folder"
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A name with no path in it: what a session may name.
+pub fn plain_file_name(name: &str) -> bool {
+    !name.is_empty()
+        && name != "."
+        && name != ".."
+        && !name.contains(['/', '\\'])
+        && !name.chars().any(char::is_control)
+}
+
+/// The 1-based line of the first occurrence of `needle` (0 if absent).
+fn find_line(text: &str, needle: &str) -> usize {
+    text.find(needle)
+        .map_or(0, |i| text[..i].matches('\n').count() + 1)
+}
