@@ -197,11 +197,17 @@ pub struct Binding {
     pub key: Key,
     pub action: Action,
     pub desc: &'static str,
-    /// Shown in the status bar of its screen.
-    pub hint: bool,
+    /// Its label in the status bar of its screen ("" = not shown there).
+    pub hint: &'static str,
 }
 
-const fn b(scope: Scope, key: Key, action: Action, desc: &'static str, hint: bool) -> Binding {
+const fn b(
+    scope: Scope,
+    key: Key,
+    action: Action,
+    desc: &'static str,
+    hint: &'static str,
+) -> Binding {
     Binding {
         scope,
         key,
@@ -225,259 +231,237 @@ const SE: Scope = Scope::Screen(S::Session);
 /// reuse a key; the first match wins.
 pub const KEYMAP: &[Binding] = &[
     // Modal scopes.
-    b(Scope::Confirm, ch('y'), A::Yes, "yes, go ahead", true),
+    b(Scope::Confirm, ch('y'), A::Yes, "yes, go ahead", "yes"),
     b(
         Scope::Confirm,
         ch('n'),
         A::No,
         "no, keep what is there",
-        true,
+        "no",
     ),
-    b(Scope::Confirm, k(K::Esc), A::No, "no", false),
+    b(Scope::Confirm, k(K::Esc), A::No, "no", ""),
     b(
         Scope::Prompt,
         k(K::Enter),
         A::Submit,
         "accept the typed text",
-        true,
+        "accept",
     ),
-    b(Scope::Prompt, k(K::Esc), A::Cancel, "cancel typing", true),
+    b(
+        Scope::Prompt,
+        k(K::Esc),
+        A::Cancel,
+        "cancel typing",
+        "cancel",
+    ),
     // Survey.
     b(
         SU,
         ch('n'),
         A::NewSession,
         "new session (type its name)",
-        true,
+        "new",
     ),
-    b(SU, k(K::Up), A::SelectUp, "choose a session above", false),
-    b(
-        SU,
-        k(K::Down),
-        A::SelectDown,
-        "choose a session below",
-        false,
-    ),
+    b(SU, k(K::Up), A::SelectUp, "choose a session above", ""),
+    b(SU, k(K::Down), A::SelectDown, "choose a session below", ""),
     b(
         SU,
         ch('o'),
         A::OpenSelected,
         "open (resume) the chosen session",
-        true,
+        "open",
     ),
     b(
         SU,
         k(K::Enter),
         A::NextStep,
         "next step: capture all lightings / run",
-        true,
+        "next step",
     ),
     b(
         SU,
         ch('a'),
         A::Accept,
         "accept this image, go to the next",
-        true,
+        "accept",
     ),
-    b(SU, ch('r'), A::Redo, "redo this image (asks first)", true),
-    b(SU, ch('c'), A::CameraNext, "next camera", true),
-    b(SU, ch('p'), A::LocationNext, "next camera location", false),
-    b(SU, k(K::Esc), A::Cancel, "cancel the transfer", false),
+    b(SU, ch('r'), A::Redo, "redo this image (asks first)", "redo"),
+    b(SU, ch('c'), A::CameraNext, "next camera", "camera"),
+    b(SU, ch('p'), A::LocationNext, "next camera location", ""),
+    b(SU, k(K::Esc), A::Cancel, "cancel the transfer", ""),
     // Capture.
-    b(CA, ch('v'), A::ToggleLive, "live view on/off", true),
-    b(CA, ch('g'), A::Grab, "grab one frame", true),
-    b(CA, ch('c'), A::CameraNext, "next camera", true),
-    b(CA, k(K::Up), A::LightPrev, "previous light", false),
-    b(CA, k(K::Down), A::LightNext, "next light", false),
-    b(CA, ch(' '), A::LightToggle, "switch the chosen light", true),
-    b(CA, ch('o'), A::LightsOff, "all lights off", false),
+    b(CA, ch('v'), A::ToggleLive, "live view on/off", "live"),
+    b(CA, ch('g'), A::Grab, "grab one frame", "grab"),
+    b(CA, ch('c'), A::CameraNext, "next camera", "camera"),
+    b(CA, k(K::Up), A::LightPrev, "previous light", ""),
+    b(CA, k(K::Down), A::LightNext, "next light", ""),
     b(
         CA,
-        ch('A'),
-        A::Lighting(0),
-        "lighting configuration a",
-        false,
+        ch(' '),
+        A::LightToggle,
+        "switch the chosen light",
+        "light",
     ),
-    b(
-        CA,
-        ch('B'),
-        A::Lighting(1),
-        "lighting configuration b",
-        false,
-    ),
-    b(
-        CA,
-        ch('C'),
-        A::Lighting(2),
-        "lighting configuration c",
-        false,
-    ),
-    b(
-        CA,
-        ch('D'),
-        A::Lighting(3),
-        "lighting configuration d",
-        false,
-    ),
-    b(
-        CA,
-        ch('E'),
-        A::Lighting(4),
-        "lighting configuration e",
-        false,
-    ),
-    b(
-        CA,
-        ch('F'),
-        A::Lighting(5),
-        "lighting configuration f",
-        false,
-    ),
-    b(CA, k(K::Esc), A::Cancel, "cancel the transfer", false),
+    b(CA, ch('o'), A::LightsOff, "all lights off", ""),
+    b(CA, ch('A'), A::Lighting(0), "lighting configuration a", ""),
+    b(CA, ch('B'), A::Lighting(1), "lighting configuration b", ""),
+    b(CA, ch('C'), A::Lighting(2), "lighting configuration c", ""),
+    b(CA, ch('D'), A::Lighting(3), "lighting configuration d", ""),
+    b(CA, ch('E'), A::Lighting(4), "lighting configuration e", ""),
+    b(CA, ch('F'), A::Lighting(5), "lighting configuration f", ""),
+    b(CA, k(K::Esc), A::Cancel, "cancel the transfer", ""),
     // Pipeline.
-    b(PI, k(K::Up), A::ParamPrev, "previous parameter", false),
-    b(PI, k(K::Down), A::ParamNext, "next parameter", false),
-    b(PI, ch('+'), A::ParamInc, "increase by one step", true),
-    b(PI, ch('='), A::ParamInc, "increase by one step", false),
-    b(PI, k(K::Right), A::ParamInc, "increase by one step", false),
-    b(PI, ch('-'), A::ParamDec, "decrease by one step", true),
-    b(PI, k(K::Left), A::ParamDec, "decrease by one step", false),
-    b(PI, ch('>'), A::ParamInc10, "increase by ten steps", false),
+    b(PI, k(K::Up), A::ParamPrev, "previous parameter", ""),
+    b(PI, k(K::Down), A::ParamNext, "next parameter", ""),
+    b(PI, ch('+'), A::ParamInc, "increase by one step", "more"),
+    b(PI, ch('='), A::ParamInc, "increase by one step", ""),
+    b(PI, k(K::Right), A::ParamInc, "increase by one step", ""),
+    b(PI, ch('-'), A::ParamDec, "decrease by one step", "less"),
+    b(PI, k(K::Left), A::ParamDec, "decrease by one step", ""),
+    b(PI, ch('>'), A::ParamInc10, "increase by ten steps", ""),
     b(
         PI,
         shift(K::Right),
         A::ParamInc10,
         "increase by ten steps",
-        false,
+        "",
     ),
-    b(PI, ch('<'), A::ParamDec10, "decrease by ten steps", false),
+    b(PI, ch('<'), A::ParamDec10, "decrease by ten steps", ""),
     b(
         PI,
         shift(K::Left),
         A::ParamDec10,
         "decrease by ten steps",
-        false,
+        "",
     ),
-    b(PI, k(K::Enter), A::ParamType, "type a value", true),
-    b(PI, k(K::Tab), A::ViewNext, "next stage view", true),
-    b(PI, k(K::BackTab), A::ViewPrev, "previous stage view", false),
-    b(PI, ch('b'), A::SideBySide, "side by side / one view", false),
+    b(PI, k(K::Enter), A::ParamType, "type a value", "type"),
+    b(PI, k(K::Tab), A::ViewNext, "next stage view", "view"),
+    b(PI, k(K::BackTab), A::ViewPrev, "previous stage view", ""),
+    b(PI, ch('b'), A::SideBySide, "side by side / one view", ""),
     b(
         PI,
         ch('S'),
         A::SaveOutputs,
         "save these outputs to the session",
-        false,
+        "",
     ),
     // Pipeline and Edit share the preview keys.
-    b(PI, ch('z'), A::ZoomIn, "zoom in", false),
-    b(PI, ch('x'), A::ZoomOut, "zoom out", false),
-    b(PI, ch('a'), A::CursorLeft, "cursor left", false),
-    b(PI, ch('d'), A::CursorRight, "cursor right", false),
-    b(PI, ch('w'), A::CursorUp, "cursor up", false),
-    b(PI, ch('s'), A::CursorDown, "cursor down", false),
-    b(PI, ch('A'), A::PanLeft, "pan left", false),
-    b(PI, ch('D'), A::PanRight, "pan right", false),
-    b(PI, ch('W'), A::PanUp, "pan up", false),
-    b(PI, ch('X'), A::PanDown, "pan down", false),
+    b(PI, ch('z'), A::ZoomIn, "zoom in", ""),
+    b(PI, ch('x'), A::ZoomOut, "zoom out", ""),
+    b(PI, ch('a'), A::CursorLeft, "cursor left", ""),
+    b(PI, ch('d'), A::CursorRight, "cursor right", ""),
+    b(PI, ch('w'), A::CursorUp, "cursor up", ""),
+    b(PI, ch('s'), A::CursorDown, "cursor down", ""),
+    b(PI, ch('A'), A::PanLeft, "pan left", ""),
+    b(PI, ch('D'), A::PanRight, "pan right", ""),
+    b(PI, ch('W'), A::PanUp, "pan up", ""),
+    b(PI, ch('X'), A::PanDown, "pan down", ""),
     // Edit.
-    b(ED, ch('n'), A::LineNext, "select the next line", true),
-    b(ED, k(K::Tab), A::LineNext, "select the next line", false),
-    b(ED, ch('p'), A::LinePrev, "select the previous line", false),
+    b(ED, ch('n'), A::LineNext, "select the next line", "next"),
+    b(ED, k(K::Tab), A::LineNext, "select the next line", ""),
+    b(ED, ch('p'), A::LinePrev, "select the previous line", ""),
     b(
         ED,
         k(K::BackTab),
         A::LinePrev,
         "select the previous line",
-        false,
+        "",
     ),
     b(
         ED,
         ch('.'),
         A::LineNearest,
         "select the line nearest the cursor",
-        true,
+        "nearest",
     ),
     b(
         ED,
         ch('k'),
         A::Corner,
         "select the two lines of the corner at the cursor",
-        true,
+        "corner",
     ),
     b(
         ED,
         ch(' '),
         A::Mark,
         "add the line to / drop it from the selection",
-        false,
+        "",
     ),
     b(
         ED,
         ch('c'),
         A::Connect,
         "connect the two selected lines",
-        true,
+        "connect",
     ),
     b(
         ED,
         ch('e'),
         A::Extend,
         "extend the first line to the second",
-        true,
+        "extend",
     ),
-    b(ED, ch('x'), A::Delete, "delete the selected lines", true),
     b(
         ED,
-        k(K::Delete),
+        ch('x'),
         A::Delete,
         "delete the selected lines",
-        false,
+        "delete",
     ),
-    b(ED, ch('u'), A::Undo, "undo", true),
-    b(ED, ch('r'), A::RedoEdit, "redo", true),
-    b(ED, k(K::Esc), A::Cancel, "clear the selection", false),
-    b(ED, ch('z'), A::ZoomIn, "zoom in", false),
-    b(ED, ch('Z'), A::ZoomOut, "zoom out", false),
-    b(ED, ch('a'), A::CursorLeft, "cursor left", false),
-    b(ED, ch('d'), A::CursorRight, "cursor right", false),
-    b(ED, ch('w'), A::CursorUp, "cursor up", false),
-    b(ED, ch('s'), A::CursorDown, "cursor down", false),
-    b(ED, k(K::Left), A::PanLeft, "pan left", false),
-    b(ED, k(K::Right), A::PanRight, "pan right", false),
-    b(ED, k(K::Up), A::PanUp, "pan up", false),
-    b(ED, k(K::Down), A::PanDown, "pan down", false),
+    b(ED, k(K::Delete), A::Delete, "delete the selected lines", ""),
+    b(ED, ch('u'), A::Undo, "undo", "undo"),
+    b(ED, ch('r'), A::RedoEdit, "redo", "redo"),
+    b(ED, k(K::Esc), A::Cancel, "clear the selection", ""),
+    b(ED, ch('z'), A::ZoomIn, "zoom in", ""),
+    b(ED, ch('Z'), A::ZoomOut, "zoom out", ""),
+    b(ED, ch('a'), A::CursorLeft, "cursor left", ""),
+    b(ED, ch('d'), A::CursorRight, "cursor right", ""),
+    b(ED, ch('w'), A::CursorUp, "cursor up", ""),
+    b(ED, ch('s'), A::CursorDown, "cursor down", ""),
+    b(ED, k(K::Left), A::PanLeft, "pan left", ""),
+    b(ED, k(K::Right), A::PanRight, "pan right", ""),
+    b(ED, k(K::Up), A::PanUp, "pan up", ""),
+    b(ED, k(K::Down), A::PanDown, "pan down", ""),
     // Session / report.
     b(
         SE,
         ch('e'),
         A::Export,
         "export the PostScript and SVG reports",
-        true,
+        "export",
     ),
-    b(SE, ch('r'), A::Refresh, "re-read the session's files", true),
-    // Everywhere.
-    b(G, ch('1'), A::GoTo(S::Survey), "Survey screen", false),
-    b(G, ch('2'), A::GoTo(S::Capture), "Capture screen", false),
-    b(G, ch('3'), A::GoTo(S::Pipeline), "Pipeline screen", false),
-    b(G, ch('4'), A::GoTo(S::Edit), "Edit screen", false),
     b(
-        G,
-        ch('5'),
-        A::GoTo(S::Session),
-        "Session/Report screen",
-        false,
+        SE,
+        ch('r'),
+        A::Refresh,
+        "re-read the session's files",
+        "refresh",
     ),
-    b(G, ch('?'), A::Help, "help: every key", true),
+    b(SE, k(K::Up), A::SelectUp, "scroll the file list up", ""),
+    b(
+        SE,
+        k(K::Down),
+        A::SelectDown,
+        "scroll the file list down",
+        "",
+    ),
+    // Everywhere.
+    b(G, ch('1'), A::GoTo(S::Survey), "Survey screen", ""),
+    b(G, ch('2'), A::GoTo(S::Capture), "Capture screen", ""),
+    b(G, ch('3'), A::GoTo(S::Pipeline), "Pipeline screen", ""),
+    b(G, ch('4'), A::GoTo(S::Edit), "Edit screen", ""),
+    b(G, ch('5'), A::GoTo(S::Session), "Session/Report screen", ""),
+    b(G, ch('?'), A::Help, "help: every key", "help"),
     b(
         G,
         ch('l'),
         A::ToggleLog,
         "log pane: hide / show / expand",
-        true,
+        "log",
     ),
-    b(G, ch('q'), A::Quit, "quit", true),
-    b(G, ctrl('c'), A::Quit, "quit", false),
+    b(G, ch('q'), A::Quit, "quit", "quit"),
+    b(G, ctrl('c'), A::Quit, "quit", ""),
 ];
 
 /// The action of a key in a scope (global rows are tried after the scope's
@@ -512,23 +496,13 @@ pub fn describe(scope: Scope) -> Vec<(String, &'static str)> {
     out.into_iter().map(|(k, _, d)| (k, d)).collect()
 }
 
-/// The status-bar hints of a scope: `key desc` pairs, shortest first words.
+/// The status-bar hints of a scope: (key, short label) pairs.
 pub fn hints(scope: Scope) -> Vec<(String, &'static str)> {
     KEYMAP
         .iter()
-        .filter(|b| b.hint && (b.scope == scope))
-        .map(|b| (b.key.label(), short(b.desc)))
+        .filter(|b| !b.hint.is_empty() && b.scope == scope)
+        .map(|b| (b.key.label(), b.hint))
         .collect()
-}
-
-/// The first words of a description, for the status bar.
-fn short(desc: &'static str) -> &'static str {
-    let end = desc
-        .char_indices()
-        .filter(|(_, c)| *c == ' ' || *c == ':' || *c == '(' || *c == ',')
-        .nth(1)
-        .map_or(desc.len(), |(i, _)| i);
-    desc[..end].trim_end_matches([':', ' ', ','])
 }
 
 #[cfg(test)]
@@ -598,6 +572,6 @@ mod tests {
         );
         let h = hints(Scope::Global);
         assert!(h.iter().any(|(k, d)| k == "q" && *d == "quit"));
-        assert!(h.iter().all(|(_, d)| d.len() <= 16), "{h:?}");
+        assert!(h.iter().all(|(_, d)| d.len() <= 10), "{h:?}");
     }
 }

@@ -136,6 +136,9 @@ pub struct Preview<'a> {
     pub cursor: Option<(usize, usize)>,
     /// Indices of lines to draw highlighted (Edit screen selection).
     pub selected: &'a [usize],
+    /// The image size to frame the layer in (edges and lines of an image
+    /// share its frame); `None` = the layer's own extent.
+    pub frame: Option<(usize, usize)>,
 }
 
 impl<'a> Preview<'a> {
@@ -147,11 +150,15 @@ impl<'a> Preview<'a> {
             colour,
             cursor: None,
             selected: &[],
+            frame: None,
         }
     }
 
     /// The image size the layer refers to.
     pub fn image_size(&self) -> (usize, usize) {
+        if let Some(f) = self.frame {
+            return f;
+        }
         match self.layer {
             Layer::Grey(g) | Layer::LinesOver(g, _) => g.size(),
             Layer::Edges(e) => (e.width.max(1), e.height.max(1)),
