@@ -57,6 +57,9 @@ pub fn run(g: &Global, preview: Option<&str>) -> anyhow::Result<ExitCode> {
     install_panic_hook();
     let mut terminal = enter().context("setting up the terminal")?;
     let result = run_loop(&mut terminal, profile, look, &stop);
+    // Drop the terminal first: its own clean-up writes to the screen, and
+    // leaving the alternate screen must be the last thing written.
+    drop(terminal);
     leave();
     result.map(|()| ExitCode::SUCCESS)
 }

@@ -98,7 +98,7 @@ impl PipelineScreen {
 }
 
 pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
-    let (panel, right) = split_panel(area, 36);
+    let (panel, right) = split_panel(area, 32);
     params_panel(app, panel, buf);
     let [views, info] = Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(right);
     let Some(cur) = app.current.as_ref().filter(|c| !c.frames.is_empty()) else {
@@ -182,7 +182,10 @@ fn params_panel(app: &App, area: Rect, buf: &mut Buffer) {
         .take(room)
         .map(|(i, sp)| {
             let v = app.params.get(sp.key).map(fmt_value).unwrap_or_default();
-            let text = format!("{:<24}{:>8}", sp.key, v);
+            let w = (area.width as usize)
+                .saturating_sub(3 + sp.key.len())
+                .max(v.len());
+            let text = format!("{} {v:>w$}", sp.key);
             if i == sel {
                 Line::styled(text, t.selected())
             } else {
@@ -247,7 +250,7 @@ fn cursor_line(app: &App, cur: &Loaded, area: Rect, buf: &mut Buffer) {
     };
     let out = cur.outputs.as_deref();
     let text = format!(
-        "x {x} y {y}  grey {g}  resp H {} V {}  zoom {}×  [{}]",
+        "x{x} y{y} grey {g} H{} V{} zoom {} [{}]",
         resp(out.map(|o| &o.response_h)),
         resp(out.map(|o| &o.response_v)),
         app.pipeline.nav.view.zoom,
