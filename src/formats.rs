@@ -151,10 +151,12 @@ pub(crate) fn decode_text<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a str, F
     })
 }
 
-/// Reads a text file as UTF-8.
+/// Reads a text file as UTF-8, without a leading byte-order mark (which
+/// some Windows editors add).
 pub(crate) fn read_text(path: &Path) -> Result<String, FormatError> {
     let bytes = read_bytes(path)?;
-    decode_text(&bytes, path).map(str::to_string)
+    let text = decode_text(&bytes, path)?;
+    Ok(text.strip_prefix('\u{feff}').unwrap_or(text).to_string())
 }
 
 /// The lines of a text with their 1-based numbers, without `\r\n`/`\n`.

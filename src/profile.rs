@@ -12,6 +12,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::llv::Params;
 
+mod check;
+pub mod edit;
+
 /// A whole profile.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -27,6 +30,11 @@ pub struct Profile {
     pub survey: SurveyConfig,
     pub sim: SimConfig,
     pub llv: Params,
+    /// The file this profile was loaded from (`None` when built in code);
+    /// relative paths in it (`survey.cdf`, `survey.dir`) are relative to its
+    /// folder.
+    #[serde(skip)]
+    pub source: Option<PathBuf>,
 }
 
 /// Which frame grabber, and how to reach it.
@@ -191,19 +199,13 @@ pub enum ProfileError {
 }
 
 impl Profile {
-    /// Parses a profile from text; `path` is only used in error messages.
+    /// Parses and checks a profile from text; `path` is used in error
+    /// messages (and becomes [`Profile::source`]). Every error names the
+    /// file, the line and the key, and says what is allowed.
     pub fn from_toml(text: &str, path: &Path) -> Result<Profile, ProfileError> {
-        toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|s| text[..s.start.min(text.len())].lines().count().max(1))
-                .unwrap_or(0);
-            ProfileError::Invalid {
-                path: path.to_path_buf(),
-                line,
-                message: e.message().to_string(),
-            }
-        })
+        let mut p = check::parse_checked(text, path)?;
+        p.source = Some(path.to_path_buf());
+        Ok(p)
     }
 
     /// Loads a profile by path, or by name from the `profiles/` folder.
@@ -214,6 +216,42 @@ impl Profile {
             source,
         })?;
         Profile::from_toml(&text, &path)
+    }
+
+    /// The folder relative paths of this profile are relative to (the
+    /// profile file's folder; the current folder for a built-in profile).
+    pub fn dir(&self) -> PathBuf {
+        match self.source.as_deref().and_then(Path::parent) {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        }
+    }
+
+    /// A path from the profile, made relative to [`Profile::dir`] unless it
+    /// is absolute.
+    pub fn resolve_path(&self, p: &Path) -> PathBuf {
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.dir().join(p)
+        }
+    }
+
+    /// The `.cdf` file of camera `cam` (1-based), resolved.
+    pub fn cdf_path(&self, cam: u32) -> Option<PathBuf> {
+        let i = usize::try_from(cam).ok()?.checked_sub(1)?;
+        self.survey.cdf.get(i).map(|p| self.resolve_path(p))
+    }
+
+    /// The lighting configuration of a letter.
+    pub fn lighting(&self, letter: char) -> Option<&Lighting> {
+        self.lighting.iter().find(|l| l.letter == letter)
+    }
+
+    /// The profile as TOML (comments of the original file are not kept; see
+    /// [`edit::set_llv`] to change values in place).
+    pub fn to_toml(&self) -> Result<String, toml::ser::Error> {
+        toml::to_string(self)
     }
 }
 

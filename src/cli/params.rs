@@ -1,16 +1,176 @@
-//! `vss params` (to be written).
+//! `vss params`: the LLV parameters between profiles and the cell's old
+//! parameter files (formats.md §3).
+//!
+//! - `vss params list`: every parameter with its default, range, unit and doc.
+//! - `vss params export PROFILE --set edges|lines|connect|lens|all [--out F.par]`
+//! - `vss params import F.par [--out P.toml]`: applied to the `--profile`
+//!   (default `default`); with `--out`, that profile's text with the values
+//!   replaced in place (comments kept), else the `[llv.*]` tables on stdout.
+//!
+//! The mapping (set `vss edges`, entries named by key, types i/b/f) is
+//! documented in [`crate::formats::par`].
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
+use anyhow::Context;
+use clap::Subcommand;
+
 use super::Global;
+use crate::formats::par::{ParamSet, format_par, from_params, import_params, write_par};
+use crate::llv::Params;
+use crate::llv::params::{Kind, PARAMS};
+use crate::profile::{Profile, edit, resolve};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Arguments (not yet defined).
-    #[arg(trailing_var_arg = true)]
-    pub rest: Vec<String>,
+    #[command(subcommand)]
+    pub cmd: Cmd,
 }
 
-pub fn run(_g: &Global, _a: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`vss params` is not implemented yet")
+#[derive(Debug, Subcommand)]
+pub enum Cmd {
+    /// List every LLV parameter: key, default, range, unit and what it does.
+    List,
+    /// Write a profile's LLV parameters as a parameter file (.par).
+    Export {
+        /// Profile: a path to a .toml file or a name from profiles/.
+        profile: String,
+        /// Which parameters: lens, edges, lines, connect or all.
+        #[arg(long = "set", value_name = "SET", default_value = "all", value_parser = ["lens", "edges", "lines", "connect", "all"])]
+        set: String,
+        /// Output file (default: standard output).
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+    },
+    /// Read a parameter file (.par) into a profile's LLV parameters.
+    Import {
+        /// The parameter file.
+        file: PathBuf,
+        /// Write the changed profile here (default: print the [llv] tables).
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+    },
+}
+
+pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
+    match a.cmd {
+        Cmd::List => {
+            print!("{}", list_text());
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Export { profile, set, out } => {
+            let p = Profile::load(&profile)?;
+            let set = ParamSet::parse(&set).context("unknown parameter set")?;
+            let f = from_params(&p.llv, set);
+            match out {
+                Some(o) => {
+                    write_par(&o, &f)?;
+                    eprintln!(
+                        "vss: wrote {} ({} parameters, set \"{}\")",
+                        o.display(),
+                        f.entries.len(),
+                        f.name
+                    );
+                }
+                None => print!("{}", format_par(&f)),
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Cmd::Import { file, out } => {
+            let base_name = g.profile.as_deref().unwrap_or("default");
+            let base_path = resolve(base_name)?;
+            let base_text = std::fs::read_to_string(&base_path)
+                .with_context(|| format!("cannot read profile {}", base_path.display()))?;
+            let base = Profile::from_toml(&base_text, &base_path)?;
+            let text =
+                std::fs::read(&file).with_context(|| format!("cannot read {}", file.display()))?;
+            let text = std::str::from_utf8(&text).map_err(|_| {
+                anyhow::anyhow!(
+                    "{}: not UTF-8 text; expected a parameter file",
+                    file.display()
+                )
+            })?;
+            let (params, notes) = import_params(text, &file, &base.llv)?;
+            for n in notes {
+                eprintln!("vss: note: {}: {n}", file.display());
+            }
+            match out {
+                Some(o) => {
+                    let new_text = edit::set_llv(&base_text, &base_path, &params)?;
+                    crate::fsutil::write_atomic(&o, new_text.as_bytes())
+                        .with_context(|| format!("cannot write {}", o.display()))?;
+                    let moved = o.parent().map(|d| d.canonicalize().ok())
+                        != base_path.parent().map(|d| d.canonicalize().ok());
+                    if moved && base.survey.cdf.iter().any(|c| c.is_relative()) {
+                        eprintln!(
+                            "vss: note: {} is in another folder than {}: its relative survey.cdf paths now point elsewhere",
+                            o.display(),
+                            base_path.display()
+                        );
+                    }
+                    eprintln!(
+                        "vss: wrote {} ({} from {})",
+                        o.display(),
+                        changed_text(&base.llv, &params),
+                        file.display()
+                    );
+                }
+                None => print!("{}", llv_toml(&params)),
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+fn changed_text(old: &Params, new: &Params) -> String {
+    let n = PARAMS
+        .iter()
+        .filter(|sp| old.get(sp.key) != new.get(sp.key))
+        .count();
+    format!("{n} parameter(s) changed")
+}
+
+/// The `[llv.*]` tables of a parameter set, as they stand in a profile.
+pub fn llv_toml(p: &Params) -> String {
+    let mut s = String::new();
+    let mut group = "";
+    for sp in PARAMS {
+        let (g, name) = sp.key.split_once('.').unwrap_or(("", sp.key));
+        if g != group {
+            if !s.is_empty() {
+                s.push('\n');
+            }
+            s.push_str(&format!("[llv.{g}]\n"));
+            group = g;
+        }
+        let v = edit::toml_value(sp.kind, p.get(sp.key).unwrap_or(0.0));
+        s.push_str(&format!("{name} = {v}\n"));
+    }
+    s
+}
+
+/// The table of `vss params list`.
+pub fn list_text() -> String {
+    let d = Params::default();
+    let mut s = format!(
+        "{:<26} {:>8}  {:<15} {:<12} {}\n",
+        "KEY", "DEFAULT", "RANGE", "UNIT", "WHAT IT DOES"
+    );
+    for sp in PARAMS {
+        let v = d.get(sp.key).unwrap_or(f64::NAN);
+        let def = match sp.kind {
+            Kind::Bool => (v != 0.0).to_string(),
+            _ => format!("{v}"),
+        };
+        s.push_str(&format!(
+            "{:<26} {:>8}  {:<15} {:<12} {}\n",
+            sp.key,
+            def,
+            sp.range_text(),
+            sp.unit,
+            sp.doc
+        ));
+    }
+    s
 }

@@ -93,9 +93,10 @@ pub fn parse_lines(text: &str, path: &Path) -> Result<Vec<Segment>, FormatError>
                     format!("expected \"start end\", found \"{}\"", shorten(t)),
                 ));
             };
+            let ia = parse_index(a, path, n, "a start vertex index")?;
+            let ib = parse_index(b, path, n, "an end vertex index")?;
             let mut ends = [Point::default(); 2];
-            for (end, tok) in ends.iter_mut().zip([a, b]) {
-                let i = parse_index(tok, path, n, "a vertex index")?;
+            for (end, i) in ends.iter_mut().zip([ia, ib]) {
                 let Some((p, _)) = vertices.get(&i) else {
                     return Err(FormatError::at_line(
                         path,
