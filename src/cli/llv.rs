@@ -1,16 +1,353 @@
-//! `vss llv` (to be written).
+//! `vss llv IMAGE...`: runs lens correction, edges, line extraction and
+//! CONNECT on grey images and writes `.imc` (with `--cdf`), `.hpo`, `.vpo`,
+//! `.lex` and `.ldr`; `vss llv --from-edges STEM.hpo STEM.vpo` re-runs the
+//! line stages from saved edge files alone.
+//!
+//! Images of one view under several lightings (`cube1a.img cube1b.img`: the
+//! same stem but for the lighting letter, formats.md §1) are ONE input to the
+//! photometric pipeline and give `cube1.hpo` etc.; other images are
+//! processed one by one. A failing input is reported on stderr and the
+//! others still run; the exit code is 1 if any failed.
 
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use anyhow::{Context, bail};
+use serde_json::json;
+
 use super::Global;
+use crate::formats::names::VssFile;
+use crate::formats::{cdf, edgefile, imageio, img::ImgFile, lines as linefile};
+use crate::llv::lens::{CameraModel, LensMap};
+use crate::llv::pipeline::{Input, StageOutputs, Workspace, lines_from_edges};
+use crate::llv::{GreyImage, Params};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Arguments (not yet defined).
-    #[arg(trailing_var_arg = true)]
-    pub rest: Vec<String>,
+    /// Grey images (.img .imc .png .pgm .tif .bmp); lightings of one view
+    /// (cube1a.img cube1b.img) are combined.
+    #[arg(required_unless_present = "from_edges", conflicts_with = "from_edges")]
+    pub images: Vec<PathBuf>,
+    /// Camera description: lens-correct the images and write .imc files.
+    #[arg(long, value_name = "CAMERA.cdf")]
+    pub cdf: Option<PathBuf>,
+    /// Change a parameter for this run: --set edges.per_region=12 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Directory for the outputs (default: beside each input).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Print one JSON object per image instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// An image taken with only ambient light, subtracted from every lit image.
+    #[arg(long, value_name = "IMG")]
+    pub ambient: Option<PathBuf>,
+    /// Re-run line extraction and CONNECT from STEM.hpo STEM.vpo.
+    #[arg(long, num_args = 2, value_names = ["STEM.hpo", "STEM.vpo"])]
+    pub from_edges: Option<Vec<PathBuf>>,
 }
 
-pub fn run(_g: &Global, _a: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`vss llv` is not implemented yet")
+/// One input of the pipeline: the images of one view and the output stem.
+#[derive(Debug)]
+struct Group {
+    stem: String,
+    dir: PathBuf,
+    files: Vec<PathBuf>,
+}
+
+/// Groups image paths into views, in order of first appearance.
+fn group(paths: &[PathBuf]) -> Vec<Group> {
+    let mut groups: Vec<Group> = Vec::new();
+    let mut index: HashMap<(PathBuf, String), usize> = HashMap::new();
+    for p in paths {
+        let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
+        let name = p
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let parsed = VssFile::parse(&name).ok().filter(|f| f.lighting.is_some());
+        let stem = match &parsed {
+            Some(f) => format!("{}{}", f.session, f.image),
+            None => p
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "image".to_string()),
+        };
+        match (parsed.is_some(), index.get(&(dir.clone(), stem.clone()))) {
+            (true, Some(&k)) => groups[k].files.push(p.clone()),
+            _ => {
+                if parsed.is_some() {
+                    index.insert((dir.clone(), stem.clone()), groups.len());
+                }
+                groups.push(Group {
+                    stem,
+                    dir,
+                    files: vec![p.clone()],
+                });
+            }
+        }
+    }
+    for g in &mut groups {
+        g.files
+            .sort_by_key(|f| f.file_name().map(|n| n.to_os_string()));
+    }
+    groups
+}
+
+fn params(g: &Global, a: &Args) -> anyhow::Result<Params> {
+    let mut p = g.load_profile()?.llv;
+    for s in &a.set {
+        p.set_str(s).with_context(|| format!("--set {s}"))?;
+    }
+    p.validate()?;
+    Ok(p)
+}
+
+pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
+    let p = params(g, &a)?;
+    if let Some(out) = &a.out {
+        std::fs::create_dir_all(out)
+            .with_context(|| format!("{}: cannot create the output directory", out.display()))?;
+    }
+    if let Some(files) = &a.from_edges {
+        let [hpo, vpo] = files.as_slice() else {
+            bail!("--from-edges needs two files: STEM.hpo STEM.vpo");
+        };
+        let r = from_edges(hpo, vpo, &a, &p);
+        return finish(r.map(|()| 0));
+    }
+    let camera = match &a.cdf {
+        Some(path) => Some(cdf::read_cdf(path)?.camera_model().with_context(|| {
+            format!(
+                "{}: the camera description lacks S, C or f (or marks them N): cannot correct the lens",
+                path.display()
+            )
+        })?),
+        None => None,
+    };
+    let ambient = match &a.ambient {
+        Some(path) => Some(imageio::read_any(path)?.image),
+        None => None,
+    };
+    let mut maps: HashMap<(usize, usize), LensMap> = HashMap::new();
+    let mut ws = Workspace::new();
+    let mut failed = 0;
+    for grp in group(&a.images) {
+        if let Err(e) = run_group(
+            &grp,
+            &a,
+            &p,
+            camera.as_ref(),
+            ambient.as_ref(),
+            &mut maps,
+            &mut ws,
+        ) {
+            eprintln!("vss: error: {}: {e:#}", grp.stem);
+            failed += 1;
+        }
+    }
+    finish(Ok(failed))
+}
+
+fn finish(r: anyhow::Result<usize>) -> anyhow::Result<ExitCode> {
+    Ok(if r? == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
+fn out_path(a: &Args, dir: &Path, name: &str) -> PathBuf {
+    a.out.as_deref().unwrap_or(dir).join(name)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_group(
+    grp: &Group,
+    a: &Args,
+    p: &Params,
+    camera: Option<&CameraModel>,
+    ambient: Option<&GreyImage>,
+    maps: &mut HashMap<(usize, usize), LensMap>,
+    ws: &mut Workspace,
+) -> anyhow::Result<()> {
+    let files: Vec<ImgFile> = grp
+        .files
+        .iter()
+        .map(|f| imageio::read_any(f))
+        .collect::<Result<_, _>>()?;
+    let images: Vec<GreyImage> = files.iter().map(|f| f.image.clone()).collect();
+    let size = images.first().map(GreyImage::size).unwrap_or_default();
+    let map = camera.map(|m| {
+        &*maps
+            .entry(size)
+            .or_insert_with(|| LensMap::new(m, size.0, size.1))
+    });
+    let input = Input {
+        images: &images,
+        ambient,
+        lens: map,
+    };
+    let out = ws.run(&input, p)?;
+    let mut written = Vec::new();
+    if camera.is_some() {
+        // The corrected images (the inputs themselves when the map is the
+        // identity or correction is switched off).
+        for (k, (path, f)) in grp.files.iter().zip(&files).enumerate() {
+            let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+            let target = out_path(a, &grp.dir, &format!("{}.imc", stem.unwrap_or_default()));
+            let image = out.corrected.get(k).unwrap_or(&f.image).clone();
+            let imc = ImgFile {
+                image,
+                comment: f.comment.clone(),
+                x0: f.x0,
+                y0: f.y0,
+            };
+            imageio::write_any(&target, &imc)?;
+            written.push(target);
+        }
+    }
+    written.extend(write_outputs(a, &grp.dir, &grp.stem, out, true)?);
+    report(a, &grp.stem, &grp.files, size, out, &written);
+    Ok(())
+}
+
+/// Writes `.hpo`/`.vpo` (when `edges`), `.lex` and `.ldr`.
+fn write_outputs(
+    a: &Args,
+    dir: &Path,
+    stem: &str,
+    out: &StageOutputs,
+    edges: bool,
+) -> anyhow::Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    if edges {
+        for (ext, e) in [("hpo", &out.edges_h), ("vpo", &out.edges_v)] {
+            let t = out_path(a, dir, &format!("{stem}.{ext}"));
+            edgefile::write_edges(&t, e)?;
+            written.push(t);
+        }
+    }
+    for (ext, l) in [("lex", &out.lines_raw), ("ldr", &out.lines)] {
+        let t = out_path(a, dir, &format!("{stem}.{ext}"));
+        linefile::write_lines(&t, l)?;
+        written.push(t);
+    }
+    Ok(written)
+}
+
+fn from_edges(hpo: &Path, vpo: &Path, a: &Args, p: &Params) -> anyhow::Result<()> {
+    let eh = edgefile::read_edges(hpo)?;
+    let ev = edgefile::read_edges(vpo)?;
+    let out = lines_from_edges(eh, ev, p);
+    let stem = hpo
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "edges".to_string());
+    let dir = hpo.parent().map(Path::to_path_buf).unwrap_or_default();
+    let written = write_outputs(a, &dir, &stem, &out, false)?;
+    let size = (out.edges_h.width, out.edges_h.height);
+    report(
+        a,
+        &stem,
+        &[hpo.to_path_buf(), vpo.to_path_buf()],
+        size,
+        &out,
+        &written,
+    );
+    Ok(())
+}
+
+/// Prints what one input gave: text, or one JSON object per line.
+fn report(
+    a: &Args,
+    stem: &str,
+    files: &[PathBuf],
+    size: (usize, usize),
+    out: &StageOutputs,
+    written: &[PathBuf],
+) {
+    let t = &out.timings;
+    let shown = |p: &PathBuf| crate::formats::sanitize(&p.display().to_string());
+    if a.json {
+        let attrs: Vec<_> = out
+            .lines
+            .iter()
+            .map(|l| json!({"response": l.response, "residual": l.residual, "shadow": l.shadow}))
+            .collect();
+        let v = json!({
+            "image": stem,
+            "files": files.iter().map(shown).collect::<Vec<_>>(),
+            "width": size.0,
+            "height": size.1,
+            "edges_h": out.edges_h.points.len(),
+            "edges_v": out.edges_v.points.len(),
+            "lines_raw": out.lines_raw.len(),
+            "lines": out.lines.len(),
+            "timings_us": {"lens": t.lens_us, "edges": t.edges_us, "lines": t.lines_us, "connect": t.connect_us},
+            "line_attributes": attrs,
+            "written": written.iter().map(shown).collect::<Vec<_>>(),
+        });
+        println!("{v}");
+        return;
+    }
+    let ms = |us: u64| us as f64 / 1000.0;
+    println!(
+        "{stem} ({}): {} × {}",
+        files.iter().map(shown).collect::<Vec<_>>().join(" "),
+        size.0,
+        size.1
+    );
+    println!(
+        "  edge points  H {:>6}   V {:>6}",
+        out.edges_h.points.len(),
+        out.edges_v.points.len()
+    );
+    println!(
+        "  lines        {:>6} extracted, {} after CONNECT",
+        out.lines_raw.len(),
+        out.lines.len()
+    );
+    println!(
+        "  time (ms)    lens {:.2}  edges {:.2}  lines {:.2}  connect {:.2}",
+        ms(t.lens_us),
+        ms(t.edges_us),
+        ms(t.lines_us),
+        ms(t.connect_us)
+    );
+    println!(
+        "  wrote        {}",
+        written.iter().map(shown).collect::<Vec<_>>().join(" ")
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lightings_of_one_view_form_one_group() {
+        let paths: Vec<PathBuf> = [
+            "d/cube1b.img",
+            "d/cube1a.img",
+            "d/photo.png",
+            "d/cube2a.img",
+            "e/cube1a.img",
+        ]
+        .iter()
+        .map(PathBuf::from)
+        .collect();
+        let g = group(&paths);
+        assert_eq!(g.len(), 4);
+        assert_eq!(g[0].stem, "cube1");
+        assert_eq!(
+            g[0].files,
+            vec![PathBuf::from("d/cube1a.img"), PathBuf::from("d/cube1b.img")]
+        );
+        assert_eq!(g[1].stem, "photo");
+        assert_eq!(g[2].stem, "cube2");
+        assert_eq!(g[3].dir, PathBuf::from("e"));
+    }
 }

@@ -66,8 +66,12 @@ pub fn angle_between(s1: &Segment, s2: &Segment) -> f64 {
 
 /// Whether CONNECT merges two segments under `p`.
 pub fn mergeable(s1: &Segment, s2: &Segment, p: &ConnectParams) -> bool {
-    angle_between(s1, s2) <= p.max_angle_deg.to_radians()
-        && rects_intersect(&environment(s1, p.wl, p.wd), &environment(s2, p.wl, p.wd))
+    let max = p
+        .max_angle_deg
+        .to_radians()
+        .clamp(0.0, std::f64::consts::FRAC_PI_2);
+    let (sin_max, cos_max) = max.sin_cos();
+    geo_mergeable(&Geo::of(s1, p), &Geo::of(s2, p), sin_max, cos_max)
 }
 
 /// The canonical order of segments: longer first, then by coordinates.
@@ -141,11 +145,48 @@ pub fn merge(s1: &Segment, s2: &Segment) -> Segment {
     }
 }
 
+/// What the pair test needs of a segment, computed once per change.
+#[derive(Clone, Copy, Debug)]
+struct Geo {
+    env: Rect,
+    /// Axis-aligned bounds of the environment: min x, min y, max x, max y.
+    bounds: [f64; 4],
+}
+
+impl Geo {
+    fn of(s: &Segment, p: &ConnectParams) -> Geo {
+        let env = environment(s, p.wl, p.wd);
+        let ex = env.hl * env.d.0.abs() + env.hw * env.d.1.abs();
+        let ey = env.hl * env.d.1.abs() + env.hw * env.d.0.abs();
+        Geo {
+            env,
+            bounds: [env.c.x - ex, env.c.y - ey, env.c.x + ex, env.c.y + ey],
+        }
+    }
+}
+
+/// The merge test on cached geometry: bounds, then the angle (`|cross| ≤
+/// tan(max)·|dot|` is `atan2(|cross|, |dot|) ≤ max` without the atan2), then
+/// the separating-axis test.
+fn geo_mergeable(g1: &Geo, g2: &Geo, sin_max: f64, cos_max: f64) -> bool {
+    let (b1, b2) = (&g1.bounds, &g2.bounds);
+    if b1[0] > b2[2] || b2[0] > b1[2] || b1[1] > b2[3] || b2[1] > b1[3] {
+        return false;
+    }
+    let (a1, a2) = (g1.env.d, g2.env.d);
+    let cross = (a1.0 * a2.1 - a1.1 * a2.0).abs();
+    let dot = (a1.0 * a2.0 + a1.1 * a2.1).abs();
+    cross * cos_max <= dot * sin_max && rects_intersect(&g1.env, &g2.env)
+}
+
 /// Reusable buffers of CONNECT.
 #[derive(Clone, Debug, Default)]
 pub struct ConnectScratch {
     segs: Vec<Segment>,
+    geo: Vec<Geo>,
     alive: Vec<bool>,
+    /// The pass in which each segment last changed (0: never).
+    changed: Vec<u32>,
 }
 
 /// CONNECT (§4) of a line set; the result is sorted longest first.
@@ -157,6 +198,10 @@ pub fn connect(lines: &[Segment], p: &ConnectParams) -> Vec<Segment> {
 }
 
 /// [`connect`] into reusable buffers.
+///
+/// A pair is tested again in a later pass only if one of the two changed in
+/// the previous pass or this one: otherwise it was already tested in the
+/// same state and failed. This makes the final "nothing merges" pass cheap.
 pub fn connect_into(
     lines: &[Segment],
     p: &ConnectParams,
@@ -173,9 +218,19 @@ pub fn connect_into(
         l.a.x.is_finite() && l.a.y.is_finite() && l.b.x.is_finite() && l.b.y.is_finite()
     }));
     s.segs.sort_unstable_by(order);
-    s.alive.clear();
-    s.alive.resize(s.segs.len(), true);
     let n = s.segs.len();
+    s.geo.clear();
+    s.geo.extend(s.segs.iter().map(|l| Geo::of(l, p)));
+    s.alive.clear();
+    s.alive.resize(n, true);
+    s.changed.clear();
+    s.changed.resize(n, 0);
+    let max = p
+        .max_angle_deg
+        .to_radians()
+        .clamp(0.0, std::f64::consts::FRAC_PI_2);
+    let (sin_max, cos_max) = max.sin_cos();
+    let mut pass = 1u32;
     loop {
         let mut merged_any = false;
         for i in 0..n {
@@ -184,8 +239,11 @@ pub fn connect_into(
             }
             let mut j = i + 1;
             while j < n {
-                if s.alive[j] && mergeable(&s.segs[i], &s.segs[j], p) {
+                let fresh = s.changed[i] + 1 >= pass || s.changed[j] + 1 >= pass;
+                if s.alive[j] && fresh && geo_mergeable(&s.geo[i], &s.geo[j], sin_max, cos_max) {
                     s.segs[i] = merge(&s.segs[i], &s.segs[j]);
+                    s.geo[i] = Geo::of(&s.segs[i], p);
+                    s.changed[i] = pass;
                     s.alive[j] = false;
                     merged_any = true;
                     j = i + 1;
@@ -197,6 +255,7 @@ pub fn connect_into(
         if !merged_any {
             break;
         }
+        pass += 1;
     }
     out.extend(
         s.segs

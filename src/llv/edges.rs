@@ -92,18 +92,30 @@ fn check_half_width(a: usize) -> Result<(), LlvError> {
 /// The Lee response of `img` along `dir` with half-width `a` (3–7).
 pub fn response(img: &GreyImage, dir: ScanDir, a: usize) -> Result<Response, LlvError> {
     let mut out = Response::default();
-    response_into(img, dir, a, &mut out, &mut Vec::new())?;
+    response_into(img, dir, a, &mut out, &mut ResponseScratch::default())?;
     Ok(out)
 }
 
-/// [`response`] into reusable buffers (`scratch` holds invalid-pixel counts
-/// when the image has a validity mask).
+/// Reusable buffers of [`response_into`].
+#[derive(Clone, Debug, Default)]
+pub struct ResponseScratch {
+    /// Invalid-pixel counts (images with a validity mask).
+    counts: Vec<u32>,
+    /// Pixels as `f32`, converted once per call.
+    pixels: Vec<f32>,
+}
+
+/// [`response`] into reusable buffers.
+///
+/// The antisymmetry of the kernel halves the work:
+/// `E(x) = Σ_{s=1..A} c_s (Img(x+s) - Img(x-s))` with `c_s = 6 s (A-s)`
+/// (then scaled by `1/A³`); all sums are of whole numbers, exact in `f32`.
 pub fn response_into(
     img: &GreyImage,
     dir: ScanDir,
     a: usize,
     out: &mut Response,
-    scratch: &mut Vec<u32>,
+    scratch: &mut ResponseScratch,
 ) -> Result<(), LlvError> {
     check_half_width(a)?;
     img.check_stage_size()?;
@@ -113,14 +125,34 @@ pub fn response_into(
     out.dir = dir;
     out.data.clear();
     out.data.resize(w * h, f32::NAN);
-    let k: Vec<f32> = integer_kernel(a).into_iter().map(|v| v as f32).collect();
+    let mut coef = [0f32; 7];
+    for (s, v) in coef.iter_mut().enumerate().take(a) {
+        *v = (6 * (s + 1) * (a - s - 1)) as f32;
+    }
+    let c = &coef[..a];
     let scale = 1.0 / (a * a * a) as f32;
-    let src = img.data();
+    let px = &mut scratch.pixels;
+    px.clear();
+    px.extend(img.data().iter().map(|&v| v as f32));
     match dir {
         ScanDir::Horizontal => {
             if w > 2 * a {
-                for (row, orow) in src.chunks_exact(w).zip(out.data.chunks_exact_mut(w)) {
-                    convolve_row(row, &k, a, &mut orow[a..w - a], scale);
+                for (row, orow) in px.chunks_exact(w).zip(out.data.chunks_exact_mut(w)) {
+                    let o = &mut orow[a..w - a];
+                    o.fill(0.0);
+                    let n = o.len();
+                    for (k, &cs) in c.iter().enumerate() {
+                        let s = k + 1;
+                        // Output j is pixel x = j + A: x + s = j + A + s.
+                        let right = &row[a + s..a + s + n];
+                        let left = &row[a - s..a - s + n];
+                        for ((o, &r), &l) in o.iter_mut().zip(right).zip(left) {
+                            *o += cs * (r - l);
+                        }
+                    }
+                    for v in o.iter_mut() {
+                        *v *= scale;
+                    }
                 }
             }
         }
@@ -129,48 +161,25 @@ pub fn response_into(
                 for y in a..h - a {
                     let orow = &mut out.data[y * w..(y + 1) * w];
                     orow.fill(0.0);
-                    // EdgeV(x, y) = Σ_t Img(x, y - t) φ'(t).
-                    for (i, &kt) in k.iter().enumerate() {
-                        if kt == 0.0 {
-                            continue;
-                        }
-                        let sy = y + a - i;
-                        let srow = &src[sy * w..(sy + 1) * w];
-                        for (o, &s) in orow.iter_mut().zip(srow) {
-                            *o += kt * s as f32;
+                    for (k, &cs) in c.iter().enumerate() {
+                        let s = k + 1;
+                        let below = &px[(y + s) * w..(y + s + 1) * w];
+                        let above = &px[(y - s) * w..(y - s + 1) * w];
+                        for ((o, &b), &t) in orow.iter_mut().zip(below).zip(above) {
+                            *o += cs * (b - t);
                         }
                     }
-                    for o in orow.iter_mut() {
-                        *o *= scale;
+                    for v in orow.iter_mut() {
+                        *v *= scale;
                     }
                 }
             }
         }
     }
     if let Some(mask) = img.valid_mask() {
-        mask_invalid(mask, w, h, dir, a, &mut out.data, scratch);
+        mask_invalid(mask, w, h, dir, a, &mut out.data, &mut scratch.counts);
     }
     Ok(())
-}
-
-/// One row of the horizontal convolution: `out[j] = Σ_t row[j + A - t] φ'(t)`
-/// for output pixels `x = j + A`.
-fn convolve_row(row: &[u8], k: &[f32], a: usize, out: &mut [f32], scale: f32) {
-    out.fill(0.0);
-    let n = out.len();
-    for (i, &kt) in k.iter().enumerate() {
-        if kt == 0.0 {
-            continue;
-        }
-        // t = i - A; source x - t = j + A - (i - A) = j + 2A - i.
-        let off = 2 * a - i;
-        for (o, &s) in out.iter_mut().zip(&row[off..off + n]) {
-            *o += kt * s as f32;
-        }
-    }
-    for o in out.iter_mut() {
-        *o *= scale;
-    }
 }
 
 /// Sets NaN wherever the kernel window touches an invalid pixel.
@@ -252,6 +261,39 @@ pub struct PeakScratch {
     candidates: Vec<Candidate>,
     hist: Vec<u32>,
     thresholds: Vec<u32>,
+    flags: Vec<u8>,
+}
+
+/// `flags[i] = 1` where `|mid[i]|` is a peak between `|lo[i]|` and `|hi[i]|`
+/// (§2.3) above `t`. Branch-free so it vectorises; NaN compares false.
+#[inline]
+fn peak_flags(lo: &[f32], mid: &[f32], hi: &[f32], t: f32, flags: &mut [u8]) {
+    for (((f, &m), &l), &h) in flags.iter_mut().zip(mid).zip(lo).zip(hi) {
+        let e0 = m.abs();
+        *f = u8::from((e0 > l.abs()) & (e0 >= h.abs()) & (e0 > t));
+    }
+}
+
+/// Calls `f(i)` for every `i` with `flags[i] != 0`, in order, skipping
+/// empty stretches eight bytes at a time.
+#[inline]
+fn for_each_flag(flags: &[u8], mut f: impl FnMut(usize)) {
+    let mut chunks = flags.chunks_exact(8);
+    let mut base = 0;
+    for ch in &mut chunks {
+        let mut word = u64::from_le_bytes([ch[0], ch[1], ch[2], ch[3], ch[4], ch[5], ch[6], ch[7]]);
+        while word != 0 {
+            let bit = word.trailing_zeros() as usize;
+            f(base + bit / 8);
+            word &= !(0xFFu64 << (bit / 8 * 8));
+        }
+        base += 8;
+    }
+    for (k, &v) in chunks.remainder().iter().enumerate() {
+        if v != 0 {
+            f(base + k);
+        }
+    }
 }
 
 /// Parabolic subpixel offset through `|E|` at a peak and its two neighbours,
@@ -296,24 +338,30 @@ pub fn peaks_into(resp: &Response, p: &EdgeParams, out: &mut EdgePoints, s: &mut
     let r = p.region_lines.max(1) as usize;
     let cands = &mut s.candidates;
     cands.clear();
+    s.flags.clear();
+    s.flags.resize(w, 0);
+    let flags = &mut s.flags;
     match resp.dir {
         ScanDir::Horizontal => {
             for (y, row) in resp.data.chunks_exact(w).enumerate() {
+                peak_flags(
+                    &row[..w - 2],
+                    &row[1..w - 1],
+                    &row[2..],
+                    t,
+                    &mut flags[1..w - 1],
+                );
                 let region = (y / r) as u32;
-                for x in 1..w - 1 {
-                    let e0 = row[x].abs();
-                    let em = row[x - 1].abs();
-                    let ep = row[x + 1].abs();
-                    if e0 > em && e0 >= ep && e0 > t {
-                        cands.push(Candidate {
-                            x: x as u32,
-                            y: y as u32,
-                            e: row[x],
-                            delta: subpixel(em, e0, ep),
-                            region,
-                        });
-                    }
-                }
+                for_each_flag(flags, |x| {
+                    let (em, e0, ep) = (row[x - 1].abs(), row[x].abs(), row[x + 1].abs());
+                    cands.push(Candidate {
+                        x: x as u32,
+                        y: y as u32,
+                        e: row[x],
+                        delta: subpixel(em, e0, ep),
+                        region,
+                    });
+                });
             }
         }
         ScanDir::Vertical => {
@@ -321,20 +369,17 @@ pub fn peaks_into(resp: &Response, p: &EdgeParams, out: &mut EdgePoints, s: &mut
                 let up = &resp.data[(y - 1) * w..y * w];
                 let row = &resp.data[y * w..(y + 1) * w];
                 let dn = &resp.data[(y + 1) * w..(y + 2) * w];
-                for x in 0..w {
-                    let e0 = row[x].abs();
-                    let em = up[x].abs();
-                    let ep = dn[x].abs();
-                    if e0 > em && e0 >= ep && e0 > t {
-                        cands.push(Candidate {
-                            x: x as u32,
-                            y: y as u32,
-                            e: row[x],
-                            delta: subpixel(em, e0, ep),
-                            region: (x / r) as u32,
-                        });
-                    }
-                }
+                peak_flags(up, row, dn, t, flags);
+                for_each_flag(flags, |x| {
+                    let (em, e0, ep) = (up[x].abs(), row[x].abs(), dn[x].abs());
+                    cands.push(Candidate {
+                        x: x as u32,
+                        y: y as u32,
+                        e: row[x],
+                        delta: subpixel(em, e0, ep),
+                        region: (x / r) as u32,
+                    });
+                });
             }
         }
     }

@@ -157,6 +157,26 @@ impl LineFit {
         })
     }
 
+    /// An (unnormalised) vector along the fitted line, without trigonometry:
+    /// the eigenvector of the largest eigenvalue of the scatter matrix, from
+    /// whichever of its two closed forms is better conditioned. The line
+    /// extractor calls this after every added point.
+    pub fn major_axis(&self) -> Option<(f64, f64)> {
+        if self.count < 2 || self.w <= 0.0 {
+            return None;
+        }
+        let (s11, s22, s12) = self.scatter();
+        let half = 0.5 * (s11 - s22);
+        let lmax = 0.5 * (s11 + s22) + half.hypot(s12);
+        let v1 = (s12, lmax - s11);
+        let v2 = (lmax - s22, s12);
+        let n1 = v1.0 * v1.0 + v1.1 * v1.1;
+        let n2 = v2.0 * v2.0 + v2.1 * v2.1;
+        let v = if n1 >= n2 { v1 } else { v2 };
+        let n = n1.max(n2);
+        (n > 1e-24 * (1.0 + lmax * lmax) && n.is_finite()).then_some(v)
+    }
+
     /// Projects `p` onto the fitted line (the point itself without a line).
     pub fn project(&self, p: Point) -> Point {
         self.line().map_or(p, |l| l.project(p))

@@ -85,6 +85,11 @@ impl GreyImage {
     pub fn valid_mask(&self) -> Option<&[bool]> {
         self.valid.as_deref()
     }
+    /// Removes and returns the validity mask (every pixel is then valid),
+    /// so a buffer can be reused without allocating.
+    pub fn take_valid_mask(&mut self) -> Option<Vec<bool>> {
+        self.valid.take()
+    }
     /// Whether pixel `(x, y)` holds real data (false outside the image).
     pub fn is_valid(&self, x: usize, y: usize) -> bool {
         x < self.width

@@ -128,6 +128,27 @@ fn template_of(s: &LineScratch, si: usize, nrows: usize) -> usize {
     best
 }
 
+/// Whether an unused point lies where any initial prediction (slope -1, 0
+/// or 1) could find it on the next `max_gap` scan lines.
+fn has_successor(s: &LineScratch, sp: &ScanPoint, nrows: usize, p: &LineParams) -> bool {
+    let row = sp.v.round() as usize;
+    (1..=p.max_gap as usize).any(|i| {
+        let r = row + i;
+        if r >= nrows {
+            return false;
+        }
+        let reach = i as f64 + p.search_width;
+        let (lo, hi) = (s.row_start[r] as usize, s.row_start[r + 1] as usize);
+        let pts = &s.points[lo..hi];
+        let first = pts.partition_point(|q| (q.u as f64) < sp.u as f64 - reach);
+        pts[first..]
+            .iter()
+            .enumerate()
+            .take_while(|(_, q)| q.u as f64 <= sp.u as f64 + reach)
+            .any(|(k, _)| !s.used[lo + first + k])
+    })
+}
+
 /// [`extract`] into reusable buffers; appends nothing else to `out` (it is
 /// cleared first).
 pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &mut LineScratch) {
@@ -195,6 +216,11 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
         }
         s.used[start] = true;
         let sp = s.points[start];
+        if !has_successor(s, &sp, nrows, p) {
+            // No unused point within reach of any template's prediction: no
+            // line can start here (the same result, without the templates).
+            continue;
+        }
         let mut slope = TEMPLATE_SLOPE[template_of(s, start, nrows)];
         let mut fit = LineFit::new();
         fit.add(Point::new(sp.u as f64, sp.v as f64));
@@ -240,12 +266,11 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
             fit.add(Point::new(q.u as f64, q.v as f64));
             resp_sum += q.response as f64;
             last = q;
-            if let Some(l) = fit.line() {
-                // Direction (-b, a) in (u, v): du/dv = -b / a.
-                slope = if l.a.abs() * MAX_SLOPE > l.b.abs() {
-                    -l.b / l.a
+            if let Some((du, dv)) = fit.major_axis() {
+                slope = if dv.abs() * MAX_SLOPE > du.abs() {
+                    du / dv
                 } else {
-                    -MAX_SLOPE * l.b.signum() * l.a.signum()
+                    MAX_SLOPE * du.signum() * dv.signum()
                 };
             }
         }

@@ -13,7 +13,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::connect::{ConnectScratch, connect_into};
-use super::edges::{PeakScratch, Response, peaks_into, response_into};
+use super::edges::{PeakScratch, Response, ResponseScratch, peaks_into, response_into};
 use super::image::GreyImage;
 use super::lens::{LensMap, correct_into};
 use super::lines::{LineScratch, extract_into};
@@ -81,7 +81,7 @@ impl<'a> Input<'a> {
 pub struct Workspace {
     out: StageOutputs,
     ambient_corrected: GreyImage,
-    mask_counts: Vec<u32>,
+    response: ResponseScratch,
     peaks: PeakScratch,
     lines: LineScratch,
     connect: ConnectScratch,
@@ -241,14 +241,14 @@ impl Workspace {
                 ScanDir::Horizontal,
                 a,
                 &mut self.out.response_h,
-                &mut self.mask_counts,
+                &mut self.response,
             )?;
             response_into(
                 img,
                 ScanDir::Vertical,
                 a,
                 &mut self.out.response_v,
-                &mut self.mask_counts,
+                &mut self.response,
             )?;
         } else {
             let ep = &self.out.params.edges;
@@ -308,6 +308,37 @@ fn check_input(input: &Input) -> Result<(usize, usize), LlvError> {
         }
     }
     Ok(size)
+}
+
+/// Line extraction and CONNECT from saved edge points alone (`vss llv
+/// --from-edges`): the outputs have no images or responses.
+pub fn lines_from_edges(edges_h: EdgePoints, edges_v: EdgePoints, p: &Params) -> StageOutputs {
+    let mut ws = Workspace::new();
+    ws.out.edges_h = edges_h;
+    ws.out.edges_v = edges_v;
+    ws.out.params = p.clone();
+    let t = Instant::now();
+    extract_into(
+        &ws.out.edges_h,
+        &p.lines,
+        &mut ws.out.lines_raw,
+        &mut ws.lines,
+    );
+    extract_into(&ws.out.edges_v, &p.lines, &mut ws.tmp, &mut ws.lines);
+    ws.out.lines_raw.extend_from_slice(&ws.tmp);
+    ws.out.timings.lines_us = micros(t);
+    let t = Instant::now();
+    connect_into(
+        &ws.out.lines_raw,
+        &p.connect,
+        &mut ws.out.lines,
+        &mut ws.connect,
+    );
+    if p.connect.corner_radius > 0.0 {
+        crate::llv::corners::close_corners(&mut ws.out.lines, p.connect.corner_radius);
+    }
+    ws.out.timings.connect_us = micros(t);
+    ws.take_outputs()
 }
 
 /// Runs the whole pipeline once (a fresh [`Workspace`]).

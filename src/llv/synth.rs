@@ -13,6 +13,7 @@
 //! the distance to it. Cast shadows are not rendered (every light reaches
 //! every surface that faces it), so every image edge is a polygon edge.
 
+pub mod eval;
 mod geom;
 mod raster;
 mod render;

@@ -63,6 +63,7 @@ impl<'a> Prepared<'a> {
         ideal_bounds: [f64; 4],
     ) -> Prepared<'a> {
         let mut faces = Vec::new();
+        let planes = frustum(cam, ideal_bounds);
         for obj in scene.objects.iter().chain(scene.plate.iter()) {
             for f in &obj.faces {
                 let cv: Vec<V3> = f
@@ -77,7 +78,7 @@ impl<'a> Prepared<'a> {
                 if d_cam >= -1e-9 {
                     continue;
                 }
-                let clipped = clip_near(&cv);
+                let clipped = clip(&cv, &planes);
                 if clipped.len() < 3 {
                     continue;
                 }
@@ -245,19 +246,63 @@ fn rotate(pose: &[[f64; 4]; 3], v: V3) -> V3 {
     [r(0), r(1), r(2)]
 }
 
-/// Sutherland–Hodgman against `z ≥ NEAR`.
-fn clip_near(poly: &[V3]) -> Vec<V3> {
-    let mut out = Vec::with_capacity(poly.len() + 1);
-    for (i, &a) in poly.iter().enumerate() {
-        let b = poly[(i + 1) % poly.len()];
-        let (ina, inb) = (a[2] >= NEAR, b[2] >= NEAR);
-        if ina {
-            out.push(a);
+/// The half-spaces `p · (x, y, z, 1) ≥ 0` (camera frame) of what projects
+/// inside the ideal-pixel rectangle `[x0, y0, x1, y1]` in front of the near
+/// plane: clipping to them keeps projected polygons finite and small.
+pub fn frustum(cam: &Camera, b: [f64; 4]) -> [[f64; 4]; 5] {
+    let m = &cam.model;
+    let (fx, fy) = (m.f / m.sx, m.f / m.sy);
+    [
+        [0.0, 0.0, 1.0, -NEAR],
+        [fx, 0.0, m.cx - b[0], 0.0],
+        [-fx, 0.0, b[2] - m.cx, 0.0],
+        [0.0, fy, m.cy - b[1], 0.0],
+        [0.0, -fy, b[3] - m.cy, 0.0],
+    ]
+}
+
+fn side(p: &[f64; 4], q: V3) -> f64 {
+    p[0] * q[0] + p[1] * q[1] + p[2] * q[2] + p[3]
+}
+
+/// Sutherland–Hodgman against each half-space.
+fn clip(poly: &[V3], planes: &[[f64; 4]]) -> Vec<V3> {
+    let mut cur = poly.to_vec();
+    for p in planes {
+        let mut out = Vec::with_capacity(cur.len() + 1);
+        for (i, &a) in cur.iter().enumerate() {
+            let b = cur[(i + 1) % cur.len()];
+            let (sa, sb) = (side(p, a), side(p, b));
+            if sa >= 0.0 {
+                out.push(a);
+            }
+            if (sa >= 0.0) != (sb >= 0.0) {
+                let t = sa / (sa - sb);
+                out.push(geom::add(a, geom::scale(geom::sub(b, a), t)));
+            }
         }
-        if ina != inb {
-            let t = (NEAR - a[2]) / (b[2] - a[2]);
-            out.push(geom::add(a, geom::scale(geom::sub(b, a), t)));
+        cur = out;
+        if cur.is_empty() {
+            break;
         }
     }
-    out
+    cur
+}
+
+/// The parameter range `[t0, t1] ⊆ [0, 1]` of the segment `a + t (b - a)`
+/// inside all half-spaces (Liang–Barsky), if any.
+pub fn clip_segment(a: V3, b: V3, planes: &[[f64; 4]]) -> Option<(f64, f64)> {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for p in planes {
+        let (sa, sb) = (side(p, a), side(p, b));
+        if sa < 0.0 && sb < 0.0 {
+            return None;
+        }
+        if sa < 0.0 {
+            t0 = t0.max(sa / (sa - sb));
+        } else if sb < 0.0 {
+            t1 = t1.min(sa / (sa - sb));
+        }
+    }
+    (t0 < t1).then_some((t0, t1))
 }

@@ -175,7 +175,7 @@ pub fn cell_lights() -> Vec<PointLight> {
     .iter()
     .map(|&(x, y)| PointLight {
         position: [x, y, 800.0],
-        intensity: 0.5,
+        intensity: 0.6,
     })
     .collect()
 }
@@ -227,12 +227,17 @@ fn acceptable((scene, cam, lights): &(Scene, Camera, Vec<PointLight>)) -> bool {
 
 fn random_view(rng: &mut SplitMix64, w: usize, h: usize) -> (Scene, Camera, Vec<PointLight>) {
     let count = 1 + rng.below(3);
+    // Parts lie square to each other on the plate (as on a fixture), give or
+    // take a few degrees; the lights are set relative to them (below).
+    let base_yaw = rng.range(0.0, std::f64::consts::TAU);
     let mut objects: Vec<Polyhedron> = Vec::new();
     let mut placed: Vec<(f64, f64, f64)> = Vec::new(); // x, y, radius
     for k in 0..count {
         let kind = rng.below(3);
         let albedo = rng.range(150.0, 215.0);
-        let yaw = rng.range(0.0, std::f64::consts::PI);
+        let yaw = base_yaw
+            + std::f64::consts::FRAC_PI_2 * rng.below(4) as f64
+            + rng.range(-6.0, 6.0f64).to_radians();
         let (size, radius) = match kind {
             0 => {
                 let s = rng.range(50.0, 90.0);
@@ -294,7 +299,7 @@ fn random_view(rng: &mut SplitMix64, w: usize, h: usize) -> (Scene, Camera, Vec<
     };
     let scene = Scene {
         objects,
-        plate: Some(plate(3000.0, 3000.0, 10.0, rng.range(55.0, 85.0))),
+        plate: Some(plate(3000.0, 3000.0, 10.0, rng.range(18.0, 28.0))),
         background: 10.0,
     };
     let d = [
@@ -317,7 +322,7 @@ fn random_view(rng: &mut SplitMix64, w: usize, h: usize) -> (Scene, Camera, Vec<
         rng.range(-30.0, 30.0f64).to_radians(),
     );
     let cam = fitted_camera(m, w, h, centroid, view, &fit, 0.12);
-    let key_az = rng.range(0.0, std::f64::consts::TAU);
+    let key_az = base_yaw + rng.range(15.0, 25.0f64).to_radians();
     let light = |az: f64, el_deg: f64, dist: f64, intensity: f64| PointLight {
         position: geom::add(
             centroid,
@@ -332,19 +337,18 @@ fn random_view(rng: &mut SplitMix64, w: usize, h: usize) -> (Scene, Camera, Vec<
         ),
         intensity,
     };
-    let lights = vec![
-        light(
-            key_az,
-            rng.range(40.0, 65.0),
+    // Key, fill and rim light 120° apart, turned 20° from the parts' faces:
+    // every vertical face gets direct light from one of them, and the four
+    // sides of a part get four clearly different brightnesses (about 0.86,
+    // 0.68, 0.53 and 0.41 of the albedo) instead of two equal ones.
+    let mut lights = Vec::new();
+    for (k, intensity) in [0.75, 0.42, 0.24].into_iter().enumerate() {
+        lights.push(light(
+            key_az + (120.0 * k as f64 + rng.range(-5.0, 5.0)).to_radians(),
+            rng.range(35.0, 50.0),
             rng.range(900.0, 1200.0),
-            rng.range(0.8, 1.0),
-        ),
-        light(
-            key_az + rng.range(100.0, 160.0f64).to_radians(),
-            rng.range(30.0, 50.0),
-            rng.range(900.0, 1200.0),
-            rng.range(0.3, 0.45),
-        ),
-    ];
+            intensity * rng.range(0.92, 1.08),
+        ));
+    }
     (scene, cam, lights)
 }

@@ -185,4 +185,3 @@ fn every_cell_light_brightens_every_camera() {
         }
     }
 }
-

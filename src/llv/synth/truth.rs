@@ -12,7 +12,7 @@
 //! step. Runs shorter than [`MIN_PIECE`] px are dropped.
 
 use super::geom::{self, V3};
-use super::raster::Prepared;
+use super::raster::{self, Prepared};
 use super::{Camera, PointLight, RenderOptions, Scene};
 use crate::llv::{Point, Segment};
 
@@ -29,6 +29,7 @@ struct Walker<'a> {
     cam: &'a Camera,
     distort: bool,
     min_contrast: f64,
+    planes: [[f64; 4]; 5],
 }
 
 impl Walker<'_> {
@@ -80,6 +81,7 @@ pub fn visible_edges(
         cam,
         distort,
         min_contrast,
+        planes: raster::frustum(cam, bounds),
     };
     let mut out = Vec::new();
     for obj in scene.objects.iter().chain(scene.plate.iter()) {
@@ -93,17 +95,11 @@ pub fn visible_edges(
 fn walk_edge(wk: &Walker, a: V3, b: V3, out: &mut Vec<Segment>) {
     let qa = geom::to_camera(&wk.cam.pose, a);
     let qb = geom::to_camera(&wk.cam.pose, b);
-    // Clip to z ≥ 1 mm so the projection is defined.
-    let (mut t0, mut t1) = (0.0, 1.0);
-    let near = 1.0;
-    if qa[2] < near && qb[2] < near {
+    // Only the part that projects near the image matters (and z > 0 keeps
+    // the projection defined).
+    let Some((t0, t1)) = raster::clip_segment(qa, qb, &wk.planes) else {
         return;
-    }
-    if qa[2] < near {
-        t0 = (near - qa[2]) / (qb[2] - qa[2]) + 1e-9;
-    } else if qb[2] < near {
-        t1 = (near - qa[2]) / (qb[2] - qa[2]) - 1e-9;
-    }
+    };
     let at = |t: f64| geom::add(qa, geom::scale(geom::sub(qb, qa), t));
     let (pa, pb) = (
         geom::project(&wk.cam.model, at(t0)),

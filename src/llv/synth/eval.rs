@@ -1,0 +1,235 @@
+//! The accuracy evaluation behind `vss selftest` and `tests/accuracy.rs`:
+//! render the test scenes, run the LLV pipeline per noise level, score the
+//! lines against the true edges, and repeat with whole-pixel edge positions
+//! and through lens distortion and correction.
+//!
+//! Every scene is rendered noise-free once; each noise level adds its own
+//! seeded noise to that render, so levels differ only in noise.
+
+use serde::Serialize;
+
+use super::rng::mix;
+use super::score::{Metrics, Tally};
+use super::{Camera, PointLight, RenderOptions, Scene};
+use crate::llv::lens::LensMap;
+use crate::llv::pipeline::{self, Input};
+use crate::llv::{EdgePoints, GreyImage, LlvError, Params, Segment, connect, lines};
+
+/// What to evaluate.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EvalConfig {
+    /// Noise σ levels (grey levels).
+    pub noise: Vec<f64>,
+    pub scenes: usize,
+    /// Image width and height (px).
+    pub size: usize,
+    pub seed: u64,
+    /// Blur σ (px) of every render.
+    pub blur: f64,
+    /// Edges with less noise-free contrast are no true edges (grey levels).
+    pub min_contrast: f64,
+    /// Noise σ of the lens check's images.
+    pub lens_noise: f64,
+}
+
+impl Default for EvalConfig {
+    fn default() -> Self {
+        EvalConfig {
+            noise: vec![2.0, 5.0, 10.0],
+            scenes: 12,
+            size: 512,
+            seed: 1,
+            blur: 1.0,
+            min_contrast: 10.0,
+            lens_noise: 2.0,
+        }
+    }
+}
+
+/// Scores at one noise level.
+#[derive(Clone, Debug, Serialize)]
+pub struct NoiseResult {
+    pub noise: f64,
+    /// The pipeline as it is (subpixel edge positions).
+    pub subpixel: Metrics,
+    /// The same edges rounded to whole pixels, then lines and CONNECT.
+    pub whole_pixel: Metrics,
+    /// Edge points per image, both directions (mean).
+    pub edge_points: f64,
+    /// Lines per image after CONNECT (mean).
+    pub lines: f64,
+}
+
+/// The lens check: mean line-fit residual (px, length-weighted over the
+/// extracted lines) of the undistorted render, of the distorted render as it
+/// is, and of the distorted render after lens correction.
+#[derive(Clone, Debug, Serialize)]
+pub struct LensResult {
+    pub residual_undistorted: f64,
+    pub residual_distorted: f64,
+    pub residual_corrected: f64,
+    /// Scores of the corrected images' lines against the true edges.
+    pub corrected: Metrics,
+    /// Scores of the uncorrected distorted images' lines.
+    pub uncorrected: Metrics,
+}
+
+/// The whole evaluation.
+#[derive(Clone, Debug, Serialize)]
+pub struct EvalReport {
+    pub config: EvalConfig,
+    pub levels: Vec<NoiseResult>,
+    pub lens: LensResult,
+}
+
+struct Case {
+    scene: Scene,
+    cam: Camera,
+    lights: Vec<PointLight>,
+    exact: Vec<f64>,
+    truth: Vec<Segment>,
+}
+
+fn options(cfg: &EvalConfig, noise: f64, seed: u64, distort: bool) -> RenderOptions {
+    RenderOptions {
+        blur_sigma: cfg.blur,
+        noise_sigma: noise,
+        seed,
+        distort,
+        ..Default::default()
+    }
+}
+
+/// Runs the evaluation with the given LLV parameters.
+pub fn evaluate(cfg: &EvalConfig, params: &Params) -> Result<EvalReport, LlvError> {
+    let cases: Vec<Case> = super::test_scenes(cfg.scenes, cfg.size, cfg.size, cfg.seed)
+        .into_iter()
+        .map(|(scene, cam, lights)| {
+            let o = options(cfg, 0.0, 0, false);
+            let exact = super::render_exact(&scene, &cam, &lights, &o);
+            let truth = super::true_edges(&scene, &cam, &lights, &o, cfg.min_contrast);
+            Case {
+                scene,
+                cam,
+                lights,
+                exact,
+                truth,
+            }
+        })
+        .collect();
+    let mut levels = Vec::new();
+    for (j, &noise) in cfg.noise.iter().enumerate() {
+        let (mut sub, mut whole) = (Tally::default(), Tally::default());
+        let (mut points, mut nlines) = (0usize, 0usize);
+        for (i, c) in cases.iter().enumerate() {
+            let seed = mix(cfg.seed, 1000 + 64 * i as u64 + j as u64);
+            let img = super::finish(
+                c.exact.clone(),
+                c.cam.width,
+                c.cam.height,
+                &options(cfg, noise, seed, false),
+            );
+            let out = run_one(&img, None, params)?;
+            sub.add(&out.lines, &c.truth);
+            points += out.edges_h.points.len() + out.edges_v.points.len();
+            nlines += out.lines.len();
+            let wp = whole_pixel_lines(&out.edges_h, &out.edges_v, params);
+            whole.add(&wp, &c.truth);
+        }
+        let n = cases.len().max(1) as f64;
+        levels.push(NoiseResult {
+            noise,
+            subpixel: sub.metrics(),
+            whole_pixel: whole.metrics(),
+            edge_points: points as f64 / n,
+            lines: nlines as f64 / n,
+        });
+    }
+    let lens = lens_check(cfg, &cases, params)?;
+    Ok(EvalReport {
+        config: cfg.clone(),
+        levels,
+        lens,
+    })
+}
+
+fn run_one(
+    img: &GreyImage,
+    lens: Option<&LensMap>,
+    params: &Params,
+) -> Result<pipeline::StageOutputs, LlvError> {
+    let images = std::slice::from_ref(img);
+    pipeline::run(
+        &Input {
+            images,
+            ambient: None,
+            lens,
+        },
+        params,
+    )
+}
+
+/// Lines from edge points rounded to whole pixels: what the pipeline would
+/// give without the subpixel step (llv.md §2.4).
+pub fn whole_pixel_lines(h: &EdgePoints, v: &EdgePoints, params: &Params) -> Vec<Segment> {
+    let round = |e: &EdgePoints| {
+        let mut r = e.clone();
+        for p in &mut r.points {
+            p.x = p.x.round();
+            p.y = p.y.round();
+        }
+        r
+    };
+    let mut raw = lines::extract(&round(h), &params.lines);
+    raw.extend(lines::extract(&round(v), &params.lines));
+    if params.connect.enabled {
+        connect::connect(&raw, &params.connect)
+    } else {
+        raw
+    }
+}
+
+/// Length-weighted mean residual of the lines.
+pub fn mean_residual(lines: &[Segment]) -> f64 {
+    let (mut s, mut w) = (0.0, 0.0);
+    for l in lines {
+        let len = l.length();
+        if len.is_finite() && l.residual.is_finite() {
+            s += l.residual * len;
+            w += len;
+        }
+    }
+    if w > 0.0 { s / w } else { 0.0 }
+}
+
+fn lens_check(cfg: &EvalConfig, cases: &[Case], params: &Params) -> Result<LensResult, LlvError> {
+    let (mut plain, mut dist, mut corr) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut t_corr, mut t_unc) = (Tally::default(), Tally::default());
+    for (i, c) in cases.iter().enumerate() {
+        let seed = mix(cfg.seed, 9000 + i as u64);
+        let (w, h) = (c.cam.width, c.cam.height);
+        let undistorted = super::finish(
+            c.exact.clone(),
+            w,
+            h,
+            &options(cfg, cfg.lens_noise, seed, false),
+        );
+        plain.extend(run_one(&undistorted, None, params)?.lines_raw);
+        let od = options(cfg, cfg.lens_noise, seed, true);
+        let distorted = super::render(&c.scene, &c.cam, &c.lights, &od);
+        let out = run_one(&distorted, None, params)?;
+        t_unc.add(&out.lines, &c.truth);
+        dist.extend(out.lines_raw);
+        let map = LensMap::new(&c.cam.model, w, h);
+        let out = run_one(&distorted, Some(&map), params)?;
+        t_corr.add(&out.lines, &c.truth);
+        corr.extend(out.lines_raw);
+    }
+    Ok(LensResult {
+        residual_undistorted: mean_residual(&plain),
+        residual_distorted: mean_residual(&dist),
+        residual_corrected: mean_residual(&corr),
+        corrected: t_corr.metrics(),
+        uncorrected: t_unc.metrics(),
+    })
+}

@@ -1,0 +1,117 @@
+//! `vss llv` as a user runs it: outputs written where asked, lightings of one
+//! view combined, JSON with stable keys, `--from-edges`, bad inputs reported.
+
+use std::path::Path;
+
+use assert_cmd::Command;
+use vss::formats::img::{ImgFile, write_img};
+use vss::llv::GreyImage;
+
+fn write(dir: &Path, name: &str, f: impl Fn(usize, usize) -> u8) {
+    let (w, h) = (96, 80);
+    let d = (0..w * h).map(|i| f(i % w, i / w)).collect();
+    let img = GreyImage::new(w, h, d).unwrap();
+    write_img(&dir.join(name), &ImgFile::new(img)).unwrap();
+}
+
+fn rect(x: usize, y: usize, hi: u8, lo: u8) -> u8 {
+    if (20..70).contains(&x) && (15..60).contains(&y) {
+        hi
+    } else {
+        lo
+    }
+}
+
+fn vss() -> Command {
+    Command::cargo_bin("vss").unwrap()
+}
+
+#[test]
+fn images_give_edge_and_line_files_and_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "cube1a.img", |x, y| rect(x, y, 200, 40));
+    write(d, "cube1b.img", |x, y| rect(x, y, 120, 70));
+    write(d, "plate2.img", |x, y| if x + y > 90 { 170 } else { 60 });
+    let out = d.join("out");
+    let r = vss()
+        .args(["llv", "--json", "--out"])
+        .arg(&out)
+        .arg(d.join("cube1a.img"))
+        .arg(d.join("cube1b.img"))
+        .arg(d.join("plate2.img"))
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let text = String::from_utf8(r.stdout).unwrap();
+    let objs: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(
+        objs.len(),
+        2,
+        "two lightings of one view are one input: {text}"
+    );
+    assert_eq!(objs[0]["image"], "cube1");
+    assert_eq!(objs[0]["lines"], 4, "{}", objs[0]);
+    for o in &objs {
+        for k in ["edges_h", "edges_v", "lines_raw", "lines"] {
+            assert!(o[k].as_u64().is_some(), "{k} in {o}");
+        }
+        for k in ["lens", "edges", "lines", "connect"] {
+            assert!(o["timings_us"][k].as_u64().is_some(), "timings_us.{k}");
+        }
+        let attrs = o["line_attributes"].as_array().unwrap();
+        assert_eq!(attrs.len() as u64, o["lines"].as_u64().unwrap());
+    }
+    for f in [
+        "cube1.hpo",
+        "cube1.vpo",
+        "cube1.lex",
+        "cube1.ldr",
+        "plate2.ldr",
+    ] {
+        assert!(out.join(f).is_file(), "{f} written");
+    }
+    assert!(!out.join("cube1a.imc").exists(), ".imc only with --cdf");
+
+    // The line stages again from the edge files alone give the same lines.
+    let out2 = d.join("again");
+    vss()
+        .args(["llv", "--out"])
+        .arg(&out2)
+        .arg("--from-edges")
+        .arg(out.join("cube1.hpo"))
+        .arg(out.join("cube1.vpo"))
+        .assert()
+        .success();
+    assert_eq!(
+        std::fs::read(out.join("cube1.ldr")).unwrap(),
+        std::fs::read(out2.join("cube1.ldr")).unwrap()
+    );
+}
+
+#[test]
+fn a_missing_image_fails_but_the_others_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "plate2.img", |x, y| if x + y > 90 { 170 } else { 60 });
+    let r = vss()
+        .args(["llv", "--set", "edges.per_region=4"])
+        .arg(d.join("nothere.img"))
+        .arg(d.join("plate2.img"))
+        .output()
+        .unwrap();
+    assert_eq!(r.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("nothere.img"), "{err}");
+    assert!(d.join("plate2.ldr").is_file(), "written beside the input");
+    let r = vss()
+        .args(["llv", "--set", "edges.half_width=9"])
+        .arg(d.join("plate2.img"))
+        .output()
+        .unwrap();
+    assert!(!r.status.success());
+    assert!(String::from_utf8_lossy(&r.stderr).contains("edges.half_width"));
+}
