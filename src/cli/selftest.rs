@@ -114,6 +114,21 @@ pub fn table(r: &EvalReport, profile: &str) -> String {
         "lens (noise σ = {}): mean line-fit residual {:.4} px undistorted, {:.4} px distorted, {:.4} px corrected ({:+.1} %)",
         c.lens_noise, lr.residual_undistorted, lr.residual_distorted, lr.residual_corrected, rel
     );
+    let srel = if lr.straightness_undistorted > 0.0 {
+        100.0 * (lr.straightness_corrected / lr.straightness_undistorted - 1.0)
+    } else {
+        0.0
+    };
+    let _ = writeln!(
+        s,
+        "lens (distortion ×{}): edge-point straightness {:.4} px undistorted, {:.4} px distorted, {:.4} px corrected ({:+.1} %, {} edges)",
+        c.lens_scale,
+        lr.straightness_undistorted,
+        lr.straightness_distorted,
+        lr.straightness_corrected,
+        srel,
+        lr.straightness_edges
+    );
     let _ = writeln!(
         s,
         "lens: endpoint mean {:.3} px and angle {:.3}° corrected, {:.3} px and {:.3}° uncorrected",

@@ -20,6 +20,7 @@ mod render;
 pub mod rng;
 mod scenes;
 mod score;
+pub mod straight;
 mod truth;
 
 pub use geom::{Face, Polyhedron, V3, look_at};

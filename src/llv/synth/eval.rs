@@ -10,10 +10,11 @@ use serde::Serialize;
 
 use super::rng::mix;
 use super::score::{Metrics, Tally};
+use super::straight::Straightness;
 use super::{Camera, PointLight, RenderOptions, Scene};
 use crate::llv::lens::LensMap;
 use crate::llv::pipeline::{self, Input};
-use crate::llv::{EdgePoints, GreyImage, LlvError, Params, Segment, connect, lines};
+use crate::llv::{EdgePoints, GreyImage, LlvError, Params, Point, Segment, connect, lines};
 
 /// What to evaluate.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -30,6 +31,10 @@ pub struct EvalConfig {
     pub min_contrast: f64,
     /// Noise σ of the lens check's images.
     pub lens_noise: f64,
+    /// The lens check multiplies each test camera's distortion by this, so
+    /// that uncorrected lines are measurably bent (the test cameras' own
+    /// distortion moves image corners by only 1–3 px).
+    pub lens_scale: f64,
 }
 
 impl Default for EvalConfig {
@@ -42,6 +47,7 @@ impl Default for EvalConfig {
             blur: 1.0,
             min_contrast: 10.0,
             lens_noise: 2.0,
+            lens_scale: 3.0,
         }
     }
 }
@@ -68,6 +74,13 @@ pub struct LensResult {
     pub residual_undistorted: f64,
     pub residual_distorted: f64,
     pub residual_corrected: f64,
+    /// RMS residual (px) of the edge points along each true edge about their
+    /// own fitted line (`straight.rs`): undistorted, distorted, corrected.
+    pub straightness_undistorted: f64,
+    pub straightness_distorted: f64,
+    pub straightness_corrected: f64,
+    /// True edges measured for straightness (all images).
+    pub straightness_edges: usize,
     /// Scores of the corrected images' lines against the true edges.
     pub corrected: Metrics,
     /// Scores of the uncorrected distorted images' lines.
@@ -205,30 +218,52 @@ pub fn mean_residual(lines: &[Segment]) -> f64 {
 fn lens_check(cfg: &EvalConfig, cases: &[Case], params: &Params) -> Result<LensResult, LlvError> {
     let (mut plain, mut dist, mut corr) = (Vec::new(), Vec::new(), Vec::new());
     let (mut t_corr, mut t_unc) = (Tally::default(), Tally::default());
+    let (mut s_plain, mut s_dist, mut s_corr) = (
+        Straightness::default(),
+        Straightness::default(),
+        Straightness::default(),
+    );
+    let ident = |p: Point| p;
     for (i, c) in cases.iter().enumerate() {
         let seed = mix(cfg.seed, 9000 + i as u64);
         let (w, h) = (c.cam.width, c.cam.height);
+        let mut cam = c.cam.clone();
+        if let Some(d) = cam.model.distortion.as_mut() {
+            d.iter_mut().for_each(|k| *k *= cfg.lens_scale);
+        }
         let undistorted = super::finish(
             c.exact.clone(),
             w,
             h,
             &options(cfg, cfg.lens_noise, seed, false),
         );
-        plain.extend(run_one(&undistorted, None, params)?.lines_raw);
+        let out = run_one(&undistorted, None, params)?;
+        s_plain.add(&c.truth, &out.edges_h, &out.edges_v, &ident);
+        plain.extend(out.lines_raw);
         let od = options(cfg, cfg.lens_noise, seed, true);
-        let distorted = super::render(&c.scene, &c.cam, &c.lights, &od);
+        let distorted = super::render(&c.scene, &cam, &c.lights, &od);
         let out = run_one(&distorted, None, params)?;
         t_unc.add(&out.lines, &c.truth);
+        let through_lens = |p: Point| {
+            let (x, y) = cam.model.ideal_to_observed(p.x, p.y);
+            Point::new(x, y)
+        };
+        s_dist.add(&c.truth, &out.edges_h, &out.edges_v, &through_lens);
         dist.extend(out.lines_raw);
-        let map = LensMap::new(&c.cam.model, w, h);
+        let map = LensMap::new(&cam.model, w, h);
         let out = run_one(&distorted, Some(&map), params)?;
         t_corr.add(&out.lines, &c.truth);
+        s_corr.add(&c.truth, &out.edges_h, &out.edges_v, &ident);
         corr.extend(out.lines_raw);
     }
     Ok(LensResult {
         residual_undistorted: mean_residual(&plain),
         residual_distorted: mean_residual(&dist),
         residual_corrected: mean_residual(&corr),
+        straightness_undistorted: s_plain.rms(),
+        straightness_distorted: s_dist.rms(),
+        straightness_corrected: s_corr.rms(),
+        straightness_edges: s_plain.edges(),
         corrected: t_corr.metrics(),
         uncorrected: t_unc.metrics(),
     })
