@@ -14,6 +14,8 @@ pub mod cell;
 pub mod grabber;
 pub mod lights;
 pub mod protocol;
+#[cfg(test)]
+mod script;
 pub mod sim;
 
 pub use cell::{Capture, Cell};

@@ -1,16 +1,141 @@
-//! `vss grab` (to be written).
+//! `vss grab`: headless capture of one image under several lightings. For
+//! each lighting: switch, settle, freeze, transfer (progress on stderr),
+//! verify the CRCs, save `NAMEKa.img` atomically. A failed capture saves
+//! nothing of its frame and exits non-zero with the reason; the frames
+//! already saved are kept.
 
+use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use anyhow::{Context, bail};
 
 use super::Global;
+use crate::formats::img::{ImgFile, write_img};
+use crate::formats::names::{SessionName, VssFile};
+use crate::rig::Cell;
+use crate::rig::sim::Faults;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Arguments (not yet defined).
-    #[arg(trailing_var_arg = true)]
-    pub rest: Vec<String>,
+    /// Camera number (1-based).
+    #[arg(long)]
+    pub camera: u32,
+    /// Lighting configurations to capture, e.g. `a,b,c,e`.
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub lighting: Vec<char>,
+    /// The session folder; its last component is the session name.
+    #[arg(long, value_name = "DIR/NAME")]
+    pub session: PathBuf,
+    /// Image number within the session.
+    #[arg(long)]
+    pub image: u32,
+    /// Overwrite images that exist already.
+    #[arg(long)]
+    pub yes: bool,
+    /// Faults injected into an embedded simulated grabber (testing).
+    #[arg(long, value_name = "SPEC", hide = true)]
+    pub sim_faults: Option<String>,
 }
 
-pub fn run(_g: &Global, _a: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`vss grab` is not implemented yet")
+pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
+    let profile = g.load_profile()?;
+    let name = a
+        .session
+        .file_name()
+        .and_then(|n| n.to_str())
+        .with_context(|| format!("{}: the session path ends in no name", a.session.display()))?;
+    let session = SessionName::new(name)
+        .with_context(|| format!("{}: not a valid session name", a.session.display()))?;
+    let files: Vec<(char, PathBuf)> = a
+        .lighting
+        .iter()
+        .map(|&letter| {
+            let f = VssFile {
+                session: session.clone(),
+                image: a.image,
+                lighting: Some(letter),
+                ext: "img".into(),
+            };
+            (letter, a.session.join(f.file_name()))
+        })
+        .collect();
+    if !a.yes {
+        let existing: Vec<String> = files
+            .iter()
+            .filter(|(_, p)| p.exists())
+            .map(|(_, p)| p.display().to_string())
+            .collect();
+        if !existing.is_empty() {
+            bail!(
+                "refusing to overwrite {} (add --yes to replace them)",
+                existing.join(", ")
+            );
+        }
+    }
+    std::fs::create_dir_all(&a.session)
+        .with_context(|| format!("cannot create the session folder {}", a.session.display()))?;
+    let faults = match &a.sim_faults {
+        Some(s) => Faults::parse(s)?,
+        None => Faults::default(),
+    };
+    let cancel = Arc::new(AtomicBool::new(false));
+    for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register(sig, Arc::clone(&cancel))
+            .context("cannot install the Ctrl-C handler")?;
+    }
+    let mut cell = Cell::open_with_faults(&profile, faults)?;
+    for (letter, path) in &files {
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        capture_one(&mut cell, a.camera, *letter, path, &stem, &cancel).with_context(|| {
+            format!(
+                "capturing {stem} (camera {}, lighting {letter}) failed; nothing of it was saved",
+                a.camera
+            )
+        })?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn capture_one(
+    cell: &mut Cell,
+    camera: u32,
+    letter: char,
+    path: &Path,
+    stem: &str,
+    cancel: &AtomicBool,
+) -> anyhow::Result<()> {
+    let mut err = std::io::stderr();
+    let mut last_pct = u64::MAX;
+    let mut progress = |done: usize, total: usize| {
+        let pct = (done as u64 * 100) / (total.max(1) as u64);
+        if pct != last_pct {
+            last_pct = pct;
+            let _ = write!(err, "\r{stem}: {done}/{total} bytes ({pct}%)");
+            let _ = err.flush();
+        }
+        !cancel.load(Ordering::SeqCst)
+    };
+    let result = cell.capture(camera, letter, &mut progress);
+    eprintln!();
+    let cap = result?;
+    let img = ImgFile::new(cap.image).with_comment(stem);
+    write_img(path, &img)?;
+    let on = if cap.lights_on.is_empty() {
+        "ambient only".to_string()
+    } else {
+        cap.lights_on.join(", ")
+    };
+    println!(
+        "{}: camera {camera}, lighting {letter} ({on}), crc {:08X}, {} ms",
+        path.display(),
+        cap.frame.crc,
+        cap.elapsed.as_millis()
+    );
+    Ok(())
 }

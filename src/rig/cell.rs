@@ -40,6 +40,37 @@ pub struct Capture {
 /// Channels of an LCUS board when the profile's lights do not say more.
 const LCUS_CHANNELS: u32 = 8;
 
+/// Opens the relay board a profile names (`sim` is the embedded simulated
+/// cell, needed when the board is `simulated`).
+pub fn open_lights(
+    profile: &Profile,
+    sim: Option<&SimCell>,
+) -> Result<Box<dyn LightSwitch>, RigError> {
+    let r = &profile.relay;
+    let timeout = Duration::from_millis(r.timeout_ms.max(1));
+    Ok(match (r.kind, sim) {
+        (RelayKind::Simulated, Some(s)) => {
+            Box::new(NumatoBoard::open(s.relay_path(), r.baud, timeout)?)
+        }
+        (RelayKind::Simulated, None) => {
+            return Err(RigError::Config(
+                "the relay board is `simulated` but no simulated cell runs".into(),
+            ));
+        }
+        (RelayKind::Lcus, _) => {
+            let channels = profile
+                .lights
+                .iter()
+                .map(|l| l.relay + 1)
+                .max()
+                .unwrap_or(0)
+                .max(LCUS_CHANNELS);
+            Box::new(LcusBoard::open(&r.port, channels, timeout)?)
+        }
+        (RelayKind::Numato, _) => Box::new(NumatoBoard::open(&r.port, r.baud, timeout)?),
+    })
+}
+
 impl Cell {
     /// Opens the cell a profile describes. `simulated` devices start the
     /// embedded simulator on pseudo-terminals and the same drivers connect
@@ -63,24 +94,7 @@ impl Cell {
             _ => g.port.clone(),
         };
         let grabber = VsgClient::open(&grabber_path, g.baud, ClientConfig::from_profile(g))?;
-        let r = &profile.relay;
-        let timeout = Duration::from_millis(r.timeout_ms.max(1));
-        let lights: Box<dyn LightSwitch> = match (&r.kind, &sim) {
-            (RelayKind::Simulated, Some(s)) => {
-                Box::new(NumatoBoard::open(s.relay_path(), r.baud, timeout)?)
-            }
-            (RelayKind::Lcus, _) => {
-                let channels = profile
-                    .lights
-                    .iter()
-                    .map(|l| l.relay + 1)
-                    .max()
-                    .unwrap_or(0)
-                    .max(LCUS_CHANNELS);
-                Box::new(LcusBoard::open(&r.port, channels, timeout)?)
-            }
-            _ => Box::new(NumatoBoard::open(&r.port, r.baud, timeout)?),
-        };
+        let lights = open_lights(profile, sim.as_ref())?;
         let mut cell = Cell {
             grabber: Box::new(grabber),
             lights,

@@ -694,3 +694,6 @@ impl<P: Link> FrameGrabber for VsgClient<P> {
         self.stats
     }
 }
+
+#[cfg(test)]
+mod tests;

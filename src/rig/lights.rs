@@ -289,6 +289,15 @@ impl<P: Link> LightSwitch for LcusBoard<P> {
     }
 
     fn set_mask(&mut self, mask: u32) -> Result<(), RigError> {
+        if self.channels < 32 && mask >> self.channels != 0 {
+            return Err(RigError::Board {
+                port: self.name.clone(),
+                detail: format!(
+                    "relay mask {mask:04x} names relays beyond this {}-channel LCUS board",
+                    self.channels
+                ),
+            });
+        }
         for relay in 0..self.channels {
             self.set(relay, mask & (1 << relay) != 0)?;
         }
@@ -301,5 +310,81 @@ impl<P: Link> LightSwitch for LcusBoard<P> {
 
     fn port_name(&self) -> &str {
         &self.name
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rig::script::Script;
+
+    fn board(answers: &[&str]) -> NumatoBoard<Script> {
+        let a = answers.iter().map(|s| s.as_bytes().to_vec()).collect();
+        NumatoBoard::new(
+            Script::new(b'\r', a),
+            "/dev/relay0",
+            Duration::from_millis(50),
+        )
+    }
+
+    #[test]
+    fn switch_checks_echo_and_reads_back() {
+        let mut b = board(&["relay on 2\r\n\r>", "relay read 2\r\n\ron\n\r>"]);
+        assert!(b.set(2, true).is_ok());
+        assert_eq!(b.port.sent_text(), "relay on 2\rrelay read 2\r");
+    }
+
+    #[test]
+    fn a_relay_that_did_not_switch_is_reported() {
+        let mut b = board(&["relay on 2\r\n\r>", "relay read 2\r\n\roff\n\r>"]);
+        let e = b.set(2, true);
+        assert!(
+            matches!(&e, Err(RigError::RelayMismatch { port, expected, got, .. })
+                if port == "/dev/relay0" && expected == "on" && got == "off"),
+            "{e:?}"
+        );
+    }
+
+    #[test]
+    fn a_wrong_echo_is_an_error() {
+        let mut b = board(&["relay on 3\n\r>"]);
+        let e = b.set(2, true);
+        assert!(
+            matches!(&e, Err(RigError::Board { detail, .. }) if detail.contains("echoed")),
+            "{e:?}"
+        );
+    }
+
+    #[test]
+    fn mask_round_trip_and_version() {
+        let mut b = board(&[
+            "relay writeall 0005\n\r>",
+            "relay readall\n\r0005\n\r>",
+            "ver\n\r00000008\n\r>",
+        ]);
+        assert!(b.set_mask(5).is_ok());
+        assert_eq!(b.version().ok().as_deref(), Some("00000008"));
+    }
+
+    #[test]
+    fn no_prompt_is_a_timeout() {
+        let mut b = board(&["relay readall\n\r0005\n\r"]);
+        assert!(matches!(b.read_mask(), Err(RigError::Timeout { .. })));
+    }
+
+    #[test]
+    fn lcus_sends_frames_and_remembers() {
+        let s = Script::new(b'\n', vec![]);
+        let mut b = LcusBoard::new(s, "/dev/lcus", 4, Duration::from_millis(50));
+        assert!(b.set(0, true).is_ok());
+        assert!(b.set(3, true).is_ok());
+        assert!(b.set(0, false).is_ok());
+        assert_eq!(b.read_mask().ok(), Some(0b1000));
+        assert_eq!(
+            b.port.sent,
+            vec![0xA0, 1, 1, 0xA2, 0xA0, 4, 1, 0xA5, 0xA0, 1, 0, 0xA1]
+        );
+        assert!(matches!(b.set(4, true), Err(RigError::Board { .. })));
+        assert!(matches!(b.set_mask(1 << 6), Err(RigError::Board { .. })));
     }
 }

@@ -521,13 +521,13 @@ mod tests {
     fn lines_round_trip_and_checksum_is_nmea_xor() {
         // NMEA's classic example sentence body.
         assert_eq!(checksum(b"GPGLL,5300.97914,N,00259.98174,E,125926,A"), 0x28);
-        assert_eq!(encode_line("HELLO"), b"HELLO*02\r\n".to_vec());
-        assert_eq!(decode_line(b"HELLO*02"), Ok("HELLO"));
+        assert_eq!(encode_line("HELLO"), b"HELLO*42\r\n".to_vec());
+        assert_eq!(decode_line(b"HELLO*42"), Ok("HELLO"));
         assert_eq!(
-            decode_line(b"HELLO*03"),
+            decode_line(b"HELLO*43"),
             Err(LineError::Mismatch {
-                found: 3,
-                computed: 2
+                found: 0x43,
+                computed: 0x42
             })
         );
         assert_eq!(decode_line(b"HELLO"), Err(LineError::NoChecksum));

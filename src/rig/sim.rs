@@ -78,6 +78,11 @@ pub struct SimOptions {
 }
 
 impl SimOptions {
+    /// The standard simulated cell at this image size, without faults.
+    pub fn new(width: u32, height: u32) -> SimOptions {
+        SimOptions::from_profile(&cell_profile(width, height))
+    }
+
     /// The simulated cell a profile describes: its image size, noise, seed
     /// and lights (a light without a position gets one of the default
     /// positions, so every profile has a lit scene).
@@ -327,4 +332,61 @@ impl SimCell {
         self.grabber.shutdown();
         self.board.shutdown();
     }
+}
+
+/// The standard simulated cell as a profile: the embedded grabber and relay
+/// board, the synthetic cell's four lights on relays 0–3 at their positions,
+/// lightings `a`–`d` (one light each) and `e` (ambient only), and the
+/// cameras' `.cdf` files from `profiles/sim/`. `profiles/default.toml` is
+/// this profile at 512 × 512; tests use it smaller.
+pub fn cell_profile(width: u32, height: u32) -> Profile {
+    use crate::profile::{Light, Lighting};
+    let positions = render::default_light_positions();
+    let names = crate::llv::synth::CELL_LIGHT_NAMES;
+    let mut p = Profile {
+        name: "simulated cell".into(),
+        ..Profile::default()
+    };
+    p.sim.width = width;
+    p.sim.height = height;
+    p.lights = names
+        .iter()
+        .zip(&positions)
+        .enumerate()
+        .map(|(i, (n, pos))| Light {
+            name: (*n).to_string(),
+            relay: i as u32,
+            position: Some(*pos),
+        })
+        .collect();
+    p.lighting = names
+        .iter()
+        .zip(['a', 'b', 'c', 'd'])
+        .map(|(n, letter)| Lighting {
+            letter,
+            on: vec![(*n).to_string()],
+            note: format!("{n} light only"),
+        })
+        .chain(std::iter::once(Lighting {
+            letter: 'e',
+            on: Vec::new(),
+            note: "ambient only".into(),
+        }))
+        .collect();
+    p.survey.cameras = 4;
+    p.survey.cdf = (1..=4)
+        .map(|k| std::path::PathBuf::from(format!("sim/cam{k}.cdf")))
+        .collect();
+    p
+}
+
+/// The `.cdf` of simulated camera `cam` (1-based) at this image size:
+/// intrinsics, lens distortion and pose as the simulator renders them.
+pub fn camera_cdf(cam: u32, width: u32, height: u32) -> Option<crate::formats::cdf::Cdf> {
+    let cams = crate::llv::synth::cell_cameras(width as usize, height as usize);
+    let c = cams.get(cam.checked_sub(1)? as usize)?;
+    Some(crate::formats::cdf::Cdf::from_camera(
+        &c.model,
+        Some(c.pose),
+    ))
 }

@@ -1,0 +1,240 @@
+//! The VSG/1 client against scripted bytes: replies good, garbled, late,
+//! missing; blocks with bad CRCs; a device that vanishes.
+
+use std::time::Duration;
+
+use super::*;
+use crate::rig::protocol::encode_line;
+use crate::rig::script::Script;
+
+fn cfg() -> ClientConfig {
+    ClientConfig {
+        timeout: Duration::from_millis(50),
+        retries: 2,
+        block: 4,
+    }
+}
+
+fn line(s: &str) -> Vec<u8> {
+    encode_line(s)
+}
+
+fn data(off: u32, bytes: &[u8]) -> Vec<u8> {
+    let mut v = line(&format!("DATA {off} {} {:08X}", bytes.len(), crc32(bytes)));
+    v.extend_from_slice(bytes);
+    v
+}
+
+const HELLO: &str = "OK VSG/1 model=T width=4 height=2 depth=8 cameras=2 maxblock=4";
+
+fn client(answers: Vec<Vec<u8>>) -> VsgClient<Script> {
+    VsgClient::new(Script::new(b'\n', answers), "/dev/test0", cfg())
+}
+
+#[test]
+fn hello_after_garbage_on_connect() {
+    let s = Script::new(b'\n', vec![line(HELLO)]).with_initial(b"\x00\xffjunk\r\nOK*4B\r\nmore");
+    let mut c = VsgClient::new(s, "/dev/test0", cfg());
+    let info = c.connect();
+    assert_eq!(
+        info.ok().map(|i| (i.width, i.height, i.cameras)),
+        Some((4, 2, 2))
+    );
+    // The re-sync sent an empty line before HELLO.
+    assert!(c.port_mut().sent_text().starts_with("\r\nHELLO*42\r\n"));
+}
+
+#[test]
+fn garbled_reply_is_retried_and_counted() {
+    let mut bad = line(HELLO);
+    bad[3] ^= 0x20;
+    let mut c = client(vec![bad, line(HELLO)]);
+    assert!(c.hello().is_ok());
+    assert_eq!(c.wire_stats().retries, 1);
+    assert_eq!(c.port_mut().sent_text().matches("HELLO*42").count(), 2);
+}
+
+#[test]
+fn silence_ends_in_a_timeout_naming_port_and_command() {
+    let mut c = client(vec![]);
+    let e = c.status();
+    match e {
+        Err(RigError::Timeout {
+            port,
+            command,
+            attempts,
+            ..
+        }) => {
+            assert_eq!(
+                (port.as_str(), command.as_str(), attempts),
+                ("/dev/test0", "STATUS", 3)
+            );
+        }
+        other => panic!("expected a timeout, got {other:?}"),
+    }
+}
+
+#[test]
+fn non_idempotent_command_is_not_retried() {
+    let mut c = client(vec![]);
+    let e = c.load(&GreyImage::filled(2, 2, 9).unwrap_or_default());
+    assert!(
+        matches!(e, Err(RigError::Timeout { attempts: 1, .. })),
+        "{e:?}"
+    );
+    assert_eq!(c.port_mut().sent_text().matches("LOAD").count(), 1);
+}
+
+#[test]
+fn device_errors_are_reported_with_their_code() {
+    let mut c = client(vec![line("ERR RANGE camera 9 of 2")]);
+    match c.select_camera(9) {
+        Err(RigError::Device { code, text, .. }) => {
+            assert_eq!(code, ErrCode::Range);
+            assert_eq!(text, "camera 9 of 2");
+        }
+        other => panic!("{other:?}"),
+    }
+    let mut c = client(vec![line("ERR NOFRAME no frame frozen")]);
+    c.frame = Some(FrameInfo {
+        width: 4,
+        height: 2,
+        crc: 0,
+    });
+    assert!(matches!(
+        c.transfer(&mut |_, _| true),
+        Err(RigError::NoFrame { .. })
+    ));
+}
+
+#[test]
+fn transfer_rereads_a_bad_block_and_checks_the_frame() {
+    let pixels = [1u8, 2, 3, 4, 5, 6, 7, 8];
+    let frame_crc = crc32(&pixels);
+    let mut corrupt = data(4, &pixels[4..]);
+    let last = corrupt.len() - 1;
+    corrupt[last] ^= 1;
+    let mut c = client(vec![
+        line(HELLO),
+        line(&format!("OK FRAME 4 2 {frame_crc:08X}")),
+        data(0, &pixels[..4]),
+        corrupt,
+        data(4, &pixels[4..]),
+    ]);
+    assert!(c.hello().is_ok());
+    assert!(c.freeze().is_ok());
+    let mut calls = Vec::new();
+    let img = c.transfer(&mut |d, t| {
+        calls.push((d, t));
+        true
+    });
+    assert_eq!(img.ok().map(|i| i.data().to_vec()), Some(pixels.to_vec()));
+    assert_eq!(calls, vec![(4, 8), (8, 8)]);
+    let st = c.wire_stats();
+    assert_eq!((st.bad_blocks, st.payload), (1, 8));
+    assert_eq!(c.port_mut().sent_text().matches("READ 4 4").count(), 2);
+}
+
+#[test]
+fn a_frame_whose_crc_differs_from_freeze_is_refused() {
+    let pixels = [1u8, 2, 3, 4, 5, 6, 7, 8];
+    let mut c = client(vec![
+        line(HELLO),
+        line("OK FRAME 4 2 00000001"),
+        data(0, &pixels[..4]),
+        data(4, &pixels[4..]),
+    ]);
+    assert!(c.hello().is_ok() && c.freeze().is_ok());
+    let e = c.transfer(&mut |_, _| true);
+    assert!(
+        matches!(e, Err(RigError::FrameCrc { expected: 1, .. })),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn a_late_data_reply_is_skipped() {
+    let pixels = [9u8, 8, 7, 6, 5, 4, 3, 2];
+    let crc = crc32(&pixels);
+    // The answer to READ 4 4 first brings a stale block 0 (after a stall).
+    let mut second = data(0, &pixels[..4]);
+    second.extend(data(4, &pixels[4..]));
+    let mut c = client(vec![
+        line(HELLO),
+        line(&format!("OK FRAME 4 2 {crc:08X}")),
+        data(0, &pixels[..4]),
+        second,
+    ]);
+    assert!(c.hello().is_ok() && c.freeze().is_ok());
+    let img = c.transfer(&mut |_, _| true);
+    assert_eq!(img.ok().map(|i| i.data().to_vec()), Some(pixels.to_vec()));
+}
+
+#[test]
+fn cancel_stops_the_transfer() {
+    let pixels = [1u8; 8];
+    let crc = crc32(&pixels);
+    let mut c = client(vec![
+        line(HELLO),
+        line(&format!("OK FRAME 4 2 {crc:08X}")),
+        data(0, &pixels[..4]),
+        data(4, &pixels[4..]),
+    ]);
+    assert!(c.hello().is_ok() && c.freeze().is_ok());
+    let e = c.transfer(&mut |_, _| false);
+    assert!(
+        matches!(
+            e,
+            Err(RigError::Cancelled {
+                done: 4,
+                total: 8,
+                ..
+            })
+        ),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn a_vanished_device_is_named() {
+    let mut s = Script::new(b'\n', vec![]);
+    s.eof_at_end = true;
+    let mut c = VsgClient::new(s, "/dev/ttyUSB7", cfg());
+    let e = c.hello();
+    assert!(e.as_ref().is_err_and(RigError::is_vanished), "{e:?}");
+    let msg = e.err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(
+        msg.contains("/dev/ttyUSB7") && msg.contains("vanished"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn a_noisy_line_shrinks_the_block_and_the_budget_ends_it() {
+    let mut cfg = cfg();
+    cfg.block = 1024;
+    let pixels = vec![3u8; 2048];
+    let crc = crc32(&pixels);
+    let mut answers = vec![
+        line("OK VSG/1 model=T width=64 height=32 depth=8 cameras=2 maxblock=4096"),
+        line(&format!("OK FRAME 64 32 {crc:08X}")),
+    ];
+    // Every block comes back damaged.
+    for _ in 0..40 {
+        answers.push(line("DATA 0 1 00000000"));
+    }
+    let mut c = VsgClient::new(Script::new(b'\n', answers), "/dev/test0", cfg);
+    assert!(c.hello().is_ok() && c.freeze().is_ok());
+    let e = c.transfer(&mut |_, _| true);
+    assert!(
+        matches!(e, Err(RigError::BlockCrc { offset: 0, .. })),
+        "{e:?}"
+    );
+    let sent = c.port_mut().sent_text();
+    for len in [1024, 512, 256, 128] {
+        assert!(
+            sent.contains(&format!("READ 0 {len}*")),
+            "no READ of {len}: {sent}"
+        );
+    }
+}

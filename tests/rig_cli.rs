@@ -1,0 +1,273 @@
+//! `vss sim`, `vss grab` and `vss lights` as a person runs them: the
+//! simulator in its own process on pseudo-terminals, grab and lights
+//! talking to it through the profile's ports; failed captures leave no
+//! image (and no temporary file) behind.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use assert_cmd::cargo::cargo_bin;
+use vss::formats::img::read_img;
+use vss::profile::{GrabberKind, Profile, RelayKind};
+use vss::rig::sim::cell_profile;
+
+fn base() -> Profile {
+    let mut p = cell_profile(128, 128);
+    p.sim.noise = 0.0;
+    p.relay.settle_ms = 5;
+    p
+}
+
+fn write_profile(dir: &Path, name: &str, p: &Profile) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, toml::to_string(p).expect("profile to toml")).expect("write profile");
+    path
+}
+
+fn vss() -> Command {
+    Command::new(cargo_bin("vss"))
+}
+
+/// `vss sim` in the background, and the two device paths it printed.
+struct SimProcess {
+    child: Child,
+    grabber: String,
+    relay: String,
+}
+
+impl SimProcess {
+    fn start(profile: &Path) -> SimProcess {
+        let mut child = vss()
+            .arg("--profile")
+            .arg(profile)
+            .arg("sim")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("start vss sim");
+        let out = child.stdout.take().expect("stdout");
+        let mut lines = BufReader::new(out).lines();
+        let mut next = || lines.next().and_then(Result::ok).unwrap_or_default();
+        let grabber = next().strip_prefix("grabber: ").map(str::to_string);
+        let relay = next().strip_prefix("relay: ").map(str::to_string);
+        let summary = next();
+        assert!(summary.starts_with("simulated cell:"), "{summary}");
+        SimProcess {
+            child,
+            grabber: grabber.expect("grabber path"),
+            relay: relay.expect("relay path"),
+        }
+    }
+
+    /// SIGTERM ends it cleanly.
+    fn stop(mut self) {
+        let pid = self.child.id().to_string();
+        let ok = Command::new("kill").args(["-TERM", &pid]).status();
+        assert!(ok.is_ok_and(|s| s.success()));
+        let deadline = Instant::now() + Duration::from_secs(5);
+        loop {
+            if let Ok(Some(st)) = self.child.try_wait() {
+                assert!(st.success(), "vss sim exits 0 on SIGTERM: {st}");
+                return;
+            }
+            assert!(Instant::now() < deadline, "vss sim did not stop on SIGTERM");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+}
+
+impl Drop for SimProcess {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn imgs(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .map(|rd| {
+            rd.filter_map(Result::ok)
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+#[test]
+fn grab_and_lights_against_vss_sim() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let sim_profile = write_profile(tmp.path(), "sim.toml", &base());
+    let sim = SimProcess::start(&sim_profile);
+    let mut p = base();
+    p.grabber.kind = GrabberKind::Vsg;
+    p.grabber.port = sim.grabber.clone();
+    p.relay.kind = RelayKind::Numato;
+    p.relay.port = sim.relay.clone();
+    let prof = write_profile(tmp.path(), "cell.toml", &p);
+    let session = tmp.path().join("s/cube");
+
+    let out = vss()
+        .arg("--profile")
+        .arg(&prof)
+        .args([
+            "grab",
+            "--camera",
+            "2",
+            "--lighting",
+            "a,b,e",
+            "--image",
+            "3",
+            "--session",
+        ])
+        .arg(&session)
+        .output()
+        .expect("run grab");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("cube3a: 16384/16384 bytes (100%)"),
+        "progress: {err}"
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("lighting b (right-front)"), "{stdout}");
+    assert_eq!(imgs(&session), ["cube3a.img", "cube3b.img", "cube3e.img"]);
+    let a = read_img(&session.join("cube3a.img")).expect("cube3a.img reads");
+    assert_eq!(a.image.size(), (128, 128));
+    assert_eq!(a.comment, "cube3a");
+    let e = read_img(&session.join("cube3e.img")).expect("cube3e.img reads");
+    assert!(a.image != e.image, "lighting changes the image");
+
+    // Existing images are not overwritten without --yes.
+    let again = vss()
+        .arg("--profile")
+        .arg(&prof)
+        .args([
+            "grab",
+            "--camera",
+            "1",
+            "--lighting",
+            "a",
+            "--image",
+            "3",
+            "--session",
+        ])
+        .arg(&session)
+        .output()
+        .expect("run grab");
+    assert!(!again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--yes"));
+    assert!(read_img(&session.join("cube3a.img")).expect("kept").image == a.image);
+
+    // Lights: set a configuration, read it back, switch off.
+    let lights = |args: &[&str]| {
+        let o = vss()
+            .arg("--profile")
+            .arg(&prof)
+            .arg("lights")
+            .args(args)
+            .output()
+            .expect("lights");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    assert!(lights(&["set", "c"]).contains("relays 0004; on: left-back"));
+    assert!(lights(&["status"]).contains("on: left-back"));
+    assert!(lights(&["on"]).contains("relays 000f"));
+    assert!(lights(&["off"]).contains("on: none"));
+    sim.stop();
+}
+
+fn grab_embedded(profile: &Path, session: &Path, faults: Option<&str>) -> std::process::Output {
+    let mut c = vss();
+    c.arg("--profile").arg(profile).args([
+        "grab",
+        "--camera",
+        "3",
+        "--lighting",
+        "a,b,c,e",
+        "--image",
+        "1",
+        "--yes",
+        "--session",
+    ]);
+    c.arg(session);
+    if let Some(f) = faults {
+        c.args(["--sim-faults", f]);
+    }
+    c.output().expect("run grab")
+}
+
+#[test]
+fn faults_never_leave_a_corrupt_image_on_disk() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let mut p = base();
+    p.grabber.block = 4096;
+    let prof = write_profile(tmp.path(), "p.toml", &p);
+    let clean = tmp.path().join("clean/ref");
+    let out = grab_embedded(&prof, &clean, None);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let names = ["ref1a.img", "ref1b.img", "ref1c.img", "ref1e.img"];
+    let want: Vec<_> = names
+        .iter()
+        .map(|n| read_img(&clean.join(n)).expect("clean image").image)
+        .collect();
+
+    for (i, faults) in [
+        "drop=1e-3,seed=4",
+        "corrupt=1e-3,seed=4",
+        "reset",
+        "garbage=500",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let dir = tmp.path().join(format!("f{i}/ref"));
+        let out = grab_embedded(&prof, &dir, Some(faults));
+        assert!(
+            out.status.success(),
+            "{faults}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for (n, w) in names.iter().zip(&want) {
+            let got = read_img(&dir.join(n)).expect("image");
+            assert!(
+                got.image == *w,
+                "{faults}: {n} differs from the clean capture"
+            );
+        }
+        assert_eq!(imgs(&dir), names, "{faults}: no stray files");
+    }
+
+    // Unplugged during the third frame: the first two are kept, the third
+    // is not written at all, and the error names the port.
+    let dir = tmp.path().join("unplug/ref");
+    let out = grab_embedded(&prof, &dir, Some("unplug-after=40000"));
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("ref1c") && err.contains("vanished") && err.contains("/dev/pts/"),
+        "{err}"
+    );
+    assert_eq!(imgs(&dir), ["ref1a.img", "ref1b.img"]);
+    for (n, w) in names.iter().zip(&want).take(2) {
+        assert!(read_img(&dir.join(n)).expect("kept").image == *w);
+    }
+}
+
+#[test]
+fn grab_refuses_a_bad_session_name() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let prof = write_profile(tmp.path(), "p.toml", &base());
+    let out = grab_embedded(&prof, &tmp.path().join("bad name!"), None);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("session name"));
+    assert!(!tmp.path().join("bad name!").exists());
+}

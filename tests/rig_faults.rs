@@ -1,0 +1,178 @@
+//! The fault matrix: the simulated grabber drops and corrupts bytes, stalls,
+//! is unplugged mid-frame, greets with garbage, resets mid-transfer. Every
+//! run must end within its timeouts, either with the very frame a clean line
+//! gives (noise is off, so frames are comparable) or with a clear error —
+//! never a hang.
+
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use vss::llv::GreyImage;
+use vss::profile::Profile;
+use vss::rig::protocol::crc32;
+use vss::rig::sim::{Faults, cell_profile};
+use vss::rig::{Capture, Cell, RigError};
+
+fn profile() -> Profile {
+    let mut p = cell_profile(128, 128);
+    p.sim.noise = 0.0;
+    p.relay.settle_ms = 0;
+    p.grabber.timeout_ms = 1000;
+    p.grabber.retries = 3;
+    // Four blocks per frame, so faults can strike mid-frame.
+    p.grabber.block = 4096;
+    p
+}
+
+/// Runs `f` on a thread; a hang fails the test instead of blocking it.
+fn within<T: Send + 'static>(limit: Duration, f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(f());
+    });
+    match rx.recv_timeout(limit) {
+        Ok(v) => v,
+        Err(mpsc::RecvTimeoutError::Timeout) => panic!("no result within {limit:?}: a hang"),
+        Err(mpsc::RecvTimeoutError::Disconnected) => panic!("the run panicked (see above)"),
+    }
+}
+
+fn capture(cell: &mut Cell) -> Result<Capture, RigError> {
+    cell.capture(2, 'a', &mut |_, _| true)
+}
+
+fn reference() -> GreyImage {
+    let mut cell = Cell::open(&profile()).expect("clean cell");
+    capture(&mut cell).expect("clean capture").image
+}
+
+/// Opens a cell with `spec` faults (which may itself fail: HELLO can be
+/// garbled beyond repair) and captures once.
+fn try_faulty(spec: &str) -> (Result<(Capture, Cell), RigError>, Duration) {
+    let faults = Faults::parse(spec).expect("fault spec");
+    within(Duration::from_secs(60), move || {
+        let t = Instant::now();
+        let r = Cell::open_with_faults(&profile(), faults)
+            .and_then(|mut cell| capture(&mut cell).map(|c| (c, cell)));
+        (r, t.elapsed())
+    })
+}
+
+/// Like [`try_faulty`] for faults the cell must get through to a capture.
+fn faulty(spec: &str) -> (Result<Capture, RigError>, Duration, Cell) {
+    let faults = Faults::parse(spec).expect("fault spec");
+    let spec = spec.to_string();
+    within(Duration::from_secs(60), move || {
+        let t = Instant::now();
+        let mut cell = Cell::open_with_faults(&profile(), faults)
+            .unwrap_or_else(|e| panic!("{spec}: open: {e}"));
+        let r = capture(&mut cell);
+        (r, t.elapsed(), cell)
+    })
+}
+
+fn assert_good(spec: &str, r: &Result<Capture, RigError>, want: &GreyImage) {
+    match r {
+        Ok(c) => {
+            assert_eq!(crc32(c.image.data()), c.frame.crc, "{spec}: CRC");
+            assert!(
+                c.image == *want,
+                "{spec}: the frame differs from a clean line's"
+            );
+        }
+        Err(e) => panic!("{spec}: {e}"),
+    }
+}
+
+#[test]
+fn drops_at_1e3_still_deliver_the_frame() {
+    let want = reference();
+    let (r, took, cell) = faulty("drop=1e-3,seed=11");
+    assert_good("drop", &r, &want);
+    assert!(cell.grabber.wire_stats().bad_blocks > 0, "faults struck");
+    assert!(took < Duration::from_secs(30), "{took:?}");
+}
+
+#[test]
+fn corruption_at_1e3_still_delivers_the_frame() {
+    let want = reference();
+    let (r, took, cell) = faulty("corrupt=1e-3,seed=12");
+    assert_good("corrupt", &r, &want);
+    assert!(cell.grabber.wire_stats().bad_blocks > 0, "faults struck");
+    assert!(took < Duration::from_secs(30), "{took:?}");
+}
+
+#[test]
+fn drops_and_corruption_together() {
+    let want = reference();
+    for seed in [1, 2, 3] {
+        let spec = format!("drop=1e-3,corrupt=1e-3,seed={seed}");
+        let (r, _, _) = faulty(&spec);
+        assert_good(&spec, &r, &want);
+    }
+}
+
+#[test]
+fn a_two_second_stall_is_ridden_out() {
+    let want = reference();
+    let (r, took, cell) = faulty("stall=2s");
+    assert_good("stall", &r, &want);
+    assert!(
+        took >= Duration::from_secs(1),
+        "the stall happened: {took:?}"
+    );
+    assert!(took < Duration::from_secs(15), "{took:?}");
+    assert!(cell.grabber.wire_stats().resyncs > 1);
+}
+
+#[test]
+fn unplug_mid_frame_is_a_clear_error_and_reconnect_works() {
+    let want = reference();
+    let (r, took, mut cell) = faulty("unplug-after=9000");
+    let e = r.expect_err("the grabber vanished mid-frame");
+    assert!(e.is_vanished(), "{e}");
+    let port = cell.grabber.port_name().to_string();
+    assert!(e.to_string().contains(&port), "names the port: {e}");
+    assert!(took < Duration::from_secs(10), "{took:?}");
+    // Plugged back in: the console reconnects and captures.
+    cell.reconnect_grabber().expect("reconnect");
+    let again = within(Duration::from_secs(30), move || {
+        let r = capture(&mut cell);
+        r.map(|c| c.image)
+    });
+    assert!(again.expect("capture after reconnect") == want);
+}
+
+#[test]
+fn garbage_on_connect_is_skipped() {
+    let want = reference();
+    let (r, _, _) = faulty("garbage=3000,seed=5");
+    assert_good("garbage", &r, &want);
+}
+
+#[test]
+fn a_reset_mid_transfer_is_recovered_by_freezing_again() {
+    let want = reference();
+    let (r, _, _) = faulty("reset");
+    assert_good("reset", &r, &want);
+}
+
+#[test]
+fn a_hopeless_line_ends_in_a_clear_error_not_a_hang() {
+    let (r, took) = try_faulty("corrupt=0.01,seed=9");
+    match r {
+        Ok((c, _)) => assert_eq!(crc32(c.image.data()), c.frame.crc),
+        Err(e) => {
+            let msg = e.to_string();
+            assert!(
+                matches!(
+                    e,
+                    RigError::BlockCrc { .. } | RigError::Garbled { .. } | RigError::Timeout { .. }
+                ),
+                "{msg}"
+            );
+            assert!(msg.contains("/dev/"), "names the port: {msg}");
+        }
+    }
+    assert!(took < Duration::from_secs(45), "{took:?}");
+}
