@@ -16,7 +16,11 @@ pub mod lock;
 pub mod manifest;
 pub mod outputs;
 pub mod progress;
+pub mod redo;
+pub mod reporting;
 pub mod stamp;
+#[doc(hidden)]
+pub mod torture;
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -32,6 +36,7 @@ pub use lock::{Lock, LockInfo};
 pub use manifest::Manifest;
 pub use outputs::OutputSet;
 pub use progress::{ImageProgress, OutputState, Progress, Step};
+pub use redo::RedoSummary;
 
 use manifest::{EditRecord, FileRecord, GreyRecord, ImageRecord, LightingInfo, SessionInfo};
 

@@ -1,16 +1,221 @@
-//! `vss report` (to be written).
+//! `vss report`: PostScript and SVG of a session (the survey report) or of
+//! single files (`--ldr test1.ldr` as `ldr2ps`, `--img cube1a.img` as
+//! `img2ps`).
 
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use anyhow::{Context as _, bail};
+
 use super::Global;
+use crate::formats;
+use crate::fsutil::write_atomic;
+use crate::llv::GreyImage;
+use crate::report::{ImageReport, ps, svg};
+use crate::session::Session;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Arguments (not yet defined).
-    #[arg(trailing_var_arg = true)]
-    pub rest: Vec<String>,
+    /// Session folder to report on.
+    pub dir: Option<PathBuf>,
+    /// Only this image number of the session.
+    #[arg(long, value_name = "K")]
+    pub image: Option<u32>,
+    /// Write PostScript here (default: DIR/NAME.ps, or the input with .ps).
+    #[arg(long, value_name = "FILE")]
+    pub ps: Option<PathBuf>,
+    /// Write SVG here (for a session of several images: one file per image,
+    /// FILE with the image number before the extension).
+    #[arg(long, value_name = "FILE")]
+    pub svg: Option<PathBuf>,
+    /// A line file (.lex/.ldr) to print as ldr2ps did.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["dir", "img"])]
+    pub ldr: Option<PathBuf>,
+    /// Grey images (.img/.imc/.png/.pgm/.tif/.bmp) to print as img2ps did,
+    /// six per page. Repeat for more.
+    #[arg(long, value_name = "FILE", conflicts_with = "dir")]
+    pub img: Vec<PathBuf>,
+    /// Picture size of a line file, WxH pixels (default: a grey image of the
+    /// same name beside it, else 512x512 grown to hold every line).
+    #[arg(long, value_name = "WxH", requires = "ldr")]
+    pub size: Option<String>,
 }
 
-pub fn run(_g: &Global, _a: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`vss report` is not implemented yet")
+pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
+    if let Some(ldr) = &a.ldr {
+        return lines_report(ldr, &a);
+    }
+    if !a.img.is_empty() {
+        return grey_report(&a);
+    }
+    let Some(dir) = &a.dir else {
+        bail!("name a session folder, or --ldr FILE, or --img FILE (see `vss report --help`)");
+    };
+    session_report(dir, &a)
+}
+
+fn write(path: &Path, text: &str) -> anyhow::Result<()> {
+    write_atomic(path, text.as_bytes())
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
+fn lines_report(ldr: &Path, a: &Args) -> anyhow::Result<ExitCode> {
+    let lines = formats::lines::read_lines(ldr)?;
+    let (w, h) = match &a.size {
+        Some(s) => parse_size(s)?,
+        None => guess_size(ldr, &lines),
+    };
+    let caption = ldr.file_name().map_or_else(
+        || ldr.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let ps_path =
+        a.ps.clone()
+            .or_else(|| a.svg.is_none().then(|| ldr.with_extension("ps")));
+    if let Some(p) = ps_path {
+        write(&p, &ps::lines_page(&caption, &lines, w, h))?;
+    }
+    if let Some(p) = &a.svg {
+        write(p, &svg::lines_svg(&caption, &lines, w, h))?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn parse_size(s: &str) -> anyhow::Result<(usize, usize)> {
+    let parsed = s
+        .split_once(['x', 'X'])
+        .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
+    match parsed {
+        Some((w, h)) if w > 0 && h > 0 && w <= 65535 && h <= 65535 => Ok((w, h)),
+        _ => bail!("--size {s:?}: expected WxH in pixels, e.g. 512x512"),
+    }
+}
+
+/// The picture size of a line file: a grey image of the same VSS name beside
+/// it (`test1.ldr` → `test1a.img` or `test1.img`), else 512 × 512 grown to
+/// the lines' extent.
+fn guess_size(ldr: &Path, lines: &[crate::llv::Segment]) -> (usize, usize) {
+    let stem = ldr
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let dir = ldr.parent().unwrap_or(Path::new("."));
+    let candidates = std::iter::once(format!("{stem}.img"))
+        .chain(('a'..='z').map(|l| format!("{stem}{l}.img")))
+        .chain(std::iter::once(format!("{stem}.imc")));
+    for c in candidates {
+        if let Ok(h) = formats::img::read_header(&dir.join(c)) {
+            return (usize::from(h.width).max(1), usize::from(h.height).max(1));
+        }
+    }
+    let (mut w, mut h) = (512.0f64, 512.0f64);
+    if let Some((_, max)) = formats::lines::bounding_box(lines) {
+        w = w.max(max.x.ceil() + 1.0);
+        h = h.max(max.y.ceil() + 1.0);
+    }
+    (w.min(65535.0) as usize, h.min(65535.0) as usize)
+}
+
+fn grey_report(a: &Args) -> anyhow::Result<ExitCode> {
+    let mut images: Vec<(String, GreyImage)> = Vec::new();
+    for p in &a.img {
+        let f = formats::imageio::read_any(p)?;
+        let name = p.file_name().map_or_else(
+            || p.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        images.push((name, f.image));
+    }
+    let first = a.img.first().cloned().unwrap_or_default();
+    let ps_path =
+        a.ps.clone()
+            .or_else(|| a.svg.is_none().then(|| first.with_extension("ps")));
+    if let Some(p) = ps_path {
+        let refs: Vec<(&str, &GreyImage)> = images.iter().map(|(n, i)| (n.as_str(), i)).collect();
+        let title = images.first().map_or("", |(n, _)| n.as_str());
+        write(&p, &ps::grey_page(title, &refs))?;
+    }
+    if let Some(p) = &a.svg {
+        for (i, (name, img)) in images.iter().enumerate() {
+            let path = if images.len() == 1 {
+                p.clone()
+            } else {
+                numbered(p, i as u32 + 1)
+            };
+            write(&path, &svg::grey_svg(name, img))?;
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `out.svg` → `out3.svg`.
+fn numbered(p: &Path, k: u32) -> PathBuf {
+    let stem = p
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = p
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "svg".into());
+    p.with_file_name(format!("{stem}{k}.{ext}"))
+}
+
+fn session_report(dir: &Path, a: &Args) -> anyhow::Result<ExitCode> {
+    let s = Session::inspect(dir)?;
+    let reports: Vec<ImageReport> = match a.image {
+        Some(k) => vec![s.image_report(k)?],
+        None => s.reports()?,
+    };
+    if reports.is_empty() {
+        eprintln!("vss: note: session {} has no images yet", s.name());
+    }
+    let title = match a.image {
+        Some(k) => format!("survey {} image {k}", s.name()),
+        None => format!("survey {}", s.name()),
+    };
+    let ps_path =
+        a.ps.clone()
+            .or_else(|| a.svg.is_none().then(|| s.path(&format!("{}.ps", s.name()))));
+    if let Some(p) = ps_path {
+        write(&p, &ps::survey_report(&title, &reports))?;
+    }
+    if let Some(p) = &a.svg {
+        for r in &reports {
+            let path = if reports.len() == 1 {
+                p.clone()
+            } else {
+                let k = r
+                    .title
+                    .trim_start_matches(s.name().as_str())
+                    .parse()
+                    .unwrap_or(0);
+                numbered(p, k)
+            };
+            write(&path, &svg::image_svg(r))?;
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_or_explain() {
+        assert_eq!(parse_size("640x480").unwrap(), (640, 480));
+        assert!(parse_size("640").unwrap_err().to_string().contains("WxH"));
+        assert!(parse_size("0x5").is_err());
+    }
+
+    #[test]
+    fn numbered_inserts_the_image_number() {
+        assert_eq!(
+            numbered(Path::new("/t/out.svg"), 3),
+            Path::new("/t/out3.svg")
+        );
+    }
 }

@@ -1,16 +1,267 @@
-//! `vss session` (to be written).
+//! `vss session`: create, show, check and redo survey sessions from the
+//! command line (the console does the same through [`crate::session`]).
 
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use anyhow::Context as _;
+
 use super::Global;
+use crate::profile::Profile;
+use crate::session::{OutputState, Session};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Arguments (not yet defined).
-    #[arg(trailing_var_arg = true)]
-    pub rest: Vec<String>,
+    #[command(subcommand)]
+    pub command: Cmd,
 }
 
-pub fn run(_g: &Global, _a: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`vss session` is not implemented yet")
+#[derive(Debug, clap::Subcommand)]
+pub enum Cmd {
+    /// Make a new session folder DIR/NAME for the profile's survey.
+    New {
+        /// Session name: 1–32 letters, digits, _ or -, starting with a letter or _.
+        name: String,
+        /// Parent folder (default: the profile's survey.dir).
+        #[arg(long, value_name = "D")]
+        dir: Option<PathBuf>,
+    },
+    /// Show a session: lightings, checklist, outputs, edits, lock holder.
+    Show { dir: PathBuf },
+    /// Check that every file the manifest names exists and parses; list
+    /// stale outputs. Exits non-zero on problems.
+    Check {
+        dir: PathBuf,
+        /// Treat warnings (changed files, stale outputs) as problems too.
+        #[arg(long)]
+        strict: bool,
+    },
+    /// Re-run the stages of one image with the current profile's parameters.
+    Redo {
+        dir: PathBuf,
+        #[arg(long, value_name = "K")]
+        image: u32,
+        /// First stage to re-run.
+        #[arg(long, value_name = "STAGE", value_parser = ["lens", "edges", "lines", "connect"], default_value = "edges")]
+        from: String,
+        /// Take over the lock of a console that is gone.
+        #[arg(long)]
+        take_over: bool,
+    },
+    /// Test helper: save into a session in an endless loop (the crash-safety
+    /// test kills it at random moments).
+    #[command(hide = true)]
+    Torture {
+        dir: PathBuf,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Stop after this many saves.
+        #[arg(long, default_value_t = 1_000_000)]
+        limit: u64,
+    },
+}
+
+pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
+    match a.command {
+        Cmd::New { name, dir } => new(g, &name, dir),
+        Cmd::Show { dir } => show(&dir),
+        Cmd::Check { dir, strict } => check(&dir, strict),
+        Cmd::Redo {
+            dir,
+            image,
+            from,
+            take_over,
+        } => redo(g, &dir, image, &from, take_over),
+        Cmd::Torture { dir, seed, limit } => {
+            crate::session::torture::run(&dir, seed, limit)?;
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+/// The profile named with --profile; without one, `default` if it exists,
+/// else the built-in defaults.
+fn profile(g: &Global) -> anyhow::Result<(Profile, Option<PathBuf>)> {
+    let name = g.profile.as_deref().unwrap_or("default");
+    match crate::profile::resolve(name) {
+        Ok(path) => {
+            let p = g.load_profile()?;
+            Ok((p, Some(path)))
+        }
+        Err(_) if g.profile.is_none() => Ok((Profile::default(), None)),
+        Err(e) => Err(e.into()),
+    }
+}
+
+fn new(g: &Global, name: &str, dir: Option<PathBuf>) -> anyhow::Result<ExitCode> {
+    let (profile, profile_path) = profile(g)?;
+    let parent = dir.unwrap_or_else(|| profile.survey.dir.clone());
+    let mut s = Session::create(&parent, name, &profile)?;
+    // Camera descriptions named by the profile (relative to it) go into the
+    // session as NAMEk.cdf for every planned image of that camera.
+    let base = profile_path
+        .as_deref()
+        .and_then(Path::parent)
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
+    let cams = s.manifest().session.cameras.max(1);
+    for k in 1..=s.manifest().session.planned_images {
+        let cam = (k - 1) % cams + 1;
+        let cdf = profile
+            .survey
+            .cdf
+            .get((cam - 1) as usize)
+            .map(|c| base.join(c));
+        if let Some(c) = &cdf
+            && !c.is_file()
+        {
+            eprintln!(
+                "vss: warning: camera {cam}: {} not found; image {k} has no camera description",
+                c.display()
+            );
+            continue;
+        }
+        s.set_image_info(k, cam, (k - 1) / cams + 1, cdf.as_deref())?;
+    }
+    if let Some(w) = s.name().dos_warning(s.manifest().session.planned_images) {
+        eprintln!("vss: note: {w}");
+    }
+    println!("created session {}", s.dir().display());
+    print_checklist(&s);
+    Ok(ExitCode::SUCCESS)
+}
+
+fn show(dir: &Path) -> anyhow::Result<ExitCode> {
+    let s = Session::inspect(dir)?;
+    let m = s.manifest();
+    println!("session {} in {}", m.session.name, s.dir().display());
+    println!(
+        "  created {}, modified {} by vss {}, profile {:?}",
+        m.session.created, m.session.modified, m.session.version, m.session.profile
+    );
+    match s.lock_holder() {
+        Some(h) => println!(
+            "  in use by {h}{}",
+            if h.is_stale() {
+                " (gone: stale lock)"
+            } else {
+                ""
+            }
+        ),
+        None => println!("  not in use"),
+    }
+    println!("lightings:");
+    for l in &m.lighting {
+        println!(
+            "  {}: {}{}",
+            l.letter,
+            if l.on.is_empty() {
+                "no lights".to_string()
+            } else {
+                l.on.join(", ")
+            },
+            if l.note.is_empty() {
+                String::new()
+            } else {
+                format!(" -- {}", l.note)
+            }
+        );
+    }
+    print_checklist(&s);
+    for r in &m.image {
+        if let Some(o) = &r.outputs {
+            let c = &o.counts;
+            println!(
+                "  image {}: {} + {} edge points, {} lines extracted, {} lines; made {}",
+                r.number, c.edges_h, c.edges_v, c.lines_raw, c.lines, o.made
+            );
+        }
+        for e in &r.edit {
+            println!(
+                "  image {}: edit {} at {} -> {} lines",
+                r.number, e.op, e.at, e.lines
+            );
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_checklist(s: &Session) {
+    let p = s.progress();
+    let (done, all) = p.done();
+    println!("checklist ({done} of {all} images done):");
+    println!("  image camera location captured  outputs");
+    for i in &p.images {
+        let captured: String = p
+            .letters
+            .iter()
+            .map(|l| if i.captured.contains(l) { *l } else { '.' })
+            .collect();
+        let out = match &i.outputs {
+            OutputState::Missing => "-".to_string(),
+            OutputState::Done => "done".to_string(),
+            OutputState::Stale(why) => format!("STALE ({why})"),
+        };
+        let edits = if i.edits > 0 {
+            format!(", {} manual edits", i.edits)
+        } else {
+            String::new()
+        };
+        println!(
+            "  {:>5} {:>6} {:>8} {captured:<9} {out}{edits}",
+            i.number, i.camera, i.location
+        );
+    }
+    match p.next_step() {
+        Some(step) => println!("next: {step}"),
+        None => println!("next: nothing, the survey is complete"),
+    }
+}
+
+fn check(dir: &Path, strict: bool) -> anyhow::Result<ExitCode> {
+    let s = Session::inspect(dir)?;
+    let r = s.check();
+    for p in &r.problems {
+        println!("problem: {p}");
+    }
+    for w in &r.warnings {
+        println!("warning: {w}");
+    }
+    for (k, why) in &r.stale {
+        println!("stale: image {k}: {why}");
+    }
+    let bad = !r.problems.is_empty() || (strict && (!r.warnings.is_empty() || !r.stale.is_empty()));
+    println!(
+        "{}: {} files read, {} problems, {} warnings, {} stale",
+        if bad { "FAILED" } else { "ok" },
+        r.checked,
+        r.problems.len(),
+        r.warnings.len(),
+        r.stale.len()
+    );
+    Ok(if bad {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+fn redo(g: &Global, dir: &Path, k: u32, from: &str, take_over: bool) -> anyhow::Result<ExitCode> {
+    let (profile, _) = profile(g)?;
+    let stage = match from {
+        "lens" => crate::llv::params::Stage::Lens,
+        "edges" => crate::llv::params::Stage::Edges,
+        "lines" => crate::llv::params::Stage::Lines,
+        _ => crate::llv::params::Stage::Connect,
+    };
+    let mut s = if take_over {
+        Session::open_take_over(dir)?
+    } else {
+        Session::open(dir)?
+    };
+    let summary = s
+        .redo(k, stage, &profile.llv)
+        .with_context(|| format!("redo image {k} of {}", dir.display()))?;
+    println!("{summary}");
+    Ok(ExitCode::SUCCESS)
 }

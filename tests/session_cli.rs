@@ -1,0 +1,140 @@
+//! `vss session` as a person uses it: new, show, check (exit codes), bad
+//! names refused, a nonsense manifest reported with file:line and kept.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn vss(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_vss"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .unwrap()
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+const PROFILE: &str = r#"
+name = "two lights"
+[survey]
+cameras = 2
+cdf = ["cam1.cdf"]
+[[lighting]]
+letter = "a"
+on = ["left"]
+note = "shadows to the right"
+[[lighting]]
+letter = "b"
+on = ["right"]
+"#;
+
+const CDF: &str = "S=A\n0.01125\n0.0078\nC=E\n256\n256\nf=A\n11.9\nD=N\n";
+
+#[test]
+fn new_show_check_and_bad_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("p.toml"), PROFILE).unwrap();
+    std::fs::write(d.join("cam1.cdf"), CDF).unwrap();
+    let o = vss(
+        &[
+            "session",
+            "new",
+            "cube",
+            "--dir",
+            ".",
+            "--profile",
+            "p.toml",
+        ],
+        d,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        text(&o).contains("next: capture image 1 under lighting a"),
+        "{}",
+        text(&o)
+    );
+    assert!(
+        d.join("cube/cube1.cdf").is_file(),
+        "camera 1's cdf copied for image 1"
+    );
+    assert!(!d.join("cube/cube2.cdf").exists());
+    assert_eq!(
+        std::fs::read_to_string(d.join("cube/cube.ses")).unwrap(),
+        "2\n2\n2\n"
+    );
+
+    let o = vss(&["session", "show", "cube"], d);
+    assert!(o.status.success(), "{}", text(&o));
+    let t = text(&o);
+    assert!(t.contains("a: left -- shadows to the right"), "{t}");
+    assert!(t.contains("checklist (0 of 2 images done)"), "{t}");
+    assert!(t.contains("not in use"), "{t}");
+
+    let o = vss(&["session", "check", "cube"], d);
+    assert!(o.status.success(), "{}", text(&o));
+
+    // A file the manifest names goes missing: check fails and says which.
+    std::fs::remove_file(d.join("cube/cube1.cdf")).unwrap();
+    let o = vss(&["session", "check", "cube"], d);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("cube1.cdf"), "{}", text(&o));
+
+    let long = "x".repeat(300);
+    for bad in ["a/b", "..", "bad\u{1}name", long.as_str()] {
+        let o = vss(
+            &["session", "new", bad, "--dir", ".", "--profile", "p.toml"],
+            d,
+        );
+        assert!(!o.status.success(), "{bad:?} accepted");
+        assert!(text(&o).contains("session name"), "{bad:?}: {}", text(&o));
+    }
+    let o = vss(&["session", "show", "."], d);
+    assert!(!o.status.success(), "a folder that is no session");
+    assert!(text(&o).contains("not a session folder"), "{}", text(&o));
+}
+
+#[test]
+fn nonsense_manifest_is_reported_and_not_overwritten() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("p.toml"), PROFILE).unwrap();
+    assert!(
+        vss(
+            &["session", "new", "w", "--dir", ".", "--profile", "p.toml"],
+            d
+        )
+        .status
+        .success()
+    );
+    let m = d.join("w/w.toml");
+    let good = std::fs::read_to_string(&m).unwrap();
+    let bad = good.replace("planned_images = 2", "planned_images = -3");
+    std::fs::write(&m, &bad).unwrap();
+    for args in [
+        &["session", "show", "w"][..],
+        &["session", "check", "w"][..],
+        &["session", "redo", "w", "--image", "1"][..],
+        &["report", "w"][..],
+    ] {
+        let o = vss(args, d);
+        assert!(!o.status.success(), "{args:?}");
+        let line = bad.lines().position(|l| l.contains("-3")).unwrap() + 1;
+        assert!(
+            text(&o).contains(&format!("w.toml:{line}:")),
+            "{args:?}: {}",
+            text(&o)
+        );
+        assert_eq!(
+            std::fs::read_to_string(&m).unwrap(),
+            bad,
+            "manifest kept as it was"
+        );
+    }
+}

@@ -1,0 +1,128 @@
+//! Crash safety, for real: a child `vss` process saves into a session in a
+//! loop and is SIGKILLed at random (seeded) moments, 30 times. After every
+//! kill each file of the session must be a complete version (it parses and
+//! is self-consistent), the manifest must load, and `vss session check`
+//! must pass.
+
+use std::path::Path;
+use std::process::Command;
+use std::time::Duration;
+
+use vss::formats::{edgefile, img, lines};
+use vss::session::Session;
+use vss::session::torture::{SplitMix, consistent_edges, consistent_image, consistent_lines};
+
+const PROFILE: &str = r#"
+name = "torture"
+[survey]
+cameras = 2
+[[lighting]]
+letter = "a"
+on = ["left"]
+[[lighting]]
+letter = "b"
+on = ["right"]
+[[lighting]]
+letter = "c"
+on = ["left", "right"]
+"#;
+
+fn vss() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_vss"))
+}
+
+/// Every session file is whole; returns how many were verified.
+fn verify_files(dir: &Path) -> usize {
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let p = entry.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().to_string();
+        if name.starts_with('.') {
+            continue; // temporary file of an interrupted save: never a session file
+        }
+        let ext = name.rsplit_once('.').map_or("", |(_, e)| e);
+        match ext {
+            "img" => {
+                let f = img::read_img(&p).unwrap_or_else(|e| panic!("{e}"));
+                assert!(consistent_image(&f), "{name} is a mixed or partial image");
+            }
+            "lex" | "ldr" => {
+                let l = lines::read_lines(&p).unwrap_or_else(|e| panic!("{e}"));
+                assert!(consistent_lines(&l), "{name} holds a mixed line set");
+            }
+            "hpo" | "vpo" => {
+                let e = edgefile::read_edges(&p).unwrap_or_else(|e| panic!("{e}"));
+                assert!(consistent_edges(&e), "{name} holds mixed edge points");
+            }
+            "ses" => {
+                vss::formats::ses::read_ses(&p).unwrap_or_else(|e| panic!("{e}"));
+            }
+            "toml" | "lock" => {}
+            other => panic!("unexpected file {name} (.{other})"),
+        }
+        n += 1;
+    }
+    n
+}
+
+#[test]
+fn killed_saves_leave_complete_files_and_a_passing_check() {
+    let tmp = tempfile::tempdir().unwrap();
+    let profile = tmp.path().join("torture.toml");
+    std::fs::write(&profile, PROFILE).unwrap();
+    let st = vss()
+        .args(["session", "new", "tort", "--dir"])
+        .arg(tmp.path())
+        .arg("--profile")
+        .arg(&profile)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let dir = tmp.path().join("tort");
+    let mut rng = SplitMix(0x5eed);
+    let mut manifests = std::collections::HashSet::new();
+    for round in 0..30 {
+        let mut child = vss()
+            .args(["session", "torture"])
+            .arg(&dir)
+            .args(["--seed", &(round + 1).to_string()])
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(30 + rng.below(250)));
+        child.kill().unwrap(); // SIGKILL on Unix
+        child.wait().unwrap();
+
+        let files = verify_files(&dir);
+        assert!(files >= 3, "round {round}: only {files} files");
+        let s = Session::inspect(&dir).unwrap_or_else(|e| panic!("round {round}: {e}"));
+        let report = s.check();
+        assert!(report.is_ok(), "round {round}: {:?}", report.problems);
+        manifests.insert(std::fs::read_to_string(dir.join("tort.toml")).unwrap());
+        if round % 10 == 9 {
+            let out = vss().args(["session", "check"]).arg(&dir).output().unwrap();
+            assert!(
+                out.status.success(),
+                "round {round}: vss session check failed:\n{}",
+                String::from_utf8_lossy(&out.stdout)
+            );
+        }
+    }
+    // The children really worked between kills.
+    assert!(
+        manifests.len() >= 25,
+        "only {} distinct manifests",
+        manifests.len()
+    );
+    let s = Session::open_take_over(&dir).unwrap();
+    let m = s.manifest();
+    assert!(m.image.iter().any(|r| !r.grey.is_empty()));
+    assert!(m.image.iter().any(|r| r.outputs.is_some()));
+    assert!(
+        s.leftovers().is_empty(),
+        "opening for writing clears leftovers"
+    );
+}

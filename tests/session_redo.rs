@@ -1,0 +1,202 @@
+//! Running the LLV stages on a session: save_outputs of a pipeline run,
+//! redo from edges, lines and connect (only the later stages change), lens
+//! correction from the image's .cdf, edits cleared by a new .ldr, and the
+//! `vss session redo` command.
+
+use std::process::Command;
+
+use vss::formats::img::ImgFile;
+use vss::llv::edit::EditOp;
+use vss::llv::params::Stage;
+use vss::llv::pipeline::{self, Input};
+use vss::llv::{GreyImage, Params};
+use vss::profile::{Lighting, Profile};
+use vss::session::{OutputState, Session};
+
+/// A bright rectangle on a dark ground, anti-aliased edges by 4×4 sampling.
+fn rectangle(level: f64) -> GreyImage {
+    let (w, h) = (128, 96);
+    let (x0, y0, x1, y1) = (30.3, 20.6, 97.7, 71.2);
+    let mut img = GreyImage::filled(w, h, 40).unwrap();
+    for y in 0..h {
+        for x in 0..w {
+            let mut inside = 0;
+            for sy in 0..4 {
+                for sx in 0..4 {
+                    let (px, py) = (
+                        x as f64 + (sx as f64 + 0.5) / 4.0 - 0.5,
+                        y as f64 + (sy as f64 + 0.5) / 4.0 - 0.5,
+                    );
+                    if px > x0 && px < x1 && py > y0 && py < y1 {
+                        inside += 1;
+                    }
+                }
+            }
+            let v = 40.0 + (level - 40.0) * f64::from(inside) / 16.0;
+            img.data_mut()[y * w + x] = v.round() as u8;
+        }
+    }
+    img
+}
+
+fn profile(letters: &[char]) -> Profile {
+    let mut p = Profile::default();
+    p.survey.cameras = 1;
+    p.lighting = letters
+        .iter()
+        .map(|&letter| Lighting {
+            letter,
+            on: vec![],
+            note: String::new(),
+        })
+        .collect();
+    p
+}
+
+fn hash_of(s: &Session, file: &str) -> String {
+    let o = s.manifest().image(1).unwrap().outputs.as_ref().unwrap();
+    o.files
+        .iter()
+        .find(|f| f.file == file)
+        .unwrap()
+        .hash
+        .clone()
+}
+
+#[test]
+fn redo_runs_only_the_stages_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Session::create(dir.path(), "box", &profile(&['a'])).unwrap();
+    s.save_image(1, 'a', &ImgFile::new(rectangle(200.0)))
+        .unwrap();
+    let p = Params::default();
+    let r = s.redo(1, Stage::Edges, &p).unwrap();
+    assert!(r.counts.edges_h > 50 && r.counts.edges_v > 50, "{r}");
+    assert!(r.counts.lines >= 4, "{r}");
+    assert!(!r.lens_corrected);
+    assert!(s.progress().is_complete());
+    assert!(!s.path("box1a.imc").exists(), "no lens correction, no .imc");
+    let hpo = hash_of(&s, "box1.hpo");
+    let lex = hash_of(&s, "box1.lex");
+
+    // From lines with a larger minimum length: edges untouched, fewer lines.
+    let mut p2 = p.clone();
+    p2.lines.min_length = 55.0;
+    p2.edges.floor = 9.0; // an edge parameter: must NOT be applied from lines
+    let r2 = s.redo(1, Stage::Lines, &p2).unwrap();
+    assert!(r2.counts.lines_raw < r.counts.lines_raw, "{r2} vs {r}");
+    assert_eq!(hash_of(&s, "box1.hpo"), hpo);
+    assert_ne!(hash_of(&s, "box1.lex"), lex);
+    let used = &s
+        .manifest()
+        .image(1)
+        .unwrap()
+        .outputs
+        .as_ref()
+        .unwrap()
+        .params;
+    assert_eq!(used.lines.min_length, 55.0);
+    assert_eq!(
+        used.edges.floor, p.edges.floor,
+        "edges keep the parameters they were made with"
+    );
+
+    // A manual edit, then a redo from connect replaces the .ldr and the log.
+    let lines = s.load_lines(1).unwrap();
+    let edited = vss::llv::edit::apply(&lines, &EditOp::Delete(vec![0])).unwrap();
+    s.record_edit_op(1, &EditOp::Delete(vec![0]), &edited)
+        .unwrap();
+    assert_eq!(s.manifest().image(1).unwrap().edit[0].op, "delete 0");
+    assert_eq!(s.load_lines(1).unwrap().len(), lines.len() - 1);
+    let lex_before = hash_of(&s, "box1.lex");
+    s.redo(1, Stage::Connect, &p2).unwrap();
+    assert!(s.manifest().image(1).unwrap().edit.is_empty());
+    assert_eq!(s.load_lines(1).unwrap().len(), lines.len());
+    assert_eq!(
+        hash_of(&s, "box1.lex"),
+        lex_before,
+        "connect keeps the .lex"
+    );
+    assert!(
+        s.check().is_ok() && s.check().warnings.is_empty(),
+        "{:?}",
+        s.check()
+    );
+}
+
+#[test]
+fn photometric_run_with_lens_correction_is_saved_per_lighting() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Session::create(dir.path(), "box", &profile(&['a', 'b'])).unwrap();
+    s.save_image(1, 'a', &ImgFile::new(rectangle(200.0)))
+        .unwrap();
+    s.save_image(1, 'b', &ImgFile::new(rectangle(150.0)))
+        .unwrap();
+    let cdf = dir.path().join("cam.cdf");
+    std::fs::write(
+        &cdf,
+        "S=A\n0.01\n0.01\nC=E\n64\n48\nf=A\n8\nD=A\n-0.002\n0\n0\n0\n0\n",
+    )
+    .unwrap();
+    s.set_image_info(1, 1, 1, Some(&cdf)).unwrap();
+    let r = s.redo(1, Stage::Lens, &Params::default()).unwrap();
+    assert!(r.lens_corrected, "{r}");
+    for f in ["box1a.imc", "box1b.imc", "box1.cdf"] {
+        assert!(s.path(f).is_file(), "{f}");
+    }
+    // The console's way: run the pipeline itself, then save the outputs.
+    let imgs: Vec<GreyImage> = s
+        .load_images(1)
+        .unwrap()
+        .into_iter()
+        .map(|(_, f)| f.image)
+        .collect();
+    let out = pipeline::run(
+        &Input {
+            images: &imgs,
+            ambient: None,
+            lens: None,
+        },
+        &Params::default(),
+    )
+    .unwrap();
+    s.save_outputs(1, &out, &Params::default()).unwrap();
+    let o = s.manifest().image(1).unwrap().outputs.as_ref().unwrap();
+    assert_eq!(o.counts.lines as usize, out.lines.len());
+    assert_eq!(o.inputs.len(), 3, "two images and the cdf");
+    // Re-capturing under b makes the outputs stale again.
+    s.save_image(1, 'b', &ImgFile::new(rectangle(160.0)))
+        .unwrap();
+    assert!(matches!(
+        s.progress().images[0].outputs,
+        OutputState::Stale(_)
+    ));
+}
+
+#[test]
+fn redo_command_uses_the_profile_and_explains_missing_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Session::create(dir.path(), "box", &profile(&['a'])).unwrap();
+    let sdir = s.dir().to_path_buf();
+    s.save_image(1, 'a', &ImgFile::new(rectangle(200.0)))
+        .unwrap();
+    drop(s);
+    let vss = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_vss"))
+            .args(args)
+            .arg(&sdir)
+            .output()
+            .unwrap()
+    };
+    let o = vss(&["session", "redo", "--image", "1", "--from", "lines"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("redo from edges first"));
+    let o = vss(&["session", "redo", "--image", "1", "--from", "edges"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("image 1 redone from Edges"));
+    let o = vss(&["session", "check"]);
+    assert!(o.status.success());
+    let o = vss(&["session", "redo", "--image", "2", "--from", "edges"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no grey image captured yet"));
+}
