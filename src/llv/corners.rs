@@ -1,57 +1,438 @@
-//! Corner closing (llv.md §6). MINIMAL PLACEHOLDER written by helper `llv` so
-//! the pipeline compiles; helper `issue6` owns this file and replaces it.
+//! Corner closing (llv.md §6, "sliding-circle endpoint merge"): line endpoints
+//! stop short of the true corner where two edges come closer than the Lee
+//! kernel, because there the two edges' responses overlap and the peaks fade.
+//! Endpoints of different lines that lie within a radius of each other are
+//! moved to the point where their lines meet, when that point is near them.
 //!
-//! Here: an endpoint moves to the intersection of its line with another line
-//! when that intersection lies within `radius` of it and of one endpoint of
-//! the other line (which moves too).
+//! The rule, in order:
+//! 1. Only lines at least [`MIN_LENGTH_RADII`] × `radius` long take part.
+//!    Endpoints of different lines closer than `radius` to each other are
+//!    joined into a cluster (single linkage). A line with both endpoints in
+//!    one cluster takes no part in it (moving both of its ends to one point
+//!    would erase it).
+//! 2. For a cluster of lines that are not all parallel (some pair differs by
+//!    at least [`MIN_CORNER_ANGLE_DEG`]), the corner is the point closest, in
+//!    least squares, to all of their infinite lines — for two lines exactly
+//!    their intersection, for a cube vertex of three edges the best
+//!    compromise. It is accepted when it lies within `radius` of every
+//!    endpoint of the cluster and is a *corner move* for each: outward along
+//!    the line, or inward by at most [`MAX_INWARD_RADII`] × `radius` (a
+//!    larger inward move is a crossing or T-junction, not a corner).
+//! 3. Otherwise the cluster falls back to pairs: every pair of endpoints of
+//!    non-parallel lines within `radius`, whose intersection lies within
+//!    `radius` of both and is a corner move for both, ordered by the total
+//!    distance the two endpoints move (then by index, so the result is
+//!    deterministic); each endpoint moves at most once.
+//!
+//! Measured on twelve noisy synthetic scenes (`tests/issue6_corners.rs`):
+//! with a radius of 5 px the mean distance of endpoints near corners from
+//! the true corner falls from 2.80 px to 2.49 px, precision and recall do
+//! not drop; beyond ~6 px lines of neighbouring corners start to pair and
+//! precision falls.
+//!
+//! Nearly parallel lines are left alone: their intersection is far away or
+//! ill-defined, and joining colinear pieces is CONNECT's job (§4).
+//! Attributes (response, residual, shadow) are kept.
 
-use super::Segment;
-use super::fit::Line;
+use super::{Point, Segment};
 
-fn line_of(s: &Segment) -> Option<Line> {
-    let len = s.length();
-    (len > 0.0).then(|| {
-        let (a, b) = (-(s.b.y - s.a.y) / len, (s.b.x - s.a.x) / len);
-        Line {
-            a,
-            b,
-            c: -(a * s.a.x + b * s.a.y),
-        }
-    })
+/// Two lines whose directions differ by less than this (degrees) are treated
+/// as parallel and never form a corner. 15° keeps the intersection within
+/// about 4 × the endpoint gap of the endpoints (1/sin 15° ≈ 3.9), so the
+/// `radius` test of the intersection is what decides, not rounding.
+pub const MIN_CORNER_ANGLE_DEG: f64 = 15.0;
+
+/// Lines shorter than this many radii take no part: over a short line the
+/// direction error (noise lines, the stubs at a corner) moves the
+/// intersection by more than the gap it would close.
+pub const MIN_LENGTH_RADII: f64 = 2.0;
+
+/// Largest inward move of an endpoint, in radii (see [`keeps_direction`]).
+pub const MAX_INWARD_RADII: f64 = 0.25;
+
+/// One endpoint: line index and which end (false = `a`, true = `b`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct End {
+    line: usize,
+    b: bool,
 }
 
-/// Closes corners between lines whose endpoints lie within `radius` of the
-/// lines' intersection.
-#[allow(clippy::ptr_arg)] // the contract: issue6 may add or drop lines
+fn end_point(lines: &[Segment], e: End) -> Point {
+    let s = &lines[e.line];
+    if e.b { s.b } else { s.a }
+}
+
+/// Unit normal `(a, b)` and offset `c` of the infinite line through a
+/// segment (`a x + b y + c = 0`); `None` for a zero-length segment.
+fn normal_form(s: &Segment) -> Option<(f64, f64, f64)> {
+    let (dx, dy) = (s.b.x - s.a.x, s.b.y - s.a.y);
+    let len = dx.hypot(dy);
+    if len.is_nan() || len <= 0.0 || !len.is_finite() {
+        return None;
+    }
+    let (a, b) = (-dy / len, dx / len);
+    Some((a, b, -(a * s.a.x + b * s.a.y)))
+}
+
+/// The acute angle between two segments' directions, in degrees (0–90).
+fn angle_between_deg(s: &Segment, t: &Segment) -> f64 {
+    let (ux, uy) = (s.b.x - s.a.x, s.b.y - s.a.y);
+    let (vx, vy) = (t.b.x - t.a.x, t.b.y - t.a.y);
+    let cross = (ux * vy - uy * vx).abs();
+    let dot = (ux * vx + uy * vy).abs();
+    cross.atan2(dot).to_degrees()
+}
+
+/// The point with the least sum of squared distances to the given lines;
+/// `None` when the lines are (numerically) all parallel.
+fn least_squares_point(lines: &[Segment], idx: &[usize]) -> Option<Point> {
+    let (mut sxx, mut sxy, mut syy, mut sx, mut sy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for &i in idx {
+        let (a, b, c) = normal_form(&lines[i])?;
+        sxx += a * a;
+        sxy += a * b;
+        syy += b * b;
+        sx -= a * c;
+        sy -= b * c;
+    }
+    let det = sxx * syy - sxy * sxy;
+    if det.is_nan() || det.abs() <= 1e-12 {
+        return None;
+    }
+    let p = Point::new((syy * sx - sxy * sy) / det, (sxx * sy - sxy * sx) / det);
+    (p.x.is_finite() && p.y.is_finite()).then_some(p)
+}
+
+/// Whether moving endpoint `e` to `p` is a corner move: outward along the
+/// line (the endpoint stopped short of the corner), or inward by at most
+/// [`MAX_INWARD_RADII`] × radius (a slight overshoot). A larger inward move
+/// means the other line crosses this one well inside it: a crossing or a
+/// T-junction, not the corner this endpoint stopped short of.
+fn keeps_direction(lines: &[Segment], e: End, p: Point, radius: f64) -> bool {
+    let s = &lines[e.line];
+    let (fixed, moving) = if e.b { (s.a, s.b) } else { (s.b, s.a) };
+    let old = (moving.x - fixed.x, moving.y - fixed.y);
+    let len = old.0.hypot(old.1);
+    if len <= 0.0 {
+        return false;
+    }
+    // How far the endpoint moves outward along its line (negative: inward).
+    let along = ((p.x - moving.x) * old.0 + (p.y - moving.y) * old.1) / len;
+    along >= -MAX_INWARD_RADII * radius
+}
+
+fn find(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+/// Moves endpoints of different lines that lie within `radius` (px) of each
+/// other to their lines' intersection, when that is within `radius` of each
+/// moved endpoint (module doc for the exact rule). `radius ≤ 0` (or NaN) does
+/// nothing. Lines are neither added nor removed nor reordered (the `Vec` is
+/// the pipeline's contract, leaving room to drop lines a corner swallows).
+#[allow(clippy::ptr_arg)]
 pub fn close_corners(lines: &mut Vec<Segment>, radius: f64) {
-    if radius.is_nan() || radius <= 0.0 {
+    if radius.is_nan() || radius <= 0.0 || lines.len() < 2 {
         return;
     }
-    let n = lines.len();
-    for i in 0..n {
-        for j in i + 1..n {
-            let (Some(g1), Some(g2)) = (line_of(&lines[i]), line_of(&lines[j])) else {
-                continue;
-            };
-            let Some(x) = g1.intersect(&g2) else { continue };
-            let near = |s: &Segment| {
-                if s.a.dist(x) <= s.b.dist(x) {
-                    (0, s.a.dist(x))
-                } else {
-                    (1, s.b.dist(x))
-                }
-            };
-            let (e1, d1) = near(&lines[i]);
-            let (e2, d2) = near(&lines[j]);
-            if d1 <= radius && d2 <= radius {
-                for (k, e) in [(i, e1), (j, e2)] {
-                    if e == 0 {
-                        lines[k].a = x
-                    } else {
-                        lines[k].b = x
+    let min_len = MIN_LENGTH_RADII * radius;
+    let ends: Vec<End> = (0..lines.len())
+        .filter(|&l| lines[l].length() >= min_len)
+        .flat_map(|line| [End { line, b: false }, End { line, b: true }])
+        .filter(|&e| {
+            let p = end_point(lines, e);
+            p.x.is_finite() && p.y.is_finite()
+        })
+        .collect();
+    let pts: Vec<Point> = ends.iter().map(|&e| end_point(lines, e)).collect();
+
+    // Close pairs, found through a grid of cells one radius wide so the cost
+    // stays near-linear for the few hundred lines of a real image.
+    let cell = |p: Point| ((p.x / radius).floor() as i64, (p.y / radius).floor() as i64);
+    let mut order: Vec<usize> = (0..ends.len()).collect();
+    order.sort_by_key(|&k| cell(pts[k]));
+    let mut grid: std::collections::HashMap<(i64, i64), Vec<usize>> =
+        std::collections::HashMap::new();
+    for &k in &order {
+        grid.entry(cell(pts[k])).or_default().push(k);
+    }
+    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    for (k, &p) in pts.iter().enumerate() {
+        let (cx, cy) = cell(p);
+        for gx in cx - 1..=cx + 1 {
+            for gy in cy - 1..=cy + 1 {
+                for &m in grid.get(&(gx, gy)).map_or(&[][..], |v| v.as_slice()) {
+                    if m > k && ends[m].line != ends[k].line && p.dist(pts[m]) <= radius {
+                        pairs.push((k, m));
                     }
                 }
             }
         }
+    }
+    if pairs.is_empty() {
+        return;
+    }
+
+    let mut parent: Vec<usize> = (0..ends.len()).collect();
+    for &(k, m) in &pairs {
+        let (rk, rm) = (find(&mut parent, k), find(&mut parent, m));
+        if rk != rm {
+            parent[rk.max(rm)] = rk.min(rm);
+        }
+    }
+    let mut clusters: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+    for &(k, m) in &pairs {
+        for e in [k, m] {
+            let r = find(&mut parent, e);
+            let c = clusters.entry(r).or_default();
+            if !c.contains(&e) {
+                c.push(e);
+            }
+        }
+    }
+
+    let original = lines.clone();
+    for (_, mut members) in clusters {
+        members.sort_unstable();
+        // Drop stubs: lines with both ends in this cluster.
+        let stub = |l: usize, members: &[usize]| {
+            members.iter().filter(|&&k| ends[k].line == l).count() > 1
+        };
+        let kept: Vec<usize> = members
+            .iter()
+            .copied()
+            .filter(|&k| !stub(ends[k].line, &members))
+            .collect();
+        if kept.len() < 2 {
+            continue;
+        }
+        if let Some(p) = cluster_corner(&original, &ends, &pts, &kept, radius) {
+            for &k in &kept {
+                set_end(lines, ends[k], p);
+            }
+            continue;
+        }
+        close_pairs(lines, &original, &ends, &pts, &kept, &pairs, radius);
+    }
+}
+
+fn set_end(lines: &mut [Segment], e: End, p: Point) {
+    if let Some(s) = lines.get_mut(e.line) {
+        if e.b {
+            s.b = p;
+        } else {
+            s.a = p;
+        }
+    }
+}
+
+/// Step 2: one corner for the whole cluster, if it fits every endpoint.
+fn cluster_corner(
+    lines: &[Segment],
+    ends: &[End],
+    pts: &[Point],
+    kept: &[usize],
+    radius: f64,
+) -> Option<Point> {
+    let idx: Vec<usize> = kept.iter().map(|&k| ends[k].line).collect();
+    let spread = idx.iter().enumerate().any(|(n, &i)| {
+        idx[n + 1..]
+            .iter()
+            .any(|&j| angle_between_deg(&lines[i], &lines[j]) >= MIN_CORNER_ANGLE_DEG)
+    });
+    if !spread {
+        return None;
+    }
+    let p = least_squares_point(lines, &idx)?;
+    kept.iter()
+        .all(|&k| pts[k].dist(p) <= radius && keeps_direction(lines, ends[k], p, radius))
+        .then_some(p)
+}
+
+/// Step 3: pairwise intersections, cheapest first, each endpoint once.
+fn close_pairs(
+    lines: &mut [Segment],
+    original: &[Segment],
+    ends: &[End],
+    pts: &[Point],
+    kept: &[usize],
+    pairs: &[(usize, usize)],
+    radius: f64,
+) {
+    let mut cands: Vec<(f64, usize, usize, Point)> = Vec::new();
+    for &(k, m) in pairs {
+        if !kept.contains(&k) || !kept.contains(&m) {
+            continue;
+        }
+        let (si, sj) = (&original[ends[k].line], &original[ends[m].line]);
+        if angle_between_deg(si, sj) < MIN_CORNER_ANGLE_DEG {
+            continue;
+        }
+        let Some(p) = least_squares_point(original, &[ends[k].line, ends[m].line]) else {
+            continue;
+        };
+        let (dk, dm) = (pts[k].dist(p), pts[m].dist(p));
+        if dk <= radius
+            && dm <= radius
+            && keeps_direction(original, ends[k], p, radius)
+            && keeps_direction(original, ends[m], p, radius)
+        {
+            cands.push((dk + dm, k, m, p));
+        }
+    }
+    cands.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let mut used: Vec<usize> = Vec::new();
+    for (_, k, m, p) in cands {
+        if used.contains(&k) || used.contains(&m) {
+            continue;
+        }
+        set_end(lines, ends[k], p);
+        set_end(lines, ends[m], p);
+        used.extend([k, m]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn seg(ax: f64, ay: f64, bx: f64, by: f64) -> Segment {
+        Segment::new(Point::new(ax, ay), Point::new(bx, by))
+    }
+
+    fn close(p: Point, x: f64, y: f64) -> bool {
+        p.dist(Point::new(x, y)) < 1e-9
+    }
+
+    #[test]
+    fn l_corner_closes_at_the_intersection() {
+        // Two edges of a square meeting at (10, 10), each stopping 2 px short.
+        let mut v = vec![seg(10.0, 50.0, 10.0, 12.0), seg(12.0, 10.0, 60.0, 10.0)];
+        close_corners(&mut v, 4.0);
+        assert!(close(v[0].b, 10.0, 10.0), "{:?}", v[0]);
+        assert!(close(v[1].a, 10.0, 10.0), "{:?}", v[1]);
+        // The far ends do not move.
+        assert!(close(v[0].a, 10.0, 50.0) && close(v[1].b, 60.0, 10.0));
+    }
+
+    #[test]
+    fn attributes_survive() {
+        let mut v = vec![seg(10.0, 50.0, 10.0, 12.0), seg(12.0, 10.0, 60.0, 10.0)];
+        v[0].response = -31.5;
+        v[0].residual = 0.25;
+        v[1].shadow = true;
+        close_corners(&mut v, 4.0);
+        assert_eq!(
+            (v[0].response, v[0].residual, v[1].shadow),
+            (-31.5, 0.25, true)
+        );
+    }
+
+    #[test]
+    fn far_or_parallel_or_zero_radius_stay() {
+        let orig = vec![seg(10.0, 50.0, 10.0, 12.0), seg(12.0, 10.0, 60.0, 10.0)];
+        for r in [0.0, -1.0, f64::NAN, 2.0] {
+            let mut v = orig.clone();
+            close_corners(&mut v, r);
+            assert_eq!(v, orig, "radius {r}");
+        }
+        // Colinear pieces with a gap: CONNECT's job, not a corner.
+        let orig = vec![seg(0.0, 0.0, 20.0, 0.0), seg(22.0, 0.5, 40.0, 0.5)];
+        let mut v = orig.clone();
+        close_corners(&mut v, 5.0);
+        assert_eq!(v, orig);
+    }
+
+    #[test]
+    fn intersection_too_far_from_the_endpoints_is_refused() {
+        // Endpoints 2.2 px apart, but at 20° the lines meet 6.5 px and 5.9 px
+        // beyond them: refused with radius 3, accepted with radius 7.
+        let t = 20f64.to_radians();
+        let a = seg(0.0, 0.0, 30.0, 0.0);
+        let b = seg(31.0, 2.0, 31.0 - 40.0 * t.cos(), 2.0 + 40.0 * t.sin());
+        let orig = vec![a, b];
+        let mut v = orig.clone();
+        close_corners(&mut v, 3.0);
+        assert_eq!(v, orig);
+        close_corners(&mut v, 7.0);
+        let x = 31.0 + 2.0 / t.tan();
+        assert!(close(v[0].b, x, 0.0) && close(v[1].a, x, 0.0), "{v:?}");
+    }
+
+    #[test]
+    fn a_line_crossing_well_inside_another_is_no_corner() {
+        // b ends 2 px below a, but crosses a's line 4 px inside a's end: a
+        // T-junction, not a corner a stopped short of.
+        let orig = vec![seg(0.0, 0.0, 30.0, 0.0), seg(26.0, 2.0, 26.0, 40.0)];
+        let mut v = orig.clone();
+        close_corners(&mut v, 5.0);
+        assert_eq!(v, orig);
+        // 1 px inside (an overshoot) still closes.
+        let mut v = vec![seg(0.0, 0.0, 30.0, 0.0), seg(29.0, 2.0, 29.0, 40.0)];
+        close_corners(&mut v, 5.0);
+        assert!(
+            close(v[0].b, 29.0, 0.0) && close(v[1].a, 29.0, 0.0),
+            "{v:?}"
+        );
+    }
+
+    #[test]
+    fn three_edges_of_a_cube_vertex_meet_in_one_point() {
+        // Three edges towards (50, 50), from directions 90°, 210°, 330°, each
+        // short by ~2 px and slightly off so pairwise intersections differ.
+        let mk = |deg: f64, off: f64| {
+            let t = deg.to_radians();
+            let (c, s) = (t.cos(), -t.sin());
+            let n = (-s, c);
+            seg(
+                50.0 + 40.0 * c + off * n.0,
+                50.0 + 40.0 * s + off * n.1,
+                50.0 + 2.0 * c + off * n.0,
+                50.0 + 2.0 * s + off * n.1,
+            )
+        };
+        let mut v = vec![mk(90.0, 0.2), mk(210.0, -0.1), mk(330.0, 0.0)];
+        close_corners(&mut v, 5.0);
+        assert!(v[0].b == v[1].b && v[1].b == v[2].b, "{v:?}");
+        assert!(v[0].b.dist(Point::new(50.0, 50.0)) < 0.5, "{:?}", v[0].b);
+    }
+
+    #[test]
+    fn a_stub_inside_the_corner_is_left_alone() {
+        let stub = seg(11.0, 11.0, 12.0, 12.0);
+        let mut v = vec![
+            seg(10.0, 50.0, 10.0, 12.0),
+            seg(12.0, 10.0, 60.0, 10.0),
+            stub,
+        ];
+        close_corners(&mut v, 4.0);
+        assert_eq!(v[2], stub);
+        assert!(close(v[0].b, 10.0, 10.0) && close(v[1].a, 10.0, 10.0));
+    }
+
+    #[test]
+    fn does_not_depend_on_line_order() {
+        let v = vec![
+            seg(10.0, 50.0, 10.0, 12.0),
+            seg(12.0, 10.0, 60.0, 10.0),
+            seg(62.0, 12.0, 62.0, 50.0),
+            seg(60.0, 52.0, 12.0, 52.5),
+        ];
+        let mut fwd = v.clone();
+        close_corners(&mut fwd, 4.0);
+        let mut rev: Vec<Segment> = v.iter().rev().copied().collect();
+        close_corners(&mut rev, 4.0);
+        rev.reverse();
+        for (x, y) in fwd.iter().zip(&rev) {
+            assert!(x.a.dist(y.a) < 1e-9 && x.b.dist(y.b) < 1e-9, "{x:?} {y:?}");
+        }
+        // Every corner of the quadrilateral closed.
+        assert!(fwd[1].b.dist(fwd[2].a) < 1e-9);
+        assert!(fwd[2].b.dist(fwd[3].a) < 1e-9);
+        assert!(fwd[3].b.dist(fwd[0].a) < 1e-9);
     }
 }
