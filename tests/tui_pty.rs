@@ -186,7 +186,7 @@ fn survey(c: &mut Console, n: u32) {
         c.wait_text(&format!("Image {k}: camera"), 20);
         c.send("\r");
         c.wait(&format!("image {k} reviewed"), 60, |s| {
-            s.contains(&format!("Image {k}: ")) && s.contains("a accept")
+            s.contains(&format!("Image {k}: ")) && s.contains("before CONNECT")
         });
         c.send("a");
     }

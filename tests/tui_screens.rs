@@ -359,3 +359,37 @@ fn resuming_a_session_loads_the_partial_image() {
     let (s, _) = draw(&app, 80, 24);
     assert!(s.contains("captures lightings bc"), "{s}");
 }
+
+#[test]
+fn edits_select_delete_undo_and_go_to_the_session_log() {
+    let mut app = reviewed();
+    key(&mut app, '4');
+    let n = app
+        .current
+        .as_ref()
+        .unwrap()
+        .editor
+        .as_ref()
+        .unwrap()
+        .lines()
+        .len();
+    assert!(
+        key(&mut app, 'x').is_empty(),
+        "nothing selected: nothing deleted"
+    );
+    key(&mut app, 'n');
+    assert_eq!(app.edit.selected, vec![0]);
+    let (s, _) = draw(&app, 80, 24);
+    assert!(s.contains("#0 ("), "selected line listed:\n{s}");
+    let cmds = key(&mut app, 'x');
+    assert!(
+        cmds.iter().any(|c| matches!(c, Cmd::Store(StoreCmd::RecordEdit { k: 1, lines, .. }) if lines.len() == n - 1)),
+        "{cmds:?}"
+    );
+    let cmds = key(&mut app, 'u');
+    assert!(cmds.iter().any(|c| matches!(c, Cmd::Store(StoreCmd::RecordEdit { what, lines, .. }) if what == "undo" && lines.len() == n)));
+    // The corner key picks two different lines near the cursor.
+    key(&mut app, 'k');
+    assert_eq!(app.edit.selected.len(), 2);
+    assert_ne!(app.edit.selected[0], app.edit.selected[1]);
+}

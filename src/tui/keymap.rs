@@ -505,6 +505,26 @@ pub fn hints(scope: Scope) -> Vec<(String, &'static str)> {
         .collect()
 }
 
+/// The key table as Markdown (for the README): one line per screen.
+pub fn markdown() -> String {
+    let mut out = String::new();
+    let mut scopes: Vec<(String, Scope)> = ScreenId::ALL
+        .iter()
+        .map(|s| (s.title().to_string(), Scope::Screen(*s)))
+        .collect();
+    scopes.push(("Everywhere".into(), Scope::Global));
+    scopes.push(("Questions".into(), Scope::Confirm));
+    scopes.push(("Typing".into(), Scope::Prompt));
+    for (title, scope) in scopes {
+        let rows: Vec<String> = describe(scope)
+            .into_iter()
+            .map(|(k, d)| format!("`{k}` {d}"))
+            .collect();
+        out.push_str(&format!("- **{title}**: {}\n", rows.join("; ")));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -561,6 +581,13 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn markdown_lists_every_scope() {
+        let md = markdown();
+        assert_eq!(md.lines().count(), 8);
+        assert!(md.contains("`?` help: every key"));
     }
 
     #[test]

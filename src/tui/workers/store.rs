@@ -4,7 +4,7 @@
 //! reporting each result or error as a message. On quit the UI waits for it
 //! to finish what is queued, so nothing the operator saw saved is lost.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -93,7 +93,7 @@ impl Store {
             }
             StoreCmd::Create(name) => {
                 self.session = None;
-                let s = Session::create(&self.profile.survey.dir, &name, &self.profile)
+                let s = Session::create(&self.survey_dir(), &name, &self.profile)
                     .map_err(|e| format!("cannot create session {name}: {e}"))?;
                 self.opened(s);
             }
@@ -221,7 +221,7 @@ impl Store {
 
     /// Sessions under the survey folder: name, folder, checklist summary.
     fn list(&self) -> Vec<(String, PathBuf, String)> {
-        let Ok(rd) = std::fs::read_dir(&self.profile.survey.dir) else {
+        let Ok(rd) = std::fs::read_dir(self.survey_dir()) else {
             return Vec::new();
         };
         let mut out: Vec<_> = rd
@@ -246,13 +246,14 @@ impl Store {
         out
     }
 
+    /// Where sessions live: the profile's `survey.dir`, relative to the
+    /// profile's folder.
+    fn survey_dir(&self) -> PathBuf {
+        self.profile.resolve_path(&self.profile.survey.dir)
+    }
+
     fn cdf_path(&self, camera: u32) -> Option<PathBuf> {
-        let p = self
-            .profile
-            .survey
-            .cdf
-            .get(camera.checked_sub(1)? as usize)?;
-        resolve_cdf(p)
+        self.profile.cdf_path(camera).filter(|p| p.is_file())
     }
 
     fn camera_models(&self) -> Vec<Option<CameraModel>> {
@@ -300,17 +301,6 @@ impl Store {
         }
         Ok(paths)
     }
-}
-
-/// A `.cdf` path from the profile: as given, else beside the crate.
-fn resolve_cdf(p: &Path) -> Option<PathBuf> {
-    if p.is_file() {
-        return Some(p.to_path_buf());
-    }
-    let q = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("profiles")
-        .join(p);
-    q.is_file().then_some(q)
 }
 
 /// Everything the report shows of image `k`, read from the session's files.
