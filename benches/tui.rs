@@ -147,8 +147,9 @@ fn param_key_to_preview_512(bencher: Bencher, param: &str) {
     });
 }
 
-/// Bytes the real backend writes for one redraw after a tweak.
-fn tweak_bytes(param: &str) -> usize {
+/// Bytes the real backend writes for the redraw after each of `presses`
+/// presses of `key_char` on `param`: (bytes, lines before, lines after).
+fn tweak_bytes(param: &str, key_char: char, presses: usize) -> Vec<(usize, usize, usize)> {
     let (mut app, mut engine) = ready();
     select(&mut app, param);
     let opts = TerminalOptions {
@@ -159,11 +160,23 @@ fn tweak_bytes(param: &str) -> usize {
     let mut term = Terminal::with_options(CrosstermBackend::new(writer), opts).expect("backend");
     term.draw(|f| f.render_widget(&app, f.area()))
         .expect("draw");
-    count.store(0, Ordering::SeqCst);
-    tweak(&mut app, &mut engine, true);
-    term.draw(|f| f.render_widget(&app, f.area()))
-        .expect("draw");
-    count.load(Ordering::SeqCst)
+    let lines = |app: &App| {
+        app.current
+            .as_ref()
+            .and_then(|c| c.outputs.as_ref())
+            .map_or(0, |o| o.lines.len())
+    };
+    let mut out = Vec::new();
+    for _ in 0..presses {
+        let before = lines(&app);
+        count.store(0, Ordering::SeqCst);
+        let cmds = app.update(key(KeyCode::Char(key_char)));
+        run_pipeline(&mut app, &mut engine, cmds);
+        term.draw(|f| f.render_widget(&app, f.area()))
+            .expect("draw");
+        out.push((count.load(Ordering::SeqCst), before, lines(&app)));
+    }
+    out
 }
 
 /// A terminal that only counts the bytes written to it.
@@ -297,10 +310,18 @@ fn binary_figures() -> Option<(Duration, u64)> {
 }
 
 fn figures() {
-    for p in ["lines.min_length", "edges.per_region"] {
+    for p in ["connect.min_line_length", "edges.per_region", "edges.floor"] {
+        let runs = tweak_bytes(p, '>', 8);
+        let max = runs.iter().map(|r| r.0).max().unwrap_or(0);
+        let changed: Vec<String> = runs
+            .iter()
+            .filter(|r| r.1 != r.2)
+            .map(|r| format!("{} B for lines {} -> {}", r.0, r.1, r.2))
+            .collect();
         println!(
-            "tui: bytes written for one `{p}` tweak at 120x40: {} B (target <= 16384)",
-            tweak_bytes(p)
+            "tui: bytes written per `{p}` key press (ten steps) at 120x40: at most {max} B \
+             over 8 presses; presses that changed the lines: [{}] (target <= 16384)",
+            changed.join(", ")
         );
     }
     match binary_figures() {

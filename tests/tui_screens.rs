@@ -393,3 +393,48 @@ fn edits_select_delete_undo_and_go_to_the_session_log() {
     assert_eq!(app.edit.selected.len(), 2);
     assert_ne!(app.edit.selected[0], app.edit.selected[1]);
 }
+
+#[test]
+fn the_worker_engine_reruns_from_the_changed_stage() {
+    use vss::tui::workers::pipeline::Engine;
+    let mut app = reviewed();
+    key(&mut app, '3');
+    let i = vss::llv::params::PARAMS
+        .iter()
+        .position(|p| p.key == "connect.min_line_length")
+        .unwrap();
+    for _ in 0..i {
+        code(&mut app, KeyCode::Down);
+    }
+    let lines = |app: &App| {
+        app.current
+            .as_ref()
+            .unwrap()
+            .outputs
+            .as_ref()
+            .unwrap()
+            .lines
+            .len()
+    };
+    let before = lines(&app);
+    let mut engine = Engine::default();
+    for _ in 0..3 {
+        for c in key(&mut app, '>') {
+            if let Cmd::Pipeline(req) = c {
+                let outcome = engine.process(&req).map_err(|e| e.to_string());
+                app.update(Msg::Pipeline(PipelineResult {
+                    generation: req.generation,
+                    image_key: req.image_key,
+                    params: req.params.clone(),
+                    outcome,
+                }));
+            }
+        }
+    }
+    assert_eq!(app.params.connect.min_line_length, 42.0);
+    let after = lines(&app);
+    assert!(
+        after < before,
+        "longer minimum keeps fewer lines: {before} -> {after}"
+    );
+}

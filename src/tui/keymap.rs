@@ -586,6 +586,8 @@ mod tests {
     #[test]
     fn markdown_lists_every_scope() {
         let md = markdown();
+        // `cargo test markdown_lists -- --nocapture` prints it for the README.
+        println!("{md}");
         assert_eq!(md.lines().count(), 8);
         assert!(md.contains("`?` help: every key"));
     }
