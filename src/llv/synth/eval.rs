@@ -14,7 +14,9 @@ use super::straight::Straightness;
 use super::{Camera, PointLight, RenderOptions, Scene};
 use crate::llv::lens::LensMap;
 use crate::llv::pipeline::{self, Input};
-use crate::llv::{EdgePoints, GreyImage, LlvError, Params, Point, Segment, connect, lines};
+use crate::llv::{
+    EdgePoints, GreyImage, LlvError, Params, Point, Segment, connect, corners, lines,
+};
 
 /// What to evaluate.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -60,6 +62,10 @@ pub struct NoiseResult {
     pub subpixel: Metrics,
     /// The same edges rounded to whole pixels, then lines and CONNECT.
     pub whole_pixel: Metrics,
+    /// RMS distance (px) of edge points from their true edges (away from
+    /// the ends), with subpixel and with whole-pixel positions.
+    pub point_rms_subpixel: f64,
+    pub point_rms_whole_pixel: f64,
     /// Edge points per image, both directions (mean).
     pub edge_points: f64,
     /// Lines per image after CONNECT (mean).
@@ -134,6 +140,7 @@ pub fn evaluate(cfg: &EvalConfig, params: &Params) -> Result<EvalReport, LlvErro
     for (j, &noise) in cfg.noise.iter().enumerate() {
         let (mut sub, mut whole) = (Tally::default(), Tally::default());
         let (mut points, mut nlines) = (0usize, 0usize);
+        let (mut st_sub, mut st_whole) = (Straightness::default(), Straightness::default());
         for (i, c) in cases.iter().enumerate() {
             let seed = mix(cfg.seed, 1000 + 64 * i as u64 + j as u64);
             let img = super::finish(
@@ -148,12 +155,18 @@ pub fn evaluate(cfg: &EvalConfig, params: &Params) -> Result<EvalReport, LlvErro
             nlines += out.lines.len();
             let wp = whole_pixel_lines(&out.edges_h, &out.edges_v, params);
             whole.add(&wp, &c.truth);
+            let ident = |p: Point| p;
+            st_sub.add(&c.truth, &out.edges_h, &out.edges_v, &ident);
+            let (rh, rv) = (round_points(&out.edges_h), round_points(&out.edges_v));
+            st_whole.add(&c.truth, &rh, &rv, &ident);
         }
         let n = cases.len().max(1) as f64;
         levels.push(NoiseResult {
             noise,
             subpixel: sub.metrics(),
             whole_pixel: whole.metrics(),
+            point_rms_subpixel: st_sub.rms_to_truth(),
+            point_rms_whole_pixel: st_whole.rms_to_truth(),
             edge_points: points as f64 / n,
             lines: nlines as f64 / n,
         });
@@ -183,23 +196,31 @@ fn run_one(
 }
 
 /// Lines from edge points rounded to whole pixels: what the pipeline would
-/// give without the subpixel step (llv.md §2.4).
+/// give without the subpixel step (llv.md §2.4): extraction, CONNECT and
+/// corner closing as in `pipeline::run`.
 pub fn whole_pixel_lines(h: &EdgePoints, v: &EdgePoints, params: &Params) -> Vec<Segment> {
-    let round = |e: &EdgePoints| {
-        let mut r = e.clone();
-        for p in &mut r.points {
-            p.x = p.x.round();
-            p.y = p.y.round();
-        }
-        r
-    };
-    let mut raw = lines::extract(&round(h), &params.lines);
-    raw.extend(lines::extract(&round(v), &params.lines));
-    if params.connect.enabled {
+    let mut raw = lines::extract(&round_points(h), &params.lines);
+    raw.extend(lines::extract(&round_points(v), &params.lines));
+    // The same stages after the edges as `pipeline::run`.
+    let mut out = if params.connect.enabled {
         connect::connect(&raw, &params.connect)
     } else {
         raw
+    };
+    if params.connect.corner_radius > 0.0 {
+        corners::close_corners(&mut out, params.connect.corner_radius);
     }
+    out
+}
+
+/// The edge points with their positions rounded to whole pixels.
+pub fn round_points(e: &EdgePoints) -> EdgePoints {
+    let mut r = e.clone();
+    for p in &mut r.points {
+        p.x = p.x.round();
+        p.y = p.y.round();
+    }
+    r
 }
 
 /// Length-weighted mean residual of the lines.

@@ -24,6 +24,8 @@ pub const END: f64 = 8.0;
 #[derive(Clone, Debug, Default)]
 pub struct Straightness {
     sum_sq: f64,
+    /// Σ squared distance of the points from the true edge itself.
+    sum_sq_true: f64,
     points: usize,
     edges: usize,
 }
@@ -60,20 +62,23 @@ impl Straightness {
             let (lo, hi) = bbox(&curve, NEAR);
             let inner = END / len;
             let mut own: Vec<Point> = Vec::new();
+            let mut true_sq = 0.0;
             for p in pts {
                 let p = Point::new(p.x as f64, p.y as f64);
                 if p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y {
                     continue;
                 }
-                if let Some(u) = near_curve(&curve, p)
+                if let Some((d, u)) = near_curve(&curve, p)
                     && u > inner
                     && u < 1.0 - inner
                 {
                     own.push(p);
+                    true_sq += d * d;
                 }
             }
             if own.len() >= 10 {
                 self.sum_sq += tls_sum_sq(&own);
+                self.sum_sq_true += true_sq;
                 self.points += own.len();
                 self.edges += 1;
             }
@@ -84,6 +89,16 @@ impl Straightness {
     pub fn rms(&self) -> f64 {
         if self.points > 0 {
             (self.sum_sq / self.points as f64).sqrt()
+        } else {
+            0.0
+        }
+    }
+
+    /// RMS distance (px) of the measured points from their true edges (as
+    /// seen in the image): the accuracy of single edge points.
+    pub fn rms_to_truth(&self) -> f64 {
+        if self.points > 0 {
+            (self.sum_sq_true / self.points as f64).sqrt()
         } else {
             0.0
         }
@@ -107,9 +122,9 @@ fn bbox(c: &[Point], pad: f64) -> (Point, Point) {
     )
 }
 
-/// The curve parameter (0–1) of `p` when it lies within [`NEAR`] of the
-/// polyline.
-fn near_curve(c: &[Point], p: Point) -> Option<f64> {
+/// The distance of `p` from the polyline and its curve parameter (0–1),
+/// when it lies within [`NEAR`] of it.
+fn near_curve(c: &[Point], p: Point) -> Option<(f64, f64)> {
     let mut best: Option<(f64, f64)> = None;
     let n = c.len().saturating_sub(1).max(1) as f64;
     for (k, w) in c.windows(2).enumerate() {
@@ -126,7 +141,7 @@ fn near_curve(c: &[Point], p: Point) -> Option<f64> {
             best = Some((d, (k as f64 + t) / n));
         }
     }
-    best.map(|(_, u)| u)
+    best
 }
 
 /// Sum of squared perpendicular distances from the TLS line of the points:
@@ -184,6 +199,11 @@ mod tests {
         let mut a = Straightness::default();
         a.add(&t, &pts(ScanDir::Horizontal, &s), &v, &|p| p);
         assert!((a.rms() - 0.1).abs() < 0.01, "{}", a.rms());
+        assert!(
+            (a.rms_to_truth() - 0.1).abs() < 1e-4,
+            "{}",
+            a.rms_to_truth()
+        );
         // Bent by a parabola of 1 px sagitta.
         let bend = |p: Point| {
             let u = (p.y - 80.0) / 70.0;

@@ -185,3 +185,70 @@ fn every_cell_light_brightens_every_camera() {
         }
     }
 }
+
+#[test]
+fn odd_cameras_give_images_not_panics() {
+    let (s, c, l) = one_cube();
+    let o = RenderOptions {
+        noise_sigma: 3.0,
+        distort: true,
+        ..Default::default()
+    };
+    // Zero size: a 1 × 1 image.
+    let zero = Camera {
+        width: 0,
+        height: 0,
+        ..c.clone()
+    };
+    assert_eq!(render(&s, &zero, &l, &o).size(), (1, 1));
+    assert!(true_edges(&s, &zero, &l, &o, 10.0).is_empty());
+    // Degenerate intrinsics (f = 0, sx = 0) and a camera inside the cube.
+    let mut flat = c.clone();
+    flat.model.f = 0.0;
+    flat.model.sx = 0.0;
+    let inside = Camera {
+        pose: look_at([0.0, 0.0, 40.0], [100.0, 0.0, 40.0]),
+        ..c.clone()
+    };
+    for cam in [flat, inside] {
+        let img = render(&s, &cam, &l, &o);
+        assert_eq!(img.size(), (cam.width, cam.height));
+        let _ = true_edges(&s, &cam, &l, &o, 10.0);
+        let _ = visible_corners(&s, &cam, &l, &o, 10.0);
+    }
+    // An empty scene is the background, plus noise.
+    let empty = Scene {
+        objects: vec![],
+        plate: None,
+        background: 50.0,
+    };
+    let img = render(&empty, &c, &[], &RenderOptions::default());
+    assert!(img.data().iter().all(|&v| v == 50));
+}
+
+#[test]
+fn test_scenes_repeat_and_keep_their_promises() {
+    let a = test_scenes(6, 384, 384, 3);
+    assert_eq!(a, test_scenes(6, 384, 384, 3));
+    assert_ne!(a, test_scenes(6, 384, 384, 4));
+    let o = RenderOptions::default();
+    for (scene, cam, lights) in &a {
+        assert!(!scene.objects.is_empty() && scene.objects.len() <= 6);
+        let edges = true_edges(scene, cam, lights, &o, 4.0);
+        let long: Vec<&Segment> = edges.iter().filter(|e| e.length() >= 10.0).collect();
+        assert!(long.len() >= 5, "{} edges", long.len());
+        for e in &long {
+            assert!(e.response >= 30.0, "weak edge {e:?}");
+        }
+        // The objects fill a good part of the frame: their edges span at
+        // least half of it one way or the other.
+        let (mut lo, mut hi) = (Point::new(1e9, 1e9), Point::new(-1e9, -1e9));
+        for e in &long {
+            for p in [e.a, e.b] {
+                lo = Point::new(lo.x.min(p.x), lo.y.min(p.y));
+                hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
+            }
+        }
+        assert!((hi.x - lo.x).max(hi.y - lo.y) > 0.5 * 384.0);
+    }
+}
