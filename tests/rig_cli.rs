@@ -206,6 +206,7 @@ fn faults_never_leave_a_corrupt_image_on_disk() {
     let tmp = tempfile::tempdir().expect("tmp");
     let mut p = base();
     p.grabber.block = 4096;
+    p.grabber.timeout_ms = 400;
     let prof = write_profile(tmp.path(), "p.toml", &p);
     let clean = tmp.path().join("clean/ref");
     let out = grab_embedded(&prof, &clean, None);

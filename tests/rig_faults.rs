@@ -17,7 +17,9 @@ fn profile() -> Profile {
     let mut p = cell_profile(128, 128);
     p.sim.noise = 0.0;
     p.relay.settle_ms = 0;
-    p.grabber.timeout_ms = 1000;
+    // Short enough that recovering from a dropped byte is quick, long
+    // enough for a loaded machine.
+    p.grabber.timeout_ms = 400;
     p.grabber.retries = 3;
     // Four blocks per frame, so faults can strike mid-frame.
     p.grabber.block = 4096;
@@ -60,12 +62,16 @@ fn try_faulty(spec: &str) -> (Result<(Capture, Cell), RigError>, Duration) {
 
 /// Like [`try_faulty`] for faults the cell must get through to a capture.
 fn faulty(spec: &str) -> (Result<Capture, RigError>, Duration, Cell) {
+    faulty_with(spec, profile())
+}
+
+fn faulty_with(spec: &str, p: Profile) -> (Result<Capture, RigError>, Duration, Cell) {
     let faults = Faults::parse(spec).expect("fault spec");
     let spec = spec.to_string();
     within(Duration::from_secs(60), move || {
         let t = Instant::now();
-        let mut cell = Cell::open_with_faults(&profile(), faults)
-            .unwrap_or_else(|e| panic!("{spec}: open: {e}"));
+        let mut cell =
+            Cell::open_with_faults(&p, faults).unwrap_or_else(|e| panic!("{spec}: open: {e}"));
         let r = capture(&mut cell);
         (r, t.elapsed(), cell)
     })
@@ -115,7 +121,11 @@ fn drops_and_corruption_together() {
 #[test]
 fn a_two_second_stall_is_ridden_out() {
     let want = reference();
-    let (r, took, cell) = faulty("stall=2s");
+    // The profile's default reply timeout: a 2 s stall outlasts one wait
+    // but not the retries.
+    let mut p = profile();
+    p.grabber.timeout_ms = 1000;
+    let (r, took, cell) = faulty_with("stall=2s", p);
     assert_good("stall", &r, &want);
     assert!(
         took >= Duration::from_secs(1),
@@ -175,4 +185,48 @@ fn a_hopeless_line_ends_in_a_clear_error_not_a_hang() {
         }
     }
     assert!(took < Duration::from_secs(45), "{took:?}");
+}
+
+#[test]
+fn reconnect_reopens_the_same_port_name_when_the_device_is_back() {
+    use vss::rig::grabber::{ClientConfig, FrameGrabber, VsgClient};
+    use vss::rig::sim::{SimCell, SimOptions};
+    let tmp = tempfile::tempdir().expect("tmp");
+    let link = tmp.path().join("ttyVSG0");
+    let mut o = SimOptions::new(64, 64);
+    o.faults = Faults::parse("unplug-after=3000").expect("spec");
+    let mut sim = SimCell::start(o).expect("sim");
+    sim.link_grabber(&link).expect("link");
+    let name = link.to_string_lossy().into_owned();
+    let cfg = ClientConfig {
+        timeout: std::time::Duration::from_millis(500),
+        retries: 2,
+        block: 1024,
+    };
+    let r = within(Duration::from_secs(30), move || {
+        let mut g = VsgClient::open(&name, 921_600, cfg).expect("open by link");
+        let f = g.freeze().expect("freeze");
+        let e = g
+            .transfer(&mut |_, _| true)
+            .expect_err("unplugged mid-frame");
+        assert!(e.is_vanished() && e.to_string().contains(&name), "{e}");
+        // Still gone (the name went with it): reconnect says so, naming it.
+        while sim.grabber_plugged() {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        assert!(
+            !std::path::Path::new(&name).exists(),
+            "the device name is gone"
+        );
+        let gone = g.reconnect().expect_err("device is away");
+        assert!(gone.to_string().contains(&name), "{gone}");
+        // Back (power-cycled) under the same name: reopen, freeze again.
+        sim.replug_grabber().expect("replug");
+        g.reconnect().expect("reconnect");
+        let f2 = g.freeze().expect("freeze");
+        let img = g.transfer(&mut |_, _| true).expect("transfer");
+        (f, f2, crc32(img.data()))
+    });
+    let (_, f2, crc) = r;
+    assert_eq!(crc, f2.crc);
 }

@@ -196,3 +196,22 @@ fn the_driver_loads_and_transfers_over_a_pty() {
     assert!(e.to_string().contains("ERR RANGE"), "{e}");
     assert!(e.to_string().contains(sim.grabber_path()), "{e}");
 }
+
+#[test]
+fn wire_bytes_per_payload_byte_stay_below_1_01_with_the_default_block() {
+    let sim = SimCell::start(SimOptions::new(256, 256)).expect("sim");
+    let cfg = ClientConfig::from_profile(&vss::profile::GrabberConfig::default());
+    assert_eq!(cfg.block, 16384, "the default block");
+    let mut g = VsgClient::open(sim.grabber_path(), 921_600, cfg).expect("connect");
+    let f = g.freeze().expect("freeze");
+    let before = g.wire_stats();
+    let img = g.transfer(&mut |_, _| true).expect("transfer");
+    let after = g.wire_stats();
+    assert_eq!(crc32(img.data()), f.crc);
+    let wire = (after.tx + after.rx) - (before.tx + before.rx);
+    let payload = after.payload - before.payload;
+    assert_eq!(payload, 256 * 256);
+    let ratio = wire as f64 / payload as f64;
+    assert!(ratio <= 1.01, "{wire} wire bytes for {payload}: {ratio:.4}");
+    assert!(ratio > 1.0, "headers and commands count too");
+}

@@ -83,6 +83,9 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     };
     let cancel = Arc::new(AtomicBool::new(false));
     for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        // A second Ctrl-C ends at once; the first cancels the transfer.
+        signal_hook::flag::register_conditional_shutdown(sig, 1, Arc::clone(&cancel))
+            .context("cannot install the Ctrl-C handler")?;
         signal_hook::flag::register(sig, Arc::clone(&cancel))
             .context("cannot install the Ctrl-C handler")?;
     }

@@ -7,7 +7,7 @@ use std::io::Write;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 
@@ -20,6 +20,14 @@ pub struct Args {
     /// `drop=1e-4,corrupt=1e-4,stall=2s,unplug-after=100000,reset,garbage=64`.
     #[arg(long, value_name = "SPEC")]
     pub faults: Option<String>,
+    /// Keep a symlink here pointing at the grabber's pseudo-terminal (a
+    /// stable port name for profiles, kept across replugs).
+    #[arg(long, value_name = "PATH")]
+    pub link: Option<std::path::PathBuf>,
+    /// After an unplug fault, plug the grabber back in after this many
+    /// seconds (on a new pseudo-terminal; `--link` follows it).
+    #[arg(long, value_name = "SECONDS")]
+    pub replug_after: Option<f64>,
 }
 
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
@@ -33,19 +41,39 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         signal_hook::flag::register(sig, Arc::clone(&stop))
             .context("cannot install the Ctrl-C handler")?;
     }
-    let sim = SimCell::from_profile(&profile, faults)?;
+    let mut sim = SimCell::from_profile(&profile, faults)?;
+    if let Some(link) = &a.link {
+        sim.link_grabber(link)?;
+    }
+    let replug = match a.replug_after {
+        Some(s) => Some(
+            Duration::try_from_secs_f64(s)
+                .map_err(|_| anyhow::anyhow!("--replug-after {s}: not a number of seconds"))?,
+        ),
+        None => None,
+    };
     let mut out = std::io::stdout().lock();
     writeln!(out, "grabber: {}", sim.grabber_path())?;
     writeln!(out, "relay: {}", sim.relay_path())?;
     writeln!(out, "{}", sim.summary())?;
     out.flush()?;
     drop(out);
-    let mut told = false;
+    let mut unplugged: Option<Instant> = None;
     while !stop.load(Ordering::SeqCst) {
         std::thread::sleep(Duration::from_millis(50));
-        if !told && !sim.grabber_plugged() {
-            eprintln!("vss sim: the grabber was unplugged (fault injection); Ctrl-C to end");
-            told = true;
+        match unplugged {
+            None if !sim.grabber_plugged() => {
+                eprintln!("vss sim: the grabber was unplugged (fault injection)");
+                unplugged = Some(Instant::now());
+            }
+            Some(t) if replug.is_some_and(|d| t.elapsed() >= d) => {
+                let path = sim.replug_grabber()?.to_string();
+                println!("grabber: {path}");
+                std::io::stdout().flush()?;
+                eprintln!("vss sim: the grabber is back on {path}");
+                unplugged = None;
+            }
+            _ => {}
         }
     }
     sim.stop();

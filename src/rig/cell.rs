@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use super::RigError;
 use super::grabber::{ClientConfig, FrameGrabber, VsgClient};
 use super::lights::{LcusBoard, LightSwitch, NumatoBoard};
-use super::protocol::FrameInfo;
+use super::protocol::{FrameInfo, GrabberInfo};
 use super::sim::{Faults, SimCell};
 use crate::llv::GreyImage;
 use crate::profile::{GrabberKind, Profile, RelayKind};
@@ -20,6 +20,7 @@ pub struct Cell {
     pub lights: Box<dyn LightSwitch>,
     sim: Option<SimCell>,
     profile: Profile,
+    info: GrabberInfo,
     /// The relays known to be on (read back from the board).
     mask: u32,
     lighting: Option<char>,
@@ -93,13 +94,18 @@ impl Cell {
             (GrabberKind::Simulated, Some(s)) => s.grabber_path().to_string(),
             _ => g.port.clone(),
         };
-        let grabber = VsgClient::open(&grabber_path, g.baud, ClientConfig::from_profile(g))?;
+        let mut grabber = VsgClient::open(&grabber_path, g.baud, ClientConfig::from_profile(g))?;
+        let info = match grabber.info() {
+            Some(i) => i.clone(),
+            None => grabber.hello()?,
+        };
         let lights = open_lights(profile, sim.as_ref())?;
         let mut cell = Cell {
             grabber: Box::new(grabber),
             lights,
             sim,
             profile: profile.clone(),
+            info,
             mask: 0,
             lighting: None,
         };
@@ -118,6 +124,11 @@ impl Cell {
 
     pub fn profile(&self) -> &Profile {
         &self.profile
+    }
+
+    /// The grabber as it introduced itself (model, frame size, cameras).
+    pub fn info(&self) -> &GrabberInfo {
+        &self.info
     }
 
     /// The relay mask lighting configuration `letter` asks for.
@@ -262,5 +273,38 @@ impl Cell {
             return Ok(());
         }
         self.grabber.reconnect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The console runs the cell on a device worker thread.
+    #[test]
+    fn cell_can_move_to_a_worker_thread() {
+        fn assert_send<T: Send>() {}
+        assert_send::<Cell>();
+    }
+
+    #[test]
+    fn lighting_masks_come_from_the_profile() {
+        let mut p = crate::rig::sim::cell_profile(32, 32);
+        p.relay.settle_ms = 0;
+        let Ok(cell) = Cell::open(&p) else {
+            panic!("the simulated cell opens")
+        };
+        assert_eq!(cell.info().cameras, 4);
+        assert_eq!((cell.info().width, cell.info().height), (32, 32));
+        assert_eq!(cell.mask_for('c').ok(), Some(0b100));
+        assert_eq!(cell.mask_for('e').ok(), Some(0));
+        p.lighting[0].on.push("nowhere".into());
+        let cell = Cell { profile: p, ..cell };
+        let e = cell
+            .mask_for('a')
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("nowhere"), "{e}");
     }
 }

@@ -101,6 +101,8 @@ const GROW_AFTER: u32 = 4;
 const MAX_LINE: usize = 256;
 /// Quiet time that ends a re-sync.
 const QUIET: Duration = Duration::from_millis(40);
+/// Late replies tolerated while waiting for the one to a command.
+const MAX_STALE: u32 = 8;
 /// The largest frame a reply may announce (guards allocations).
 const MAX_FRAME: usize = 1 << 28;
 
@@ -345,9 +347,20 @@ impl<P: Link> VsgClient<P> {
                 self.stats.retries += 1;
             }
             self.send(&cmd)?;
+            let mut stale = 0;
             let fail = loop {
                 match self.read_reply() {
+                    // Late replies are few (one per earlier timeout); a flood
+                    // of them is a confused device.
+                    Ok(r)
+                        if stale > MAX_STALE && !matches!(r, Reply::Err { .. }) && !accept(&r) =>
+                    {
+                        break ReadFail::Garbage(format!(
+                            "{stale} replies that do not fit `{cmd}`"
+                        ));
+                    }
                     Ok(Reply::Data { len, .. }) => {
+                        stale += 1;
                         if let Err(f) = self.skip_stale(len) {
                             break f;
                         }
@@ -359,7 +372,7 @@ impl<P: Link> VsgClient<P> {
                     Ok(r @ Reply::Err { .. }) => return self.device_err(&cmd, r),
                     Ok(r) if accept(&r) => return Ok(r),
                     // A late OK to an earlier command: keep listening.
-                    Ok(_) => {}
+                    Ok(_) => stale += 1,
                     Err(f) => break f,
                 }
             };
@@ -419,7 +432,14 @@ impl<P: Link> VsgClient<P> {
     fn read_block(&mut self, off: u32, len: u32) -> Result<Option<Vec<u8>>, RigError> {
         let cmd = Command::Read { off, len };
         self.send(&cmd)?;
+        let mut stale = 0;
         let fail = loop {
+            if stale > MAX_STALE {
+                break Some(ReadFail::Garbage(format!(
+                    "{stale} replies that do not fit `{cmd}`"
+                )));
+            }
+            stale += 1;
             match self.read_reply() {
                 Ok(Reply::Data {
                     off: o,

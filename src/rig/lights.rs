@@ -22,6 +22,8 @@ pub trait LightSwitch: Send {
     fn port_name(&self) -> &str;
 }
 
+/// Repeats of a Numato command whose answer was garbled or missing.
+const RETRIES: u32 = 2;
 /// Longest reply before the prompt; anything longer is garbage.
 const MAX_REPLY: usize = 256;
 
@@ -116,11 +118,29 @@ impl<P: Link> NumatoBoard<P> {
     }
 
     /// Sends a command and returns the reply lines between the echo and the
-    /// `>` prompt.
+    /// `>` prompt. Every Numato command is safe to repeat (switching a relay
+    /// to a state twice leaves it there), so a garbled or missing answer is
+    /// retried after clearing the line.
     fn command(&mut self, cmd: &NumatoCommand) -> Result<Vec<String>, RigError> {
         let text = cmd
             .text()
             .ok_or_else(|| self.board_err(format!("{cmd:?}: no such relay on a Numato board")))?;
+        let mut attempt = 0;
+        loop {
+            attempt += 1;
+            match self.command_once(&text) {
+                Err(RigError::Timeout { .. } | RigError::Board { .. }) if attempt <= RETRIES => {
+                    // A bare CR ends any half-typed line; then drop the noise.
+                    self.write(b"\r")?;
+                    self.drain()?;
+                }
+                r => return r,
+            }
+        }
+    }
+
+    fn command_once(&mut self, text: &str) -> Result<Vec<String>, RigError> {
+        let text = text.to_string();
         self.rx.clear();
         self.write(format!("{text}\r").as_bytes())?;
         let deadline = Instant::now() + self.timeout;
@@ -346,13 +366,20 @@ mod tests {
     }
 
     #[test]
-    fn a_wrong_echo_is_an_error() {
-        let mut b = board(&["relay on 3\n\r>"]);
+    fn a_garbled_answer_is_retried_and_a_wrong_echo_is_an_error() {
+        let mut b = board(&[
+            "\x13\x00relay on 2\n\r>",
+            "relay on 2\r\n\r>",
+            "relay read 2\r\n\ron\n\r>",
+        ]);
+        assert!(b.set(2, true).is_ok());
+        let mut b = board(&["relay on 3\n\r>", "relay on 3\n\r>", "relay on 3\n\r>"]);
         let e = b.set(2, true);
         assert!(
             matches!(&e, Err(RigError::Board { detail, .. }) if detail.contains("echoed")),
             "{e:?}"
         );
+        assert_eq!(b.port.sent_text().matches("relay on 2\r").count(), 3);
     }
 
     #[test]

@@ -9,6 +9,7 @@
 //! device seeing a hang-up.
 
 use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
@@ -205,7 +206,7 @@ struct Device {
 impl Device {
     fn start(
         name: &str,
-        serve: impl FnOnce(TTYPort, Arc<AtomicBool>) + Send + 'static,
+        serve: impl FnOnce(TTYPort, Arc<AtomicBool>, String) + Send + 'static,
     ) -> Result<Device, RigError> {
         let (master, slave) = TTYPort::pair().map_err(|e| {
             RigError::Sim(format!("cannot make a pseudo-terminal for the {name}: {e}"))
@@ -214,14 +215,14 @@ impl Device {
             .ok_or_else(|| RigError::Sim(format!("the {name}'s pseudo-terminal has no name")))?;
         let stop = Arc::new(AtomicBool::new(false));
         let alive = Arc::new(AtomicBool::new(true));
-        let (s, a) = (Arc::clone(&stop), Arc::clone(&alive));
+        let (s, a, p) = (Arc::clone(&stop), Arc::clone(&alive), path.clone());
         let thread = std::thread::Builder::new()
             .name(format!("sim-{name}"))
             .spawn(move || {
                 // The slave side lives as long as the device: a client that
                 // closes its end must not hang the line up.
                 let _keep = slave;
-                serve(master, s);
+                serve(master, s, p);
                 a.store(false, Ordering::SeqCst);
             })
             .map_err(|e| RigError::Sim(format!("cannot start the {name} thread: {e}")))?;
@@ -252,21 +253,26 @@ pub struct SimCell {
     scene: Arc<Scene>,
     grabber: Device,
     board: Device,
+    /// A symlink kept pointing at the grabber's pty, so a client can reopen
+    /// "the same port" after a replug, as with a real `/dev/ttyUSB0`.
+    grabber_link: Arc<Mutex<Option<PathBuf>>>,
 }
 
 impl SimCell {
     /// Starts the simulated grabber and relay board on fresh ptys.
     pub fn start(opts: SimOptions) -> Result<SimCell, RigError> {
         let scene = Arc::new(Scene::new(opts));
-        let grabber = Self::start_grabber(&scene, scene.opts.faults.clone())?;
+        let grabber_link = Arc::new(Mutex::new(None));
+        let grabber = Self::start_grabber(&scene, scene.opts.faults.clone(), &grabber_link)?;
         let sc = Arc::clone(&scene);
-        let board = Device::start("relay board", move |port, stop| {
+        let board = Device::start("relay board", move |port, stop, _path| {
             board::serve(port, &sc, &stop)
         })?;
         Ok(SimCell {
             scene,
             grabber,
             board,
+            grabber_link,
         })
     }
 
@@ -277,10 +283,24 @@ impl SimCell {
         SimCell::start(o)
     }
 
-    fn start_grabber(scene: &Arc<Scene>, faults: Faults) -> Result<Device, RigError> {
+    fn start_grabber(
+        scene: &Arc<Scene>,
+        faults: Faults,
+        link: &Arc<Mutex<Option<PathBuf>>>,
+    ) -> Result<Device, RigError> {
         let sc = Arc::clone(scene);
-        Device::start("grabber", move |port, stop| {
-            vsg::serve(port, &sc, faults, &stop)
+        let link = Arc::clone(link);
+        Device::start("grabber", move |port, stop, path| {
+            vsg::serve(port, &sc, faults, &stop);
+            // Unplugged: the device name goes away, as /dev/ttyUSB0 does.
+            if !stop.load(Ordering::SeqCst) {
+                let l = link.lock().unwrap_or_else(PoisonError::into_inner).clone();
+                if let Some(l) = l {
+                    if std::fs::read_link(&l).is_ok_and(|t| t == Path::new(&path)) {
+                        let _ = std::fs::remove_file(&l);
+                    }
+                }
+            }
         })
     }
 
@@ -306,8 +326,46 @@ impl SimCell {
     /// without faults, on a new pseudo-terminal; returns its path.
     pub fn replug_grabber(&mut self) -> Result<&str, RigError> {
         self.grabber.shutdown();
-        self.grabber = Self::start_grabber(&self.scene, Faults::default())?;
+        self.grabber = Self::start_grabber(&self.scene, Faults::default(), &self.grabber_link)?;
+        let link = self
+            .grabber_link
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone();
+        if let Some(link) = link {
+            self.link_grabber(&link)?;
+        }
         Ok(&self.grabber.path)
+    }
+
+    /// Keeps a symlink at `link` pointing at the grabber's pseudo-terminal,
+    /// also across [`SimCell::replug_grabber`]: a stable device name.
+    #[cfg(unix)]
+    pub fn link_grabber(&mut self, link: &Path) -> Result<(), RigError> {
+        let name = link.file_name().map(|n| n.to_string_lossy().into_owned());
+        let tmp = link.with_file_name(format!(".{}.new", name.unwrap_or_default()));
+        let _ = std::fs::remove_file(&tmp);
+        std::os::unix::fs::symlink(&self.grabber.path, &tmp)
+            .and_then(|()| std::fs::rename(&tmp, link))
+            .map_err(|e| {
+                RigError::Sim(format!(
+                    "cannot link {} to the grabber: {e}",
+                    link.display()
+                ))
+            })?;
+        *self
+            .grabber_link
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner) = Some(link.to_path_buf());
+        Ok(())
+    }
+
+    /// The stable name of the grabber, if one was made.
+    pub fn grabber_link(&self) -> Option<PathBuf> {
+        self.grabber_link
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
     }
 
     /// One line for people.
@@ -331,6 +389,14 @@ impl SimCell {
     pub fn stop(mut self) {
         self.grabber.shutdown();
         self.board.shutdown();
+        let link = self
+            .grabber_link
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .take();
+        if let Some(link) = link {
+            let _ = std::fs::remove_file(link);
+        }
     }
 }
 

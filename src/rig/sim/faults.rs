@@ -58,12 +58,12 @@ fn parse_duration(s: &str) -> Option<Duration> {
 }
 
 impl Faults {
+    /// Whether no fault is asked for (the seed alone is no fault).
     pub fn is_clean(&self) -> bool {
-        *self == Faults::default() || {
-            let mut f = self.clone();
-            f.seed = None;
-            f == Faults::default()
-        }
+        Faults {
+            seed: None,
+            ..self.clone()
+        } == Faults::default()
     }
 
     pub fn parse(spec: &str) -> Result<Faults, FaultsError> {
