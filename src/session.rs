@@ -75,7 +75,11 @@ pub enum SessionError {
         /// The holder is on another host: can be taken over, with care.
         foreign: bool,
     },
-    #[error("{}:{line}: {message}; the manifest was left as it is: fix it by hand or restore it", path.display())]
+    #[error(
+        "{}{}: {message}; the manifest was left as it is: fix it by hand or restore it",
+        path.display(),
+        if *line > 0 { format!(":{line}") } else { String::new() }
+    )]
     Manifest {
         path: PathBuf,
         line: usize,
@@ -133,7 +137,12 @@ impl Session {
             path: dir.clone(),
             source,
         })?;
-        let lock = Lock::acquire(&dir.join(format!("{name}.lock")), false)?;
+        // No manifest yet: a lock left by a creator that died can go.
+        let lock_path = dir.join(format!("{name}.lock"));
+        let lock = match Lock::acquire(&lock_path, false) {
+            Err(SessionError::Locked { stale: true, .. }) => Lock::acquire(&lock_path, true)?,
+            other => other?,
+        };
         let now = stamp::now_rfc3339();
         let mut lighting: Vec<LightingInfo> = profile
             .lighting
@@ -215,7 +224,19 @@ impl Session {
     }
 
     fn open_with(dir: &Path, lock: Option<bool>) -> Result<Session, SessionError> {
-        let dir = dir.to_path_buf();
+        // Naming the manifest (or the .ses) means its folder.
+        let is_session_file =
+            dir.is_file() && dir.extension().is_some_and(|e| e == "toml" || e == "ses");
+        let dir = match dir.parent() {
+            Some(p) if is_session_file => {
+                if p.as_os_str().is_empty() {
+                    PathBuf::from(".")
+                } else {
+                    p.to_path_buf()
+                }
+            }
+            _ => dir.to_path_buf(),
+        };
         let dir_name = dir
             .canonicalize()
             .ok()

@@ -155,6 +155,15 @@ fn session_report_has_every_image() {
         &["report", d, "--image", "2", "--svg", "two.svg"],
         dir.path(),
     );
+    vss(&["report", d], dir.path());
+    assert!(
+        dir.path().join("cube.ps").is_file(),
+        "default NAME.ps in the current folder"
+    );
+    assert!(
+        !sdir.join("cube.ps").exists(),
+        "nothing written into the session"
+    );
     for f in ["all1.svg", "all2.svg", "two.svg"] {
         let t = svg_parses(&dir.path().join(f));
         for id in ["grey", "edges-h", "edges-v", "lines-raw", "lines"] {
@@ -168,4 +177,8 @@ fn session_report_has_every_image() {
         return;
     }
     assert_eq!(gs::render(&dir.path().join("all.ps"), "a4", 36).len(), 4);
+    assert_eq!(
+        gs::render(&dir.path().join("cube.ps"), "letter", 36).len(),
+        4
+    );
 }

@@ -22,9 +22,15 @@ fn text(o: &Output) -> String {
 
 const PROFILE: &str = r#"
 name = "two lights"
+[[lights]]
+name = "left"
+relay = 0
+[[lights]]
+name = "right"
+relay = 1
 [survey]
 cameras = 2
-cdf = ["cam1.cdf"]
+cdf = ["cam1.cdf", "cam2.cdf"]
 [[lighting]]
 letter = "a"
 on = ["left"]
@@ -65,6 +71,7 @@ fn new_show_check_and_bad_names() {
         "camera 1's cdf copied for image 1"
     );
     assert!(!d.join("cube/cube2.cdf").exists());
+    assert!(text(&o).contains("cam2.cdf not found"), "{}", text(&o));
     assert_eq!(
         std::fs::read_to_string(d.join("cube/cube.ses")).unwrap(),
         "2\n2\n2\n"
@@ -79,6 +86,12 @@ fn new_show_check_and_bad_names() {
 
     let o = vss(&["session", "check", "cube"], d);
     assert!(o.status.success(), "{}", text(&o));
+    let o = vss(&["session", "check", "cube/cube.toml"], d);
+    assert!(
+        o.status.success(),
+        "the manifest's path names its session: {}",
+        text(&o)
+    );
 
     // A file the manifest names goes missing: check fails and says which.
     std::fs::remove_file(d.join("cube/cube1.cdf")).unwrap();
@@ -137,4 +150,70 @@ fn nonsense_manifest_is_reported_and_not_overwritten() {
             "manifest kept as it was"
         );
     }
+}
+
+#[test]
+fn lock_names_a_live_holder_and_yields_only_when_it_is_gone() {
+    use std::io::{BufRead, BufReader};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("p.toml"), PROFILE).unwrap();
+    assert!(
+        vss(
+            &[
+                "session",
+                "new",
+                "held",
+                "--dir",
+                ".",
+                "--profile",
+                "p.toml"
+            ],
+            d
+        )
+        .status
+        .success()
+    );
+    // A console (here the saving test helper) holds the session.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_vss"))
+        .args(["session", "torture", "held", "--limit", "1000000"])
+        .current_dir(d)
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    out.read_line(&mut line).unwrap();
+    assert_eq!(line.trim(), "ready");
+    let pid = child.id();
+    for args in [
+        &["session", "redo", "held", "--image", "1"][..],
+        &["session", "redo", "held", "--image", "1", "--take-over"][..],
+    ] {
+        let o = vss(args, d);
+        assert!(!o.status.success(), "{args:?}");
+        let t = text(&o);
+        assert!(
+            t.contains("in use") && t.contains(&format!("process {pid}")),
+            "{args:?}: {t}"
+        );
+        assert!(t.contains("close that console"), "{t}");
+    }
+    // show works read-only and names the holder.
+    let t = text(&vss(&["session", "show", "held"], d));
+    assert!(t.contains(&format!("in use by process {pid}")), "{t}");
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let o = vss(&["session", "redo", "held", "--image", "1"], d);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("--take-over"), "{}", text(&o));
+    let t = text(&vss(&["session", "show", "held"], d));
+    assert!(t.contains("stale lock"), "{t}");
+    // Taken over: the redo itself then needs a captured image 1 (or says so).
+    let o = vss(
+        &["session", "redo", "held", "--image", "3", "--take-over"],
+        d,
+    );
+    assert!(!text(&o).contains("in use"), "{}", text(&o));
+    assert!(vss(&["session", "check", "held"], d).status.success());
 }

@@ -4,8 +4,9 @@
 //! is self-consistent), the manifest must load, and `vss session check`
 //! must pass.
 
+use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
-use std::process::Command;
+use std::process::{Command, Stdio};
 use std::time::Duration;
 
 use vss::formats::{edgefile, img, lines};
@@ -14,6 +15,12 @@ use vss::session::torture::{SplitMix, consistent_edges, consistent_image, consis
 
 const PROFILE: &str = r#"
 name = "torture"
+[[lights]]
+name = "left"
+relay = 0
+[[lights]]
+name = "right"
+relay = 1
 [survey]
 cameras = 2
 [[lighting]]
@@ -84,24 +91,40 @@ fn killed_saves_leave_complete_files_and_a_passing_check() {
     );
     let dir = tmp.path().join("tort");
     let mut rng = SplitMix(0x5eed);
-    let mut manifests = std::collections::HashSet::new();
+    let mut saves = 0;
     for round in 0..30 {
         let mut child = vss()
             .args(["session", "torture"])
             .arg(&dir)
             .args(["--seed", &(round + 1).to_string()])
+            .stdout(Stdio::piped())
             .spawn()
             .unwrap();
-        std::thread::sleep(Duration::from_millis(30 + rng.below(250)));
+        // Kill only once the child has the session open ...
+        let mut out = BufReader::new(child.stdout.take().unwrap());
+        let mut line = String::new();
+        out.read_line(&mut line).unwrap();
+        assert_eq!(line.trim(), "ready", "round {round}");
+        // ... and has completed a save, so every round kills real work.
+        line.clear();
+        out.read_line(&mut line).unwrap();
+        assert_eq!(
+            line.trim(),
+            "saved 1",
+            "round {round}: the child cannot save"
+        );
+        std::thread::sleep(Duration::from_millis(20 + rng.below(200)));
         child.kill().unwrap(); // SIGKILL on Unix
         child.wait().unwrap();
+        let mut rest = String::new();
+        out.read_to_string(&mut rest).unwrap();
+        saves += 1 + rest.lines().filter(|l| l.starts_with("saved")).count();
 
         let files = verify_files(&dir);
         assert!(files >= 3, "round {round}: only {files} files");
         let s = Session::inspect(&dir).unwrap_or_else(|e| panic!("round {round}: {e}"));
         let report = s.check();
         assert!(report.is_ok(), "round {round}: {:?}", report.problems);
-        manifests.insert(std::fs::read_to_string(dir.join("tort.toml")).unwrap());
         if round % 10 == 9 {
             let out = vss().args(["session", "check"]).arg(&dir).output().unwrap();
             assert!(
@@ -112,11 +135,7 @@ fn killed_saves_leave_complete_files_and_a_passing_check() {
         }
     }
     // The children really worked between kills.
-    assert!(
-        manifests.len() >= 25,
-        "only {} distinct manifests",
-        manifests.len()
-    );
+    eprintln!("{saves} saves completed across 30 SIGKILLed children");
     let s = Session::open_take_over(&dir).unwrap();
     let m = s.manifest();
     assert!(m.image.iter().any(|r| !r.grey.is_empty()));

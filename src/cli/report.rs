@@ -21,7 +21,8 @@ pub struct Args {
     /// Only this image number of the session.
     #[arg(long, value_name = "K")]
     pub image: Option<u32>,
-    /// Write PostScript here (default: DIR/NAME.ps, or the input with .ps).
+    /// Write PostScript here (default: NAME.ps in the current folder for a
+    /// session, the input file with .ps for --ldr/--img).
     #[arg(long, value_name = "FILE")]
     pub ps: Option<PathBuf>,
     /// Write SVG here (for a session of several images: one file per image,
@@ -176,9 +177,11 @@ fn session_report(dir: &Path, a: &Args) -> anyhow::Result<ExitCode> {
         Some(k) => format!("survey {} image {k}", s.name()),
         None => format!("survey {}", s.name()),
     };
-    let ps_path =
-        a.ps.clone()
-            .or_else(|| a.svg.is_none().then(|| s.path(&format!("{}.ps", s.name()))));
+    let ps_path = a.ps.clone().or_else(|| {
+        a.svg
+            .is_none()
+            .then(|| PathBuf::from(format!("{}.ps", s.name())))
+    });
     if let Some(p) = ps_path {
         write(&p, &ps::survey_report(&title, &reports))?;
     }

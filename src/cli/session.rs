@@ -73,7 +73,20 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             take_over,
         } => redo(g, &dir, image, &from, take_over),
         Cmd::Torture { dir, seed, limit } => {
-            crate::session::torture::run(&dir, seed, limit)?;
+            use std::io::Write as _;
+            let mut out = std::io::stdout().lock();
+            crate::session::torture::run(&dir, seed, limit, &mut |n| {
+                let _ = writeln!(
+                    out,
+                    "{}",
+                    if n == 0 {
+                        "ready".to_string()
+                    } else {
+                        format!("saved {n}")
+                    }
+                );
+                let _ = out.flush();
+            })?;
             Ok(ExitCode::SUCCESS)
         }
     }

@@ -1,8 +1,9 @@
 //! SVG output: the same content as the PostScript report, for the screen and
 //! the browser. One document per image; the `viewBox` is the image's pixel
 //! frame (`0 0 W H`), the grey image is an embedded PNG, and every layer is a
-//! `<g id=…>` that a viewer can toggle: `grey`, `edges-h`, `edges-v`,
-//! `lines-raw`, `lines`.
+//! `<g id=…>` that a viewer can toggle: `grey` (the first lighting; the others
+//! are `grey-2`, `grey-3`, … hidden), `edges-h`, `edges-v`, `lines-raw`,
+//! `lines`. The notes (parameters, counts, timings) are the `<desc>`.
 //!
 //! LLV coordinates put the origin at the *centre* of the top-left pixel, SVG
 //! at its corner: the vector layers are shifted by half a pixel so lines sit
@@ -40,12 +41,23 @@ pub fn image_svg(r: &ImageReport) -> String {
 <title>{}</title>"#,
         xml(&r.title)
     );
+    if !r.notes.is_empty() {
+        // The parameters, counts and timings travel with the picture.
+        let notes: Vec<String> = r.notes.iter().map(|n| xml(n)).collect();
+        let _ = writeln!(out, "<desc>{}</desc>", notes.join("\n"));
+    }
     let _ = writeln!(
         out,
         "<rect id=\"paper\" width=\"{w}\" height=\"{h}\" fill=\"white\"/>"
     );
-    if let Some((caption, img)) = r.greys.first() {
-        grey_layer(&mut out, "grey", caption, img);
+    for (i, (caption, img)) in r.greys.iter().enumerate() {
+        // The first lighting shows; the others are there to switch on.
+        let (id, hidden) = if i == 0 {
+            ("grey".to_string(), false)
+        } else {
+            (format!("grey-{}", i + 1), true)
+        };
+        grey_layer(&mut out, &id, caption, img, hidden);
     }
     if let Some(e) = &r.edges_h {
         edge_layer(&mut out, "edges-h", e, "#00a0ff");
@@ -99,13 +111,14 @@ pub fn grey_svg(caption: &str, img: &GreyImage) -> String {
     image_svg(&r)
 }
 
-fn grey_layer(out: &mut String, id: &str, caption: &str, img: &GreyImage) {
+fn grey_layer(out: &mut String, id: &str, caption: &str, img: &GreyImage, hidden: bool) {
     let Ok(png) = encode::png_grey(img) else {
         return;
     };
+    let vis = if hidden { " visibility=\"hidden\"" } else { "" };
     let _ = writeln!(
         out,
-        "<g id=\"{id}\"><title>{}</title><image x=\"0\" y=\"0\" width=\"{}\" height=\"{}\" style=\"image-rendering:pixelated\" xlink:href=\"data:image/png;base64,{}\"/></g>",
+        "<g id=\"{id}\"{vis}><title>{}</title><image x=\"0\" y=\"0\" width=\"{}\" height=\"{}\" style=\"image-rendering:pixelated\" xlink:href=\"data:image/png;base64,{}\"/></g>",
         xml(caption),
         img.width(),
         img.height(),
@@ -165,7 +178,10 @@ mod tests {
             title: "cube<1>".into(),
             width: 40,
             height: 30,
-            greys: vec![("cube1a.img".into(), img)],
+            greys: vec![
+                ("cube1a.img".into(), img.clone()),
+                ("cube1b.img".into(), img),
+            ],
             edges_h: Some(EdgePoints::default()),
             edges_v: Some(EdgePoints::default()),
             lines_raw: Some(vec![]),
@@ -173,9 +189,11 @@ mod tests {
                 Point::new(1.0, 2.0),
                 Point::new(3.0, 4.0),
             )]),
-            notes: vec![],
+            notes: vec!["edges.floor = 2 & more".into()],
         };
         let s = image_svg(&r);
+        assert!(s.contains("<desc>edges.floor = 2 &amp; more</desc>"));
+        assert!(s.contains("<g id=\"grey-2\" visibility=\"hidden\">"));
         for id in ["grey", "edges-h", "edges-v", "lines-raw", "lines"] {
             assert!(s.contains(&format!("<g id=\"{id}\"")), "{id}");
         }

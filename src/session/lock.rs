@@ -33,10 +33,16 @@ pub struct LockInfo {
 
 impl std::fmt::Display for LockInfo {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // The lock file may have been tampered with: no control characters
+        // reach the terminal.
+        let clean = crate::formats::sanitize;
         write!(
             f,
             "process {} of user {} on host {}, since {}",
-            self.pid, self.user, self.host, self.started
+            self.pid,
+            clean(&self.user),
+            clean(&self.host),
+            clean(&self.started)
         )
     }
 }

@@ -86,7 +86,7 @@ pub struct ImageRecord {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub outputs: Option<OutputRecord>,
     /// Manual line edits since the outputs were made, oldest first.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub edit: Vec<EditRecord>,
 }
 
@@ -363,4 +363,121 @@ pub fn plain_file_name(name: &str) -> bool {
 fn find_line(text: &str, needle: &str) -> usize {
     text.find(needle)
         .map_or(0, |i| text[..i].matches('\n').count() + 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::llv::Point;
+
+    fn full() -> Manifest {
+        let file = |f: &str| FileRecord {
+            file: f.into(),
+            hash: "crc32:01234567:89".into(),
+        };
+        let mut seg = Segment::new(Point::new(1.5, 2.0), Point::new(3.0, 4.25));
+        seg.response = -12.5;
+        seg.residual = 0.125;
+        seg.shadow = true;
+        Manifest {
+            format: FORMAT,
+            session: SessionInfo {
+                name: "cube".into(),
+                created: "2026-11-22T02:00:00Z".into(),
+                modified: "2026-11-22T03:00:00Z".into(),
+                version: "0.1.0".into(),
+                profile: "cell \"A\"".into(),
+                planned_images: 8,
+                cameras: 4,
+            },
+            lighting: vec![LightingInfo {
+                letter: 'a',
+                on: vec!["left".into(), "right".into()],
+                note: "both".into(),
+            }],
+            image: vec![ImageRecord {
+                number: 7,
+                camera: 3,
+                location: 2,
+                cdf: Some(file("cube7.cdf")),
+                grey: vec![GreyRecord {
+                    letter: 'a',
+                    file: "cube7a.img".into(),
+                    hash: "crc32:1:2".into(),
+                    width: 512,
+                    height: 480,
+                    saved: "2026-11-22T02:30:00Z".into(),
+                    version: "0.1.0".into(),
+                }],
+                outputs: Some(OutputRecord {
+                    made: "2026-11-22T02:31:00Z".into(),
+                    version: "0.1.0".into(),
+                    inputs: vec![file("cube7a.img"), file("cube7.cdf")],
+                    files: vec![file("cube7.hpo"), file("cube7.ldr")],
+                    counts: Counts {
+                        edges_h: 1,
+                        edges_v: 2,
+                        lines_raw: 3,
+                        lines: 1,
+                    },
+                    timings: TimingsRecord {
+                        lens_us: 5,
+                        edges_us: 6,
+                        lines_us: 7,
+                        connect_us: 8,
+                    },
+                    lex_attributes: LineAttributes::of(&[seg, Segment::default()]),
+                    ldr_attributes: None,
+                    params: Params::default(),
+                }),
+                edit: vec![EditRecord {
+                    at: "2026-11-22T02:32:00Z".into(),
+                    version: "0.1.0".into(),
+                    op: "delete 0".into(),
+                    lines: 0,
+                    hash: "crc32:0:0".into(),
+                }],
+            }],
+        }
+    }
+
+    #[test]
+    fn every_field_survives_toml_and_back() {
+        let m = full();
+        let text = m.to_toml().unwrap();
+        assert_eq!(Manifest::parse(&text, Path::new("cube.toml")).unwrap(), m);
+    }
+
+    #[test]
+    fn attributes_round_trip_onto_lines() {
+        let mut s = Segment::new(Point::new(0.0, 0.0), Point::new(1.0, 0.0));
+        s.response = f64::NAN;
+        s.residual = 0.5;
+        s.shadow = true;
+        let a = LineAttributes::of(&[Segment::default(), s]).unwrap();
+        assert_eq!(a.response, vec![0.0, 0.0], "NaN is stored as 0");
+        assert_eq!(a.shadow, vec![1]);
+        let mut back = vec![Segment::default(); 2];
+        a.apply(&mut back);
+        assert!(back[1].shadow && back[1].residual == 0.5 && !back[0].shadow);
+        assert!(LineAttributes::of(&[Segment::default()]).is_none());
+    }
+
+    #[test]
+    fn sense_errors_point_at_their_line() {
+        let mut m = full();
+        m.lighting.push(m.lighting[0].clone());
+        let text = m.to_toml().unwrap();
+        let err = Manifest::parse(&text, Path::new("cube.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("appears twice"), "{err}");
+        let line = text.lines().position(|l| l == "letter = \"a\"").unwrap() + 1;
+        assert!(err.starts_with(&format!("cube.toml:{line}:")), "{err}");
+
+        let mut m = full();
+        m.format = 9;
+        let err = Manifest::parse(&m.to_toml().unwrap(), Path::new("c.toml")).unwrap_err();
+        assert!(err.to_string().contains("format 9"), "{err}");
+    }
 }

@@ -95,13 +95,20 @@ pub fn consistent_edges(e: &EdgePoints) -> bool {
 }
 
 /// Saves in a loop until killed (or after `limit` saves, so a forgotten
-/// child cannot run forever).
-pub fn run(dir: &Path, seed: u64, limit: u64) -> Result<(), SessionError> {
+/// child cannot run forever). `progress(n)` is called with 0 once the session
+/// is open, then after every completed save.
+pub fn run(
+    dir: &Path,
+    seed: u64,
+    limit: u64,
+    progress: &mut dyn FnMut(u64),
+) -> Result<(), SessionError> {
     let mut rng = SplitMix(seed);
     let mut s = Session::open_take_over(dir)?;
     let letters = s.letters();
     let images = s.manifest().session.planned_images.max(1);
-    for _ in 0..limit {
+    progress(0);
+    for i in 1..=limit {
         let k = 1 + rng.below(u64::from(images)) as u32;
         match rng.below(10) {
             0..=3 => {
@@ -136,6 +143,7 @@ pub fn run(dir: &Path, seed: u64, limit: u64) -> Result<(), SessionError> {
                 s = Session::open(dir)?;
             }
         }
+        progress(i);
     }
     Ok(())
 }
