@@ -5,7 +5,12 @@
 //! measured against the known geometry of the render.
 //!
 //! The scene is a 2-D render made here (4 × 4 supersampled polygons plus
-//! seeded noise), so the true shadow and object edges are exact.
+//! seeded noise), so the true shadow and object edges are exact. Two
+//! shadows: attached to the box (the hull of the box and its moved copy) and
+//! detached (a plate held above the floor). The attached one meets the box at
+//! shallow corners, which the line extractor currently runs through, merging
+//! box and shadow edges into one line; those tests wait for the extractor's
+//! stray-point check (see the issue6 report) and run with `--ignored`.
 
 use vss::llv::pipeline::{self, Input};
 use vss::llv::shadow::{ShadowParams, flag_shadows};
@@ -30,8 +35,17 @@ fn shadow_hull(d: (f64, f64)) -> Vec<(f64, f64)> {
     vec![p0, p1, m(p1), m(p2), m(p3), p3]
 }
 
+/// The shadow of the box top held above the floor (a plate on a thin post):
+/// the box outline moved by `d`, apart from the box when `d` is large.
+fn detached(d: (f64, f64)) -> Vec<(f64, f64)> {
+    BOX.iter().map(|p| (p.0 + d.0, p.1 + d.1)).collect()
+}
+
 fn render(d: (f64, f64), seed: u64) -> GreyImage {
-    let hull = shadow_hull(d);
+    render_polygon(&shadow_hull(d), seed)
+}
+
+fn render_polygon(hull: &[(f64, f64)], seed: u64) -> GreyImage {
     let mut s = seed;
     let mut noise = || {
         // SplitMix64 → sum of four uniforms: near-Gaussian, σ ≈ 2.9 grey levels.
@@ -57,7 +71,7 @@ fn render(d: (f64, f64), seed: u64) -> GreyImage {
                     );
                     v += if inside(&BOX, sx, sy) {
                         200.0
-                    } else if inside(&hull, sx, sy) {
+                    } else if inside(hull, sx, sy) {
                         45.0
                     } else {
                         120.0
@@ -82,12 +96,17 @@ fn dist(p: Point, s: &Segment) -> f64 {
     p.dist(Point::new(s.a.x + t * dx, s.a.y + t * dy))
 }
 
-/// Whether a detected line lies along one of `truth` (both ends within 3 px:
-/// lines may overshoot a corner by a pixel or two).
+/// Whether a detected line lies along one of `truth`: both ends within 3 px
+/// of its infinite line and the middle within 3 px of the segment (lines run
+/// on through the noise a few pixels past a corner).
 fn along(l: &Segment, truth: &[Segment]) -> bool {
-    truth
-        .iter()
-        .any(|t| dist(l.a, t) < 3.0 && dist(l.b, t) < 3.0)
+    let mid = Point::new((l.a.x + l.b.x) / 2.0, (l.a.y + l.b.y) / 2.0);
+    truth.iter().any(|t| {
+        let (dx, dy) = (t.b.x - t.a.x, t.b.y - t.a.y);
+        let len = dx.hypot(dy);
+        let off = |p: Point| ((p.x - t.a.x) * dy - (p.y - t.a.y) * dx).abs() / len;
+        off(l.a) < 3.0 && off(l.b) < 3.0 && dist(mid, t) < 3.0
+    })
 }
 
 /// The box outline and the shadow outline's other four edges for shadow `d`.
@@ -162,4 +181,58 @@ fn the_same_light_twice_flags_no_outline() {
         .collect();
     assert!(outline.len() >= 6, "{} outline lines", outline.len());
     assert!(outline.iter().all(|l| !l.shadow), "{outline:?}");
+}
+
+#[test]
+fn a_detached_shadow_is_flagged_and_the_plate_is_not() {
+    // Light a throws the shadow 90 px right and 20 px down; light b, close by,
+    // 94 px and 17 px: the shadow moves (4, -3) px, the plate stays.
+    let (da, db) = ((90.0, 20.0), (94.0, 17.0));
+    let la = lines(&render_polygon(&detached(da), 3));
+    let lb = lines(&render_polygon(&detached(db), 4));
+    let object: Vec<Segment> = (0..4).map(|k| seg(BOX[k], BOX[(k + 1) % 4])).collect();
+    let sh = detached(da);
+    let shadow: Vec<Segment> = (0..4).map(|k| seg(sh[k], sh[(k + 1) % 4])).collect();
+    let flagged = flag_shadows(&la, &lb, &ShadowParams::default());
+    let (mut sh_len, mut sh_flag, mut ob_len, mut ob_flag) = (0.0, 0.0, 0.0, 0.0);
+    for l in &flagged {
+        if along(l, &shadow) {
+            sh_len += l.length();
+            sh_flag += if l.shadow { l.length() } else { 0.0 };
+        } else if along(l, &object) {
+            ob_len += l.length();
+            ob_flag += if l.shadow { l.length() } else { 0.0 };
+        }
+    }
+    eprintln!(
+        "detached: shadow edges {sh_len:.0} px found, {sh_flag:.0} px flagged; plate edges {ob_len:.0} px found, {ob_flag:.0} px flagged"
+    );
+    assert!(
+        sh_len > 0.8 * 240.0 && ob_len > 0.8 * 240.0,
+        "{sh_len} {ob_len}"
+    );
+    assert!(
+        sh_flag >= 0.9 * sh_len,
+        "shadow recall {:.2}",
+        sh_flag / sh_len
+    );
+    assert!(
+        ob_flag <= 0.05 * ob_len,
+        "plate edges flagged {:.2}",
+        ob_flag / ob_len
+    );
+    // Under the same light twice nothing on either outline moves.
+    let same = flag_shadows(
+        &la,
+        &lines(&render_polygon(&detached(da), 5)),
+        &ShadowParams::default(),
+    );
+    let outline: Vec<&Segment> = same
+        .iter()
+        .filter(|l| along(l, &object) || along(l, &shadow))
+        .collect();
+    assert!(
+        outline.len() >= 6 && outline.iter().all(|l| !l.shadow),
+        "{outline:?}"
+    );
 }

@@ -8,6 +8,10 @@
 //! photometric pipeline and give `cube1.hpo` etc.; other images are
 //! processed one by one. A failing input is reported on stderr and the
 //! others still run; the exit code is 1 if any failed.
+//!
+//! `--auto lines=200` (or `--auto clean`) first searches the parameters for
+//! that target on each input (`llv::auto`), prints what it changed, and then
+//! runs with the proposal.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -19,6 +23,7 @@ use serde_json::json;
 use super::Global;
 use crate::formats::names::VssFile;
 use crate::formats::{cdf, edgefile, imageio, img::ImgFile, lines as linefile};
+use crate::llv::auto::{self, AutoResult, Target};
 use crate::llv::lens::{CameraModel, LensMap};
 use crate::llv::pipeline::{Input, StageOutputs, Workspace, lines_from_edges};
 use crate::llv::{GreyImage, Params};
@@ -47,6 +52,11 @@ pub struct Args {
     /// Re-run line extraction and CONNECT from STEM.hpo STEM.vpo.
     #[arg(long, num_args = 2, value_names = ["STEM.hpo", "STEM.vpo"])]
     pub from_edges: Option<Vec<PathBuf>>,
+    /// Search the edge, line and CONNECT parameters for a target first and
+    /// run with the result: `lines=200` (about that many lines) or `clean`
+    /// (the fewest lines that keep the long edges). Prints what it changed.
+    #[arg(long, value_name = "TARGET", conflicts_with = "from_edges")]
+    pub auto: Option<Target>,
 }
 
 /// One input of the pipeline: the images of one view and the output stem.
@@ -190,7 +200,11 @@ fn run_group(
         ambient,
         lens: map,
     };
-    let out = ws.run(&input, p)?;
+    let proposal = match &a.auto {
+        Some(t) => Some(auto::search(&input, p, t)?),
+        None => None,
+    };
+    let out = ws.run(&input, proposal.as_ref().map_or(p, |r| &r.params))?;
     let mut written = Vec::new();
     if camera.is_some() {
         // The corrected images (the inputs themselves when the map is the
@@ -210,7 +224,20 @@ fn run_group(
         }
     }
     written.extend(write_outputs(a, &grp.dir, &grp.stem, out, true)?);
-    report(a, &grp.stem, &grp.files, size, out, &written);
+    if let (Some(t), Some(r)) = (&a.auto, &proposal) {
+        if !a.json {
+            print_auto(&grp.stem, t, r);
+        }
+    }
+    report(
+        a,
+        &grp.stem,
+        &grp.files,
+        size,
+        out,
+        &written,
+        proposal.as_ref(),
+    );
     Ok(())
 }
 
@@ -256,8 +283,36 @@ fn from_edges(hpo: &Path, vpo: &Path, a: &Args, p: &Params) -> anyhow::Result<()
         size,
         &out,
         &written,
+        None,
     );
     Ok(())
+}
+
+/// What `--auto` changed, in text.
+fn print_auto(stem: &str, t: &Target, r: &AutoResult) {
+    println!(
+        "{stem}: auto {t}: {} lines (was {}) after {} pipeline runs",
+        r.lines.len(),
+        r.base_lines,
+        r.runs
+    );
+    if r.changes.is_empty() {
+        println!("  no change: the current parameters are the best found");
+    }
+    for (key, old, new) in &r.changes {
+        println!("  --set {key}={new}   (was {old})");
+    }
+}
+
+/// What `--auto` changed, as JSON.
+fn auto_json(r: &AutoResult) -> serde_json::Value {
+    json!({
+        "lines": r.lines.len(),
+        "base_lines": r.base_lines,
+        "runs": r.runs,
+        "coverage": r.coverage,
+        "changes": r.changes.iter().map(|(k, old, new)| json!({"key": k, "old": old, "new": new})).collect::<Vec<_>>(),
+    })
 }
 
 /// Prints what one input gave: text, or one JSON object per line.
@@ -268,6 +323,7 @@ fn report(
     size: (usize, usize),
     out: &StageOutputs,
     written: &[PathBuf],
+    proposal: Option<&AutoResult>,
 ) {
     let t = &out.timings;
     let shown = |p: &PathBuf| crate::formats::sanitize(&p.display().to_string());
@@ -277,7 +333,7 @@ fn report(
             .iter()
             .map(|l| json!({"response": l.response, "residual": l.residual, "shadow": l.shadow}))
             .collect();
-        let v = json!({
+        let mut v = json!({
             "image": stem,
             "files": files.iter().map(shown).collect::<Vec<_>>(),
             "width": size.0,
@@ -290,6 +346,9 @@ fn report(
             "line_attributes": attrs,
             "written": written.iter().map(shown).collect::<Vec<_>>(),
         });
+        if let (Some(r), Some(obj)) = (proposal, v.as_object_mut()) {
+            obj.insert("auto".to_string(), auto_json(r));
+        }
         println!("{v}");
         return;
     }
