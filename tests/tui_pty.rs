@@ -361,9 +361,19 @@ fn no_color_writes_no_colour_and_previews_in_ascii() {
 }
 
 #[test]
-fn hangup_restores_the_terminal() {
+fn idle_writes_nothing_and_hangup_restores_the_terminal() {
     let mut c = Console::start(80, 24, &[]);
     c.wait_text("choose a session", 10);
+    // Once the devices have answered, an idle console writes nothing.
+    c.wait_text("relay board", 10);
+    std::thread::sleep(Duration::from_millis(300));
+    let before = c.raw.lock().unwrap().len();
+    std::thread::sleep(Duration::from_millis(1500));
+    assert_eq!(
+        c.raw.lock().unwrap().len(),
+        before,
+        "an idle console wrote to the terminal"
+    );
     let pid = c.child.process_id().expect("pid") as i32;
     let rc = send_signal(pid, libc::SIGHUP);
     assert_eq!(rc, 0);

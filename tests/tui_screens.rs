@@ -438,3 +438,89 @@ fn the_worker_engine_reruns_from_the_changed_stage() {
         "longer minimum keeps fewer lines: {before} -> {after}"
     );
 }
+
+#[test]
+fn accepting_after_hand_edits_keeps_the_edits_on_disk() {
+    let mut app = reviewed();
+    let n = app
+        .current
+        .as_ref()
+        .unwrap()
+        .editor
+        .as_ref()
+        .unwrap()
+        .lines()
+        .len();
+    key(&mut app, '4');
+    key(&mut app, 'n');
+    key(&mut app, 'x');
+    key(&mut app, '1');
+    let cmds = key(&mut app, 'a');
+    let save = cmds
+        .iter()
+        .position(|c| matches!(c, Cmd::Store(StoreCmd::SaveOutputs { k: 1, .. })));
+    let edit = cmds.iter().position(
+        |c| matches!(c, Cmd::Store(StoreCmd::RecordEdit { k: 1, lines, .. }) if lines.len() == n - 1),
+    );
+    assert!(
+        save.is_some() && edit.is_some() && save < edit,
+        "outputs, then the edits on top: {cmds:?}"
+    );
+}
+
+#[test]
+fn resumed_hand_edited_lines_win_over_the_first_rerun() {
+    let mut app = App::new(&profile(), colour());
+    let mut v = view();
+    v.images = vec![ImageState {
+        k: 1,
+        camera: 1,
+        location: 1,
+        captured: vec!['a', 'b', 'c'],
+        edits: 1,
+        ..Default::default()
+    }];
+    v.next = Some((1, None));
+    app.update(Msg::Store(StoreEvent::Opened(v)));
+    let cmds = app.update(Msg::Store(StoreEvent::Images {
+        k: 1,
+        images: vec![('a', square(150)), ('b', square(200)), ('c', square(90))],
+    }));
+    let edited = vec![vss::llv::Segment::new(
+        vss::llv::Point::new(1.0, 1.0),
+        vss::llv::Point::new(50.0, 1.0),
+    )];
+    app.update(Msg::Store(StoreEvent::Lines {
+        k: 1,
+        lines: edited.clone(),
+    }));
+    let Some(Cmd::Pipeline(req)) = cmds.into_iter().next() else {
+        panic!("resume runs the stages")
+    };
+    let out = pipeline::run(
+        &Input {
+            images: &req.images,
+            ambient: req.ambient.as_deref(),
+            lens: None,
+        },
+        &req.params,
+    )
+    .unwrap();
+    app.update(Msg::Pipeline(PipelineResult {
+        generation: req.generation,
+        image_key: req.image_key,
+        params: req.params.clone(),
+        outcome: Ok(Arc::new(out)),
+    }));
+    assert_eq!(app.work.phase, Phase::Review);
+    assert_eq!(
+        app.current
+            .as_ref()
+            .unwrap()
+            .editor
+            .as_ref()
+            .unwrap()
+            .lines(),
+        &edited[..]
+    );
+}

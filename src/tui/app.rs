@@ -90,6 +90,9 @@ pub struct Loaded {
     pub editor: Option<LineEditor>,
     /// Edits not yet part of saved outputs (for the status line).
     pub edits: usize,
+    /// Hand-edited lines read back from the session (resume), used instead
+    /// of the first pipeline result's lines.
+    pub saved_lines: Option<Vec<crate::llv::Segment>>,
 }
 
 /// The whole console state.
@@ -509,7 +512,15 @@ impl App {
         let ambient = self.ambient;
         let mut images = Vec::new();
         let mut amb = None;
-        for (l, g) in &cur.frames {
+        // Letter order, as the session names the corrected images.
+        let mut frames: Vec<&(char, GreyImage)> = cur.frames.iter().collect();
+        frames.sort_by_key(|(l, _)| {
+            self.letters
+                .iter()
+                .position(|x| x == l)
+                .unwrap_or(usize::MAX)
+        });
+        for (l, g) in frames {
             if Some(*l) == ambient {
                 amb = Some(Arc::new(g.clone()));
             } else {
@@ -568,7 +579,10 @@ impl App {
         self.shown_generation = r.generation;
         match r.outcome {
             Ok(out) => {
-                cur.editor = Some(LineEditor::new(out.lines.clone()));
+                // Lines edited by hand in an earlier run of the console win
+                // over the first re-run; a parameter change starts afresh.
+                let lines = cur.saved_lines.take().unwrap_or_else(|| out.lines.clone());
+                cur.editor = Some(LineEditor::new(lines));
                 cur.edits = 0;
                 cur.outputs = Some(out);
                 cur.outputs_params = Some(r.params);
@@ -692,7 +706,24 @@ impl App {
                 Vec::new()
             }
             StoreEvent::Images { k, images } => self.images_loaded(k, images),
-            StoreEvent::Lines { .. } => Vec::new(),
+            StoreEvent::Lines { k, lines } => {
+                if let Some(cur) = self.current.as_mut().filter(|c| c.k == k) {
+                    self.log.push(
+                        Level::Info,
+                        format!(
+                            "image {k}: {} hand-edited lines from the session",
+                            lines.len()
+                        ),
+                    );
+                    match cur.editor.as_mut() {
+                        Some(_) if cur.saved_lines.is_none() && cur.outputs.is_some() => {
+                            cur.editor = Some(LineEditor::new(lines));
+                        }
+                        _ => cur.saved_lines = Some(lines),
+                    }
+                }
+                Vec::new()
+            }
             StoreEvent::Cameras(models) => {
                 self.camera_models = models;
                 Vec::new()
@@ -737,11 +768,27 @@ impl App {
                 .push(Level::Warn, "no session open: outputs are not saved");
             return Vec::new();
         }
-        vec![Cmd::Store(StoreCmd::SaveOutputs {
-            k: cur.k,
+        // A new .ldr replaces the edited one and clears the session's edit
+        // log, so manual edits made since are recorded again on top.
+        let edited = cur
+            .editor
+            .as_ref()
+            .map(|e| e.lines().to_vec())
+            .filter(|l| *l != out.lines);
+        let k = cur.k;
+        let mut cmds = vec![Cmd::Store(StoreCmd::SaveOutputs {
+            k,
             outputs: out,
             params,
-        })]
+        })];
+        if let Some(lines) = edited {
+            cmds.push(Cmd::Store(StoreCmd::RecordEdit {
+                k,
+                what: "manual edits kept over the new outputs".into(),
+                lines,
+            }));
+        }
+        cmds
     }
 }
 

@@ -297,6 +297,7 @@ impl Loaded {
             outputs_params: None,
             editor: None,
             edits: 0,
+            saved_lines: None,
         }
     }
 }

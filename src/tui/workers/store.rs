@@ -181,7 +181,12 @@ impl Store {
                 let s = self.session_mut()?;
                 let imgs = s.load_images(k).map_err(|e| e.to_string())?;
                 let images = imgs.into_iter().map(|(l, f)| (l, f.image)).collect();
+                let edited = s.manifest().image(k).is_some_and(|r| !r.edit.is_empty());
+                let lines = if edited { s.load_lines(k).ok() } else { None };
                 self.reply(StoreEvent::Images { k, images });
+                if let Some(lines) = lines {
+                    self.reply(StoreEvent::Lines { k, lines });
+                }
             }
             StoreCmd::Redo(k) => {
                 self.session_mut()?;
