@@ -38,18 +38,27 @@ impl DeviceHandle {
     }
 }
 
+/// How the worker opens the cell (again, if it never answered).
+pub type Opener = Box<dyn FnMut() -> Result<Cell, RigError> + Send>;
+
+/// Starts the worker on the cell the profile describes.
 pub fn spawn(profile: Profile, ui: Sender<Msg>) -> std::io::Result<DeviceHandle> {
+    spawn_with(Box::new(move || Cell::open(&profile)), ui)
+}
+
+/// Starts the worker on a cell opened by `open` (tests inject faults here).
+pub fn spawn_with(open: Opener, ui: Sender<Msg>) -> std::io::Result<DeviceHandle> {
     let (tx, rx) = mpsc::channel();
     let cancel = Arc::new(AtomicBool::new(false));
     let flag = cancel.clone();
     let join = std::thread::Builder::new()
         .name("vss-device".into())
-        .spawn(move || Worker::new(profile, ui, flag).run(rx))?;
+        .spawn(move || Worker::new(open, ui, flag).run(rx))?;
     Ok(DeviceHandle { tx, cancel, join })
 }
 
 struct Worker {
-    profile: Profile,
+    open: Opener,
     ui: Sender<Msg>,
     cancel: Arc<AtomicBool>,
     cell: Option<Cell>,
@@ -65,9 +74,9 @@ fn ev(ui: &Sender<Msg>, e: DeviceEvent) {
 }
 
 impl Worker {
-    fn new(profile: Profile, ui: Sender<Msg>, cancel: Arc<AtomicBool>) -> Worker {
+    fn new(open: Opener, ui: Sender<Msg>, cancel: Arc<AtomicBool>) -> Worker {
         Worker {
-            profile,
+            open,
             ui,
             cancel,
             cell: None,
@@ -113,7 +122,7 @@ impl Worker {
         self.last_try = Some(Instant::now());
         let result = match self.cell.as_mut() {
             Some(c) => c.reconnect_grabber(),
-            None => Cell::open(&self.profile).map(|c| {
+            None => (self.open)().map(|c| {
                 self.cell = Some(c);
             }),
         };
