@@ -39,10 +39,15 @@ struct SimProcess {
 
 impl SimProcess {
     fn start(profile: &Path) -> SimProcess {
+        Self::start_with(profile, &[])
+    }
+
+    fn start_with(profile: &Path, args: &[&str]) -> SimProcess {
         let mut child = vss()
             .arg("--profile")
             .arg(profile)
             .arg("sim")
+            .args(args)
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
@@ -264,6 +269,43 @@ fn faults_never_leave_a_corrupt_image_on_disk() {
 }
 
 #[test]
+fn grab_checks_camera_and_lightings_before_the_first_frame() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let prof = write_profile(tmp.path(), "p.toml", &base());
+    let session = tmp.path().join("s/chk");
+    let run = |camera: &str, lighting: &str| {
+        vss()
+            .arg("--profile")
+            .arg(&prof)
+            .args([
+                "grab",
+                "--camera",
+                camera,
+                "--lighting",
+                lighting,
+                "--image",
+                "2",
+                "--session",
+            ])
+            .arg(&session)
+            .output()
+            .expect("run grab")
+    };
+    let out = run("5", "a");
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cameras 1 to 4"));
+    let out = run("1", "a,q");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no lighting configuration `q`"), "{err}");
+    assert!(
+        imgs(&session).is_empty(),
+        "nothing captured: {:?}",
+        imgs(&session)
+    );
+}
+
+#[test]
 fn grab_refuses_a_bad_session_name() {
     let tmp = tempfile::tempdir().expect("tmp");
     let prof = write_profile(tmp.path(), "p.toml", &base());
@@ -271,4 +313,129 @@ fn grab_refuses_a_bad_session_name() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("session name"));
     assert!(!tmp.path().join("bad name!").exists());
+}
+
+#[test]
+fn ctrl_c_cancels_a_transfer_and_saves_nothing_of_it() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let mut p = base();
+    p.grabber.block = 4096;
+    let prof = write_profile(tmp.path(), "p.toml", &p);
+    let session = tmp.path().join("s/can");
+    // The stall holds the first frame mid-transfer long enough to press Ctrl-C.
+    let mut child = vss()
+        .arg("--profile")
+        .arg(&prof)
+        .args([
+            "grab",
+            "--camera",
+            "1",
+            "--lighting",
+            "a,b",
+            "--image",
+            "1",
+            "--session",
+        ])
+        .arg(&session)
+        .args(["--sim-faults", "stall=3s"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start grab");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !session.exists() && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(1200));
+    let pid = child.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args(["-INT", &pid])
+            .status()
+            .is_ok_and(|s| s.success())
+    );
+    let t = Instant::now();
+    let status = loop {
+        if let Ok(Some(st)) = child.try_wait() {
+            break st;
+        }
+        assert!(
+            t.elapsed() < Duration::from_secs(10),
+            "grab did not end after Ctrl-C"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = std::io::Read::read_to_string(&mut e, &mut err);
+    }
+    assert!(!status.success());
+    assert!(
+        err.contains("cancelled") && err.contains("nothing"),
+        "{err}"
+    );
+    assert!(imgs(&session).is_empty(), "{:?}", imgs(&session));
+}
+
+#[test]
+fn a_grabber_pulled_and_plugged_back_is_found_under_its_name() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let sim_profile = write_profile(tmp.path(), "sim.toml", &base());
+    let link = tmp.path().join("ttyVSG0");
+    let link_s = link.to_string_lossy().into_owned();
+    let sim = SimProcess::start_with(
+        &sim_profile,
+        &[
+            "--faults",
+            "unplug-after=20000",
+            "--link",
+            &link_s,
+            "--replug-after",
+            "0.3",
+        ],
+    );
+    let mut p = base();
+    p.grabber.kind = GrabberKind::Vsg;
+    p.grabber.port = link_s.clone();
+    p.relay.kind = RelayKind::Numato;
+    p.relay.port = sim.relay.clone();
+    let prof = write_profile(tmp.path(), "cell.toml", &p);
+    let session = tmp.path().join("s/plug");
+    let grab = |letters: &str| {
+        vss()
+            .arg("--profile")
+            .arg(&prof)
+            .args([
+                "grab",
+                "--camera",
+                "1",
+                "--lighting",
+                letters,
+                "--image",
+                "1",
+                "--session",
+            ])
+            .arg(&session)
+            .output()
+            .expect("run grab")
+    };
+    // The cable is pulled during the second frame: the first is kept.
+    let out = grab("a,b");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains(&link_s) && err.contains("vanished"), "{err}");
+    assert_eq!(imgs(&session), ["plug1a.img"]);
+    // Back under the same name: the same profile works again.
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !link.exists() && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let out = grab("b");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(imgs(&session), ["plug1a.img", "plug1b.img"]);
+    sim.stop();
 }

@@ -90,6 +90,19 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             .context("cannot install the Ctrl-C handler")?;
     }
     let mut cell = Cell::open_with_faults(&profile, faults)?;
+    // Check everything asked for before the first frame, so a typo does not
+    // leave half an image set behind.
+    let cameras = cell.info().cameras;
+    if a.camera == 0 || a.camera > cameras {
+        bail!(
+            "camera {} does not exist: the grabber on {} has cameras 1 to {cameras}",
+            a.camera,
+            cell.grabber.port_name()
+        );
+    }
+    for (letter, _) in &files {
+        cell.mask_for(*letter)?;
+    }
     for (letter, path) in &files {
         let stem = path
             .file_stem()

@@ -68,8 +68,10 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             }
             Some(t) if replug.is_some_and(|d| t.elapsed() >= d) => {
                 let path = sim.replug_grabber()?.to_string();
-                println!("grabber: {path}");
-                std::io::stdout().flush()?;
+                // Whoever read the first paths may have gone: a closed
+                // stdout must not end the simulator.
+                let mut out = std::io::stdout().lock();
+                let _ = writeln!(out, "grabber: {path}").and_then(|()| out.flush());
                 eprintln!("vss sim: the grabber is back on {path}");
                 unplugged = None;
             }

@@ -254,25 +254,87 @@ impl Cell {
         }
     }
 
-    /// After the grabber vanished: plug the simulated one back in, or
-    /// reopen the real port.
+    /// After the grabber vanished or stopped answering: plug the simulated
+    /// one back in if it was pulled, and reopen the port (the old one is
+    /// closed first: serial ports are opened exclusively).
     pub fn reconnect_grabber(&mut self) -> Result<(), RigError> {
-        if let (Some(sim), GrabberKind::Simulated) = (self.sim.as_mut(), self.profile.grabber.kind)
-        {
-            let path = if sim.grabber_plugged() {
-                sim.grabber_path().to_string()
-            } else {
-                sim.replug_grabber()?.to_string()
-            };
-            let g = &self.profile.grabber;
-            self.grabber = Box::new(VsgClient::open(
-                &path,
-                g.baud,
-                ClientConfig::from_profile(g),
-            )?);
-            return Ok(());
+        let simulated = self.profile.grabber.kind == GrabberKind::Simulated;
+        let pulled = |c: &Cell| simulated && c.sim.as_ref().is_some_and(|s| !s.grabber_plugged());
+        if !pulled(self) {
+            match self.grabber.reconnect() {
+                // It went away while we tried: plug it back in below.
+                Err(_) if pulled(self) => {}
+                r => return r,
+            }
         }
-        self.grabber.reconnect()
+        let Some(sim) = self.sim.as_mut() else {
+            return Err(RigError::Sim("no simulated cell".into()));
+        };
+        let path = sim.replug_grabber()?.to_string();
+        self.grabber = Box::new(Unplugged {
+            port: self.grabber.port_name().to_string(),
+        });
+        let g = &self.profile.grabber;
+        self.grabber = Box::new(VsgClient::open(
+            &path,
+            g.baud,
+            ClientConfig::from_profile(g),
+        )?);
+        Ok(())
+    }
+}
+
+/// Stands in for a grabber between closing its old port and opening the
+/// new one; every call says the device is not there.
+struct Unplugged {
+    port: String,
+}
+
+impl Unplugged {
+    fn err(&self) -> RigError {
+        RigError::Vanished {
+            port: self.port.clone(),
+            source: std::io::Error::new(std::io::ErrorKind::NotConnected, "not connected"),
+        }
+    }
+}
+
+impl FrameGrabber for Unplugged {
+    fn hello(&mut self) -> Result<GrabberInfo, RigError> {
+        Err(self.err())
+    }
+    fn init(&mut self) -> Result<(), RigError> {
+        Err(self.err())
+    }
+    fn live(&mut self, _cam: u32) -> Result<(), RigError> {
+        Err(self.err())
+    }
+    fn freeze(&mut self) -> Result<FrameInfo, RigError> {
+        Err(self.err())
+    }
+    fn select_camera(&mut self, _cam: u32) -> Result<(), RigError> {
+        Err(self.err())
+    }
+    fn load(&mut self, _img: &GreyImage) -> Result<(), RigError> {
+        Err(self.err())
+    }
+    fn transfer(
+        &mut self,
+        _progress: &mut dyn FnMut(usize, usize) -> bool,
+    ) -> Result<GreyImage, RigError> {
+        Err(self.err())
+    }
+    fn status(&mut self) -> Result<crate::rig::GrabberStatus, RigError> {
+        Err(self.err())
+    }
+    fn port_name(&self) -> &str {
+        &self.port
+    }
+    fn reconnect(&mut self) -> Result<(), RigError> {
+        Err(self.err())
+    }
+    fn wire_stats(&self) -> crate::rig::WireStats {
+        crate::rig::WireStats::default()
     }
 }
 

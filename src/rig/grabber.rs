@@ -117,7 +117,9 @@ type Reopen<P> = Box<dyn FnMut() -> Result<P, RigError> + Send>;
 
 /// A VSG/1 client over a byte stream.
 pub struct VsgClient<P: Link> {
-    port: P,
+    /// `None` only while reconnecting: the old port is closed before the
+    /// new one opens, since a serial port is opened exclusively.
+    port: Option<P>,
     name: String,
     cfg: ClientConfig,
     /// Longest silence inside a reply once it has started.
@@ -149,7 +151,7 @@ impl<P: Link> VsgClient<P> {
     pub fn new(port: P, name: &str, cfg: ClientConfig) -> Self {
         let gap = (cfg.timeout / 5).clamp(Duration::from_millis(50), Duration::from_millis(500));
         VsgClient {
-            port,
+            port: Some(port),
             name: name.to_string(),
             cfg,
             gap,
@@ -179,8 +181,14 @@ impl<P: Link> VsgClient<P> {
     }
 
     /// The stream (tests inspect what was sent).
-    pub fn port_mut(&mut self) -> &mut P {
-        &mut self.port
+    pub fn port_mut(&mut self) -> Option<&mut P> {
+        self.port.as_mut()
+    }
+
+    fn port(&mut self) -> io::Result<&mut P> {
+        self.port
+            .as_mut()
+            .ok_or_else(|| io::Error::new(ErrorKind::NotConnected, "the port is closed"))
     }
 
     fn vanished(&self, source: io::Error) -> RigError {
@@ -192,11 +200,16 @@ impl<P: Link> VsgClient<P> {
 
     /// Reads whatever arrives within `wait` into `rx`.
     fn fill(&mut self, wait: Duration) -> Result<(), ReadFail> {
-        self.port
-            .set_timeout(wait.max(Duration::from_millis(1)))
+        let port = self.port.as_mut().ok_or_else(|| {
+            ReadFail::Vanished(io::Error::new(
+                ErrorKind::NotConnected,
+                "the port is closed",
+            ))
+        })?;
+        port.set_timeout(wait.max(Duration::from_millis(1)))
             .map_err(ReadFail::Vanished)?;
         loop {
-            match self.port.read(&mut self.buf) {
+            match port.read(&mut self.buf) {
                 Ok(0) => {
                     return Err(ReadFail::Vanished(io::Error::new(
                         ErrorKind::UnexpectedEof,
@@ -284,11 +297,12 @@ impl<P: Link> VsgClient<P> {
     }
 
     fn send_raw(&mut self, bytes: &[u8]) -> Result<(), RigError> {
-        let r = self
-            .port
-            .set_timeout(self.cfg.timeout)
-            .and_then(|()| self.port.write_all(bytes))
-            .and_then(|()| self.port.flush());
+        let timeout = self.cfg.timeout;
+        let r = self.port().and_then(|p| {
+            p.set_timeout(timeout)?;
+            p.write_all(bytes)?;
+            p.flush()
+        });
         match r {
             Ok(()) => {
                 self.stats.tx += bytes.len() as u64;
@@ -704,7 +718,9 @@ impl<P: Link> FrameGrabber for VsgClient<P> {
                 self.name
             )));
         };
-        self.port = reopen()?;
+        // Close first: the port is held exclusively.
+        self.port = None;
+        self.port = Some(reopen()?);
         self.rx.clear();
         self.frame = None;
         self.connect().map(|_| ())
