@@ -25,8 +25,8 @@ const MIN_CONTRAST: f64 = 10.0;
 /// the median |response| ≈ 3.4 σ of the response noise. At 3 (≈ 2 σ) each of
 /// the four images lets 2–3 % of its noise pixels through, their sum keeps
 /// enough peaks above the floor for the adaptive threshold to fill every row
-/// with noise, and noise points fall by only ~20 % (measured: 52 k vs 63 k);
-/// at 4 they fall to 16 %, at 5 to 1 %, with recall unchanged.
+/// with noise, and noise points fall by only ~20 % (measured: 50 k vs 62 k);
+/// at 4 they fall to 15 %, at 5 to 1 %, with recall unchanged.
 const PROPOSED_NOISE_FACTOR: f64 = 5.0;
 /// An edge point farther than this from every visible polygon edge supports
 /// no true edge (px).
