@@ -287,6 +287,11 @@ fn resize_redraws_for_the_new_size() {
         })
         .unwrap();
     c.parser.lock().unwrap().screen_mut().set_size(24, 80);
+    // The console redraws for the new size on its own (SIGWINCH)…
+    c.wait("a redraw at 80 x 24", 10, |s| {
+        s.lines().nth(23).is_some_and(|l| l.contains("quit")) && s.contains("choose a session")
+    });
+    // …and keeps taking keys.
     c.send("2");
     let s = c.wait_text("lights", 10);
     let lines: Vec<&str> = s.lines().collect();
