@@ -401,7 +401,7 @@ impl App {
         )];
         let row = |(k, d): (String, &str)| {
             Line::from(vec![
-                Span::styled(format!("{k:>12} "), t.key()),
+                Span::styled(format!("{k:>9} "), t.key()),
                 Span::raw(d.to_string()),
             ])
         };
@@ -412,9 +412,17 @@ impl App {
         );
         lines.push(Line::styled("Everywhere", t.title()));
         lines.extend(keymap::describe(Scope::Global).into_iter().map(row));
-        Paragraph::new(lines)
-            .block(block(self, "help — any key closes"))
-            .render(r, buf);
+        let b = block(self, "help — any key closes");
+        let inner = b.inner(r);
+        b.render(r, buf);
+        // Too many rows for one column (80 x 24): flow into two.
+        let rows = inner.height.max(1) as usize;
+        let cols = lines.len().div_ceil(rows).clamp(1, 3);
+        let areas = Layout::horizontal(vec![Constraint::Ratio(1, cols as u32); cols]).split(inner);
+        for (i, a) in areas.iter().enumerate() {
+            let part: Vec<Line> = lines.iter().skip(i * rows).take(rows).cloned().collect();
+            Paragraph::new(part).render(*a, buf);
+        }
     }
 }
 
