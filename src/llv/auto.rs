@@ -10,7 +10,7 @@
 //! `edges.per_region × edges.floor` (edge stage) → `lines.min_length` (line
 //! stage) → `connect.min_line_length` (CONNECT only). Each axis holds the
 //! base value and a ladder around it: with the default base, 21 edge runs,
-//! 42 line runs and 210 CONNECT runs (274 runs, ~2 s on a 320 × 320 noisy
+//! 42 line runs and 210 CONNECT runs (274 runs, ~1 s on a 320 × 320 noisy
 //! scene in the test build).
 //!
 //! **"clean", measurably.** The edges an operator must not lose are the
