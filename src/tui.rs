@@ -1,12 +1,203 @@
-//! The operator console (to be written).
+//! The operator console (issue 7): a keyboard-driven TUI over the survey,
+//! the capture hardware, the LLV pipeline, the line editor and the reports.
+//!
+//! "Functional core, imperative shell": [`app::App`] holds the state and
+//! turns messages into commands without any I/O; this file is the shell —
+//! terminal set-up and restore (panic, SIGTERM, SIGHUP, Ctrl-C), the input
+//! thread, the workers ([`workers`]), and a loop that draws only when
+//! something changed, so an idle console writes nothing.
 
+use std::io::{self, Write};
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError, Sender};
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use ratatui::Terminal;
+use ratatui::backend::CrosstermBackend;
+use ratatui::crossterm::event as term_event;
+use ratatui::crossterm::{cursor, execute, terminal};
 
 use crate::cli::Global;
 
+pub mod app;
+pub mod event;
+pub mod keymap;
+pub mod mode;
+pub mod screens;
+pub mod text;
+pub mod widgets;
+pub mod workers;
+
+use app::App;
+use event::{Cmd, Msg};
+
+/// Least time between two draws while messages pour in (progress, live).
+const FRAME: Duration = Duration::from_millis(16);
+
 /// Opens the console on the profile's cell.
-pub fn run(_g: &Global, _preview: Option<&str>) -> anyhow::Result<ExitCode> {
-    use clap::CommandFactory;
-    crate::cli::Cli::command().print_help()?;
-    Ok(ExitCode::SUCCESS)
+pub fn run(g: &Global, preview: Option<&str>) -> anyhow::Result<ExitCode> {
+    let profile = g
+        .load_profile()
+        .context("loading the profile for the console")?;
+    let look = mode::from_env(preview);
+
+    // Signals first: a hang-up during start-up must still restore the terminal.
+    let stop = Arc::new(AtomicBool::new(false));
+    for sig in [
+        signal_hook::consts::SIGTERM,
+        signal_hook::consts::SIGHUP,
+        signal_hook::consts::SIGINT,
+        signal_hook::consts::SIGQUIT,
+    ] {
+        signal_hook::flag::register(sig, stop.clone()).context("installing signal handlers")?;
+    }
+    install_panic_hook();
+    let mut terminal = enter().context("setting up the terminal")?;
+    let result = run_loop(&mut terminal, profile, look, &stop);
+    // Drop the terminal first: its own clean-up writes to the screen, and
+    // leaving the alternate screen must be the last thing written.
+    drop(terminal);
+    leave();
+    result.map(|()| ExitCode::SUCCESS)
+}
+
+type Term = Terminal<CrosstermBackend<io::Stdout>>;
+
+fn enter() -> io::Result<Term> {
+    terminal::enable_raw_mode()?;
+    let mut out = io::stdout();
+    if let Err(e) = execute!(out, terminal::EnterAlternateScreen, cursor::Hide) {
+        leave();
+        return Err(e);
+    }
+    Terminal::new(CrosstermBackend::new(out))
+}
+
+/// Puts the terminal back as the shell had it: cooked mode, cursor shown,
+/// main screen. Safe to call twice and from the panic hook.
+pub fn leave() {
+    let _ = terminal::disable_raw_mode();
+    let mut out = io::stdout();
+    let _ = execute!(out, cursor::Show, terminal::LeaveAlternateScreen);
+    let _ = out.flush();
+}
+
+fn install_panic_hook() {
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        leave();
+        previous(info);
+    }));
+}
+
+/// Reads keys and resizes on their own thread so the UI loop never blocks
+/// on the terminal; ends when the UI is gone or input fails (hang-up).
+fn spawn_input(tx: Sender<Msg>, stop: Arc<AtomicBool>) -> io::Result<()> {
+    std::thread::Builder::new()
+        .name("vss-input".into())
+        .spawn(move || {
+            while !stop.load(Ordering::SeqCst) {
+                match term_event::poll(Duration::from_millis(100)) {
+                    Ok(false) => continue,
+                    Ok(true) => {}
+                    Err(_) => break,
+                }
+                let msg = match term_event::read() {
+                    Ok(term_event::Event::Key(k)) => Msg::Key(k),
+                    Ok(term_event::Event::Resize(w, h)) => Msg::Resize(w, h),
+                    Ok(_) => continue,
+                    Err(_) => break,
+                };
+                if tx.send(msg).is_err() {
+                    break;
+                }
+            }
+            // Input is gone (terminal hung up): ask the loop to stop.
+            stop.store(true, Ordering::SeqCst);
+        })?;
+    Ok(())
+}
+
+fn run_loop(
+    terminal: &mut Term,
+    profile: crate::profile::Profile,
+    look: mode::Look,
+    stop: &Arc<AtomicBool>,
+) -> anyhow::Result<()> {
+    let (tx, rx) = mpsc::channel::<Msg>();
+    let mut app = App::new(&profile, look);
+    // Draw before anything slow starts: the operator sees the console at once.
+    terminal.draw(|f| f.render_widget(&app, f.area()))?;
+    spawn_input(tx.clone(), stop.clone())?;
+    let workers = Workers {
+        device: workers::device::spawn(profile.clone(), tx.clone())?,
+        pipeline: workers::pipeline::spawn(tx.clone())?,
+        store: workers::store::spawn(profile, tx.clone())?,
+    };
+    drop(tx);
+    let first = app.start();
+    workers.dispatch(first);
+    let mut dirty = true;
+    let mut last_draw = Instant::now();
+    while !app.quit && !stop.load(Ordering::SeqCst) {
+        if dirty && last_draw.elapsed() >= FRAME {
+            terminal.draw(|f| f.render_widget(&app, f.area()))?;
+            last_draw = Instant::now();
+            dirty = false;
+        }
+        let wait = if dirty {
+            FRAME.saturating_sub(last_draw.elapsed())
+        } else {
+            Duration::from_millis(100)
+        };
+        match rx.recv_timeout(wait) {
+            Ok(msg) => {
+                dirty |= !matches!(msg, Msg::Tick);
+                let cmds = app.update(msg);
+                workers.dispatch(cmds);
+                // Take whatever else is waiting before drawing again.
+                while let Ok(msg) = rx.try_recv() {
+                    let cmds = app.update(msg);
+                    workers.dispatch(cmds);
+                    if app.quit {
+                        break;
+                    }
+                }
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => break,
+        }
+    }
+    workers.finish();
+    Ok(())
+}
+
+struct Workers {
+    device: workers::device::DeviceHandle,
+    pipeline: workers::pipeline::PipelineHandle,
+    store: workers::store::StoreHandle,
+}
+
+impl Workers {
+    fn dispatch(&self, cmds: Vec<Cmd>) {
+        for c in cmds {
+            match c {
+                Cmd::Device(d) => self.device.send(d),
+                Cmd::Pipeline(p) => self.pipeline.send(p),
+                Cmd::Store(s) => self.store.send(s),
+            }
+        }
+    }
+
+    /// Lets the store finish the saves it has queued (nothing saved is lost),
+    /// stops the rest without waiting on a device.
+    fn finish(self) {
+        self.device.cancel.store(true, Ordering::SeqCst);
+        drop(self.device.tx);
+        drop(self.pipeline);
+        self.store.finish(Duration::from_secs(10));
+    }
 }

@@ -1,0 +1,85 @@
+//! Picking the preview mode and colour once at start, from the command line
+//! and the environment only — never by querying the terminal, which can hang
+//! over a slow SSH link.
+
+use super::widgets::preview::PreviewMode;
+
+/// How the console draws: preview mode and whether colour attributes may be
+/// written at all.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Look {
+    pub mode: PreviewMode,
+    pub colour: bool,
+}
+
+/// The look for an optional `--preview` override and the values of `TERM`
+/// and `NO_COLOR`. `NO_COLOR` (any value, per no-color.org) removes every
+/// colour attribute and, without an override, picks ASCII; a dumb, Linux
+/// console or VT100 `TERM` picks ASCII without colour.
+pub fn pick(preview: Option<&str>, term: Option<&str>, no_color: Option<&str>) -> Look {
+    let no_colour = no_color.is_some();
+    let term = term.unwrap_or("");
+    let plain_term = term.is_empty()
+        || matches!(
+            term,
+            "dumb" | "linux" | "vt100" | "vt102" | "vt220" | "ansi"
+        )
+        || term.starts_with("vt1");
+    let colour = !no_colour && !plain_term;
+    let mode = match preview {
+        Some("ascii") => PreviewMode::Ascii,
+        Some("braille") => PreviewMode::Braille,
+        Some("blocks") => PreviewMode::Blocks,
+        _ if no_colour || plain_term => PreviewMode::Ascii,
+        _ => PreviewMode::Blocks,
+    };
+    Look { mode, colour }
+}
+
+/// The look for this process's environment.
+pub fn from_env(preview: Option<&str>) -> Look {
+    let term = std::env::var("TERM").ok();
+    let no_color = std::env::var("NO_COLOR").ok();
+    pick(preview, term.as_deref(), no_color.as_deref())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn environment_and_override() {
+        let l = pick(None, Some("xterm-256color"), None);
+        assert_eq!(
+            l,
+            Look {
+                mode: PreviewMode::Blocks,
+                colour: true
+            }
+        );
+        let l = pick(None, Some("xterm-256color"), Some("1"));
+        assert_eq!(
+            l,
+            Look {
+                mode: PreviewMode::Ascii,
+                colour: false
+            }
+        );
+        for t in ["dumb", "linux", "vt100"] {
+            assert_eq!(pick(None, Some(t), None).mode, PreviewMode::Ascii, "{t}");
+            assert!(!pick(None, Some(t), None).colour);
+        }
+        let l = pick(Some("braille"), Some("xterm"), Some(""));
+        assert_eq!(
+            l,
+            Look {
+                mode: PreviewMode::Braille,
+                colour: false
+            }
+        );
+        assert_eq!(
+            pick(Some("blocks"), Some("dumb"), None).mode,
+            PreviewMode::Blocks
+        );
+    }
+}

@@ -1,0 +1,3 @@
+//! Widgets the console draws itself: image previews in text cells.
+
+pub mod preview;

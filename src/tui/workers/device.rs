@@ -1,0 +1,292 @@
+//! The device worker: owns the [`Cell`] (grabber + relay board, or the
+//! embedded simulated cell), runs captures with progress and a cancel flag,
+//! keeps the live view going at a throttled rate, and when a device vanishes
+//! says so and keeps trying to reconnect.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use super::send;
+use crate::profile::Profile;
+use crate::rig::{Cell, RigError};
+use crate::tui::event::{DeviceCmd, DeviceEvent, FramePurpose, Msg};
+
+/// Least time between two live frames: the link and the terminal keep up.
+pub const LIVE_INTERVAL: Duration = Duration::from_millis(500);
+/// Time between reconnection attempts after a device vanished.
+pub const RETRY_INTERVAL: Duration = Duration::from_secs(2);
+
+/// The UI's handle on the device worker.
+pub struct DeviceHandle {
+    pub tx: Sender<DeviceCmd>,
+    /// Set to stop the transfer under way (checked between blocks).
+    pub cancel: Arc<AtomicBool>,
+    pub join: JoinHandle<()>,
+}
+
+impl DeviceHandle {
+    /// Forwards a command; `Cancel` also raises the flag the running
+    /// transfer polls, since the worker is not reading commands then.
+    pub fn send(&self, cmd: DeviceCmd) {
+        if cmd == DeviceCmd::Cancel {
+            self.cancel.store(true, Ordering::SeqCst);
+        }
+        let _ = self.tx.send(cmd);
+    }
+}
+
+/// How the worker opens the cell (again, if it never answered).
+pub type Opener = Box<dyn FnMut() -> Result<Cell, RigError> + Send>;
+
+/// Starts the worker on the cell the profile describes.
+pub fn spawn(profile: Profile, ui: Sender<Msg>) -> std::io::Result<DeviceHandle> {
+    spawn_with(Box::new(move || Cell::open(&profile)), ui)
+}
+
+/// Starts the worker on a cell opened by `open` (tests inject faults here).
+pub fn spawn_with(open: Opener, ui: Sender<Msg>) -> std::io::Result<DeviceHandle> {
+    let (tx, rx) = mpsc::channel();
+    let cancel = Arc::new(AtomicBool::new(false));
+    let flag = cancel.clone();
+    let join = std::thread::Builder::new()
+        .name("vss-device".into())
+        .spawn(move || Worker::new(open, ui, flag).run(rx))?;
+    Ok(DeviceHandle { tx, cancel, join })
+}
+
+struct Worker {
+    open: Opener,
+    ui: Sender<Msg>,
+    cancel: Arc<AtomicBool>,
+    cell: Option<Cell>,
+    /// False after a device vanished, until reconnected.
+    healthy: bool,
+    last_try: Option<Instant>,
+    live: Option<u32>,
+    last_live: Option<Instant>,
+}
+
+fn ev(ui: &Sender<Msg>, e: DeviceEvent) {
+    send(ui, Msg::Device(e));
+}
+
+impl Worker {
+    fn new(open: Opener, ui: Sender<Msg>, cancel: Arc<AtomicBool>) -> Worker {
+        Worker {
+            open,
+            ui,
+            cancel,
+            cell: None,
+            healthy: false,
+            last_try: None,
+            live: None,
+            last_live: None,
+        }
+    }
+
+    fn run(mut self, rx: Receiver<DeviceCmd>) {
+        loop {
+            self.ensure_connected();
+            let wait = match (self.live, self.last_live) {
+                (Some(_), Some(t)) => LIVE_INTERVAL.saturating_sub(t.elapsed()),
+                (Some(_), None) => Duration::ZERO,
+                _ if !self.healthy => RETRY_INTERVAL,
+                _ => Duration::from_secs(3600),
+            };
+            match rx.recv_timeout(wait) {
+                Ok(cmd) => self.handle(cmd),
+                Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Disconnected) => break,
+            }
+            if let Some(cam) = self.live
+                && self.healthy
+                && self.last_live.is_none_or(|t| t.elapsed() >= LIVE_INTERVAL)
+            {
+                self.last_live = Some(Instant::now());
+                self.grab(FramePurpose::Live, cam, None);
+            }
+        }
+        // Leave the cell dark.
+        if let Some(c) = self.cell.as_mut() {
+            let _ = c.set_lights(0);
+        }
+    }
+
+    fn ensure_connected(&mut self) {
+        if self.healthy || self.last_try.is_some_and(|t| t.elapsed() < RETRY_INTERVAL) {
+            return;
+        }
+        self.last_try = Some(Instant::now());
+        let result = match self.cell.as_mut() {
+            Some(c) => c.reconnect_grabber(),
+            None => (self.open)().map(|c| {
+                self.cell = Some(c);
+            }),
+        };
+        let hello = result.and_then(|_| match self.cell.as_mut() {
+            Some(c) => c.grabber.hello().map(|h| {
+                (
+                    h,
+                    c.lights.port_name().to_string(),
+                    c.grabber.port_name().to_string(),
+                )
+            }),
+            None => Err(RigError::Config("no cell".into())),
+        });
+        match hello {
+            Ok((h, relay_port, grabber_port)) => {
+                self.healthy = true;
+                ev(
+                    &self.ui,
+                    DeviceEvent::Connected {
+                        grabber: format!(
+                            "{} {}×{} {} cameras on {grabber_port}",
+                            h.model, h.width, h.height, h.cameras
+                        ),
+                        relay: relay_port,
+                    },
+                );
+                self.report_lights();
+            }
+            Err(e) => {
+                self.healthy = false;
+                ev(
+                    &self.ui,
+                    DeviceEvent::Lost {
+                        error: e.to_string(),
+                    },
+                );
+            }
+        }
+    }
+
+    fn report_lights(&mut self) {
+        if let Some(c) = self.cell.as_ref() {
+            ev(
+                &self.ui,
+                DeviceEvent::Lights {
+                    on: c.lights_on(),
+                    mask: c.mask(),
+                },
+            );
+        }
+    }
+
+    fn failed(&mut self, e: &RigError) {
+        if e.is_vanished() || matches!(e, RigError::Timeout { .. }) {
+            self.healthy = false;
+            self.last_try = Some(Instant::now());
+            ev(
+                &self.ui,
+                DeviceEvent::Lost {
+                    error: e.to_string(),
+                },
+            );
+        }
+    }
+
+    fn handle(&mut self, cmd: DeviceCmd) {
+        match cmd {
+            DeviceCmd::Capture {
+                purpose,
+                camera,
+                lighting,
+            } => self.grab(purpose, camera, lighting),
+            DeviceCmd::Live { on, camera } => {
+                self.live = on.then_some(camera);
+                self.last_live = None;
+                ev(
+                    &self.ui,
+                    DeviceEvent::Note(format!("live view {}", if on { "on" } else { "off" })),
+                );
+            }
+            DeviceCmd::Cancel => {
+                self.live = None;
+                self.cancel.store(false, Ordering::SeqCst);
+            }
+            DeviceCmd::SetLight { relay, on } => self.lights(|c| {
+                let bit = 1u32 << relay.min(31);
+                let mask = if on { c.mask() | bit } else { c.mask() & !bit };
+                c.set_lights(mask)
+            }),
+            DeviceCmd::AllOff => self.lights(|c| c.set_lights(0)),
+            DeviceCmd::Lighting(l) => self.lights(|c| c.switch_lighting(l)),
+        }
+    }
+
+    fn lights(&mut self, f: impl FnOnce(&mut Cell) -> Result<(), RigError>) {
+        let Some(c) = self.cell.as_mut() else {
+            ev(
+                &self.ui,
+                DeviceEvent::Note("no relay board connected".into()),
+            );
+            return;
+        };
+        if let Err(e) = f(c) {
+            ev(&self.ui, DeviceEvent::Note(format!("lights: {e}")));
+            self.failed(&e);
+        }
+        self.report_lights();
+    }
+
+    fn grab(&mut self, purpose: FramePurpose, camera: u32, lighting: Option<char>) {
+        let (ui, cancel) = (self.ui.clone(), self.cancel.clone());
+        let Some(c) = self.cell.as_mut().filter(|_| self.healthy) else {
+            ev(
+                &self.ui,
+                DeviceEvent::CaptureFailed {
+                    purpose,
+                    error: "the grabber is not connected (see the log); retrying".into(),
+                },
+            );
+            return;
+        };
+        let mut last_sent = 0usize;
+        let mut progress = move |done: usize, total: usize| -> bool {
+            // A message per ~2 % keeps the channel light on slow links.
+            if done == total || done >= last_sent + total / 50 {
+                last_sent = done;
+                ev(&ui, DeviceEvent::Progress { done, total });
+            }
+            !cancel.load(Ordering::SeqCst)
+        };
+        let result = match lighting {
+            Some(l) => c.capture(camera, l, &mut progress).map(|cap| cap.image),
+            None => c
+                .grabber
+                .select_camera(camera)
+                .and_then(|_| c.grabber.freeze())
+                .and_then(|_| c.grabber.transfer(&mut progress)),
+        };
+        self.cancel.store(false, Ordering::SeqCst);
+        match result {
+            Ok(image) => ev(
+                &self.ui,
+                DeviceEvent::Frame {
+                    purpose,
+                    camera,
+                    image,
+                },
+            ),
+            Err(e) => {
+                if matches!(e, RigError::Cancelled { .. }) {
+                    self.live = None;
+                }
+                ev(
+                    &self.ui,
+                    DeviceEvent::CaptureFailed {
+                        purpose,
+                        error: e.to_string(),
+                    },
+                );
+                self.failed(&e);
+            }
+        }
+        if lighting.is_some() {
+            self.report_lights();
+        }
+    }
+}

@@ -1,0 +1,406 @@
+//! The console end to end, as an operator uses it: the real `vss` binary in
+//! a real pseudo-terminal (portable-pty), its screen read back through a
+//! terminal emulator (vt100). A guided survey of two images with three
+//! lightings each by key presses alone, a parameter tweak that changes the
+//! line count on screen, a report export; then the files on disk. Also a
+//! resize, `NO_COLOR=1`, and a hang-up (SIGHUP) that must leave the terminal
+//! restored.
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
+
+/// A small, quick simulated cell: 128 × 128 images, short settle.
+const PROFILE: &str = r#"
+name = "pty test cell"
+
+[relay]
+settle_ms = 5
+
+[[lights]]
+name = "left"
+relay = 0
+[[lights]]
+name = "right"
+relay = 1
+
+[[lighting]]
+letter = "a"
+on = ["left"]
+[[lighting]]
+letter = "b"
+on = ["right"]
+[[lighting]]
+letter = "c"
+on = []
+
+[survey]
+dir = "sessions"
+cameras = 4
+
+[sim]
+width = 128
+height = 128
+seed = 7
+noise = 1.0
+"#;
+
+struct Console {
+    master: Box<dyn MasterPty + Send>,
+    writer: Box<dyn Write + Send>,
+    child: Box<dyn Child + Send + Sync>,
+    parser: Arc<Mutex<vt100::Parser>>,
+    raw: Arc<Mutex<Vec<u8>>>,
+    dir: tempfile::TempDir,
+}
+
+impl Console {
+    fn start(cols: u16, rows: u16, env: &[(&str, &str)]) -> Console {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("cell.toml"), PROFILE).unwrap();
+        let pty = native_pty_system();
+        let size = PtySize {
+            rows,
+            cols,
+            pixel_width: 0,
+            pixel_height: 0,
+        };
+        let pair = pty.openpty(size).unwrap();
+        let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_vss"));
+        cmd.args(["--profile", "cell.toml"]);
+        cmd.cwd(dir.path());
+        cmd.env("TERM", "xterm-256color");
+        cmd.env_remove("NO_COLOR");
+        for (k, v) in env {
+            cmd.env(k, v);
+        }
+        let child = pair.slave.spawn_command(cmd).unwrap();
+        drop(pair.slave);
+        let mut reader = pair.master.try_clone_reader().unwrap();
+        let writer = pair.master.take_writer().unwrap();
+        let parser = Arc::new(Mutex::new(vt100::Parser::new(rows, cols, 0)));
+        let raw = Arc::new(Mutex::new(Vec::new()));
+        let (p, r) = (parser.clone(), raw.clone());
+        std::thread::spawn(move || {
+            let mut buf = [0u8; 8192];
+            loop {
+                match reader.read(&mut buf) {
+                    Ok(0) | Err(_) => break,
+                    Ok(n) => {
+                        p.lock().unwrap().process(&buf[..n]);
+                        r.lock().unwrap().extend_from_slice(&buf[..n]);
+                    }
+                }
+            }
+        });
+        Console {
+            master: pair.master,
+            writer,
+            child,
+            parser,
+            raw,
+            dir,
+        }
+    }
+
+    fn screen(&self) -> String {
+        self.parser.lock().unwrap().screen().contents()
+    }
+
+    fn send(&mut self, keys: &str) {
+        self.writer.write_all(keys.as_bytes()).unwrap();
+        self.writer.flush().unwrap();
+        std::thread::sleep(Duration::from_millis(60));
+    }
+
+    /// Waits until the screen satisfies `f`, or fails showing the screen.
+    fn wait(&self, what: &str, secs: u64, f: impl Fn(&str) -> bool) -> String {
+        let end = Instant::now() + Duration::from_secs(secs);
+        loop {
+            let s = self.screen();
+            if f(&s) {
+                return s;
+            }
+            if Instant::now() > end {
+                panic!("timed out waiting for {what}; screen:\n{s}");
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+
+    fn wait_text(&self, text: &str, secs: u64) -> String {
+        self.wait(text, secs, |s| s.contains(text))
+    }
+
+    fn wait_exit(&mut self, secs: u64) {
+        let end = Instant::now() + Duration::from_secs(secs);
+        while Instant::now() < end {
+            if self.child.try_wait().unwrap().is_some() {
+                // Let the reader drain the last bytes.
+                std::thread::sleep(Duration::from_millis(200));
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        let _ = self.child.kill();
+        panic!("vss did not exit; screen:\n{}", self.screen());
+    }
+
+    fn session(&self) -> PathBuf {
+        self.dir.path().join("sessions").join("cube")
+    }
+}
+
+impl Drop for Console {
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+        }
+    }
+}
+
+/// The line count the Pipeline screen shows as `lines N raw M`.
+fn line_count(screen: &str) -> Option<usize> {
+    screen.match_indices("lines ").find_map(|(i, l)| {
+        let rest = &screen[i + l.len()..];
+        let digits: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
+        let after = &rest[digits.len()..];
+        if digits.is_empty() || !after.starts_with(" raw") {
+            return None;
+        }
+        digits.parse().ok()
+    })
+}
+
+/// Creates session `cube` and surveys `n` images by keys alone.
+fn survey(c: &mut Console, n: u32) {
+    c.wait_text("choose a session", 10);
+    c.send("n");
+    c.wait_text("new session name", 5);
+    c.send("cube\r");
+    c.wait_text("session cube", 10);
+    for k in 1..=n {
+        c.wait_text(&format!("Image {k}: camera"), 20);
+        c.send("\r");
+        c.wait(&format!("image {k} reviewed"), 60, |s| {
+            s.contains(&format!("Image {k}: ")) && s.contains("before CONNECT")
+        });
+        c.send("a");
+    }
+    c.wait_text(&format!("Image {}: camera", n + 1), 20);
+}
+
+fn exists(dir: &Path, name: &str) -> bool {
+    dir.join(name).is_file()
+}
+
+#[test]
+fn guided_survey_tweak_report_and_quit() {
+    let mut c = Console::start(100, 32, &[]);
+    survey(&mut c, 2);
+    // Pipeline: choose lines.min_length and raise it; fewer lines remain.
+    c.send("3");
+    let s = c.wait_text("parameters", 10);
+    let before = line_count(&s).expect("line count on the Pipeline screen");
+    let down = vss::llv::params::PARAMS
+        .iter()
+        .position(|p| p.key == "lines.min_length")
+        .unwrap();
+    for _ in 0..down {
+        c.send("\x1b[B");
+    }
+    c.send(">>>");
+    let s = c.wait("a different line count", 30, |s| {
+        s.contains("lines.min_length") && line_count(s).is_some_and(|n| n != before)
+    });
+    let after = line_count(&s).unwrap();
+    assert!(
+        after < before,
+        "raising lines.min_length keeps fewer lines: {before} -> {after}"
+    );
+    // Report.
+    c.send("5");
+    c.wait_text("files (", 10);
+    c.send("e");
+    c.wait_text("report written", 30);
+    c.send("q");
+    c.wait_exit(15);
+
+    let d = c.session();
+    for f in [
+        "cube.ses",
+        "cube1a.img",
+        "cube1b.img",
+        "cube1c.img",
+        "cube2a.img",
+        "cube2b.img",
+        "cube2c.img",
+        "cube1.hpo",
+        "cube1.vpo",
+        "cube1.lex",
+        "cube1.ldr",
+        "cube2.hpo",
+        "cube2.vpo",
+        "cube2.lex",
+        "cube2.ldr",
+    ] {
+        assert!(exists(&d, f), "{f} missing in {}", d.display());
+    }
+    let ses = std::fs::read_to_string(d.join("cube.ses")).unwrap();
+    let nums: Vec<u32> = ses.lines().filter_map(|l| l.trim().parse().ok()).collect();
+    // The session plans one image per camera (4); two are surveyed.
+    assert!(nums.first().is_some_and(|&n| n >= 2), ".ses: {ses}");
+    assert_eq!(nums.get(2), Some(&3), ".ses: {ses}");
+    let names: Vec<String> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        names.iter().any(|n| n.ends_with(".toml")),
+        "manifest in {names:?}"
+    );
+    assert!(
+        names.iter().any(|n| n.ends_with(".ps")),
+        "PostScript report in {names:?}"
+    );
+    assert!(
+        names.iter().any(|n| n.ends_with(".svg")),
+        "SVG report in {names:?}"
+    );
+    let img = vss::formats::img::read_img(&d.join("cube2b.img")).unwrap();
+    assert_eq!(img.image.size(), (128, 128));
+}
+
+#[test]
+fn resize_redraws_for_the_new_size() {
+    let mut c = Console::start(100, 30, &[]);
+    c.wait_text("choose a session", 10);
+    c.master
+        .resize(PtySize {
+            rows: 24,
+            cols: 80,
+            pixel_width: 0,
+            pixel_height: 0,
+        })
+        .unwrap();
+    c.parser.lock().unwrap().screen_mut().set_size(24, 80);
+    // The console redraws for the new size on its own (SIGWINCH)…
+    c.wait("a redraw at 80 x 24", 10, |s| {
+        s.lines().nth(23).is_some_and(|l| l.contains("quit")) && s.contains("choose a session")
+    });
+    // …and keeps taking keys.
+    c.send("2");
+    let s = c.wait_text("lights", 10);
+    let lines: Vec<&str> = s.lines().collect();
+    assert!(lines.len() <= 24);
+    assert!(
+        lines.first().unwrap().contains("1 Survey"),
+        "top bar after resize:\n{s}"
+    );
+    c.master
+        .resize(PtySize {
+            rows: 40,
+            cols: 120,
+            pixel_width: 0,
+            pixel_height: 0,
+        })
+        .unwrap();
+    c.parser.lock().unwrap().screen_mut().set_size(40, 120);
+    c.send("1");
+    let s = c.wait("status bar on the last row", 10, |s| {
+        s.lines().count() >= 39 && s.lines().last().is_some_and(|l| l.contains("quit"))
+    });
+    assert!(s.contains("choose a session"));
+    c.send("q");
+    c.wait_exit(10);
+}
+
+/// Every SGR sequence in `bytes` with a colour parameter.
+fn colour_sgr(bytes: &[u8]) -> Vec<String> {
+    let s = String::from_utf8_lossy(bytes);
+    let mut found = Vec::new();
+    let mut rest = &s[..];
+    while let Some(i) = rest.find("\x1b[") {
+        rest = &rest[i + 2..];
+        let end = rest
+            .find(|c: char| !(c.is_ascii_digit() || c == ';'))
+            .unwrap_or(rest.len());
+        if rest[end..].starts_with('m') {
+            let params: Vec<u32> = rest[..end]
+                .split(';')
+                .filter_map(|p| p.parse().ok())
+                .collect();
+            if params
+                .iter()
+                .any(|&p| (30..=49).contains(&p) || (90..=107).contains(&p))
+            {
+                found.push(rest[..end].to_string());
+            }
+        }
+        rest = &rest[end..];
+    }
+    found
+}
+
+#[test]
+fn no_color_writes_no_colour_and_previews_in_ascii() {
+    let mut c = Console::start(90, 28, &[("NO_COLOR", "1")]);
+    survey(&mut c, 1);
+    c.send("3");
+    c.wait_text("[ascii]", 10);
+    c.send("2");
+    c.send("g");
+    c.wait_text("camera 1 128", 20);
+    c.send("q");
+    c.wait_exit(10);
+    let raw = c.raw.lock().unwrap().clone();
+    let bad = colour_sgr(&raw);
+    assert!(
+        bad.is_empty(),
+        "colour SGR under NO_COLOR: {:?}",
+        &bad[..bad.len().min(5)]
+    );
+}
+
+#[test]
+fn idle_writes_nothing_and_hangup_restores_the_terminal() {
+    let mut c = Console::start(80, 24, &[]);
+    c.wait_text("choose a session", 10);
+    // Once the devices have answered, an idle console writes nothing.
+    c.wait_text("relay board", 10);
+    std::thread::sleep(Duration::from_millis(300));
+    let before = c.raw.lock().unwrap().len();
+    std::thread::sleep(Duration::from_millis(1500));
+    assert_eq!(
+        c.raw.lock().unwrap().len(),
+        before,
+        "an idle console wrote to the terminal"
+    );
+    let pid = c.child.process_id().expect("pid") as i32;
+    let rc = send_signal(pid, libc::SIGHUP);
+    assert_eq!(rc, 0);
+    c.wait_exit(10);
+    let raw = c.raw.lock().unwrap().clone();
+    let s = String::from_utf8_lossy(&raw);
+    let leave = s.rfind("\x1b[?1049l").expect("left the alternate screen");
+    assert!(leave > s.rfind("\x1b[?1049h").unwrap_or(0));
+    let show = s.rfind("\x1b[?25h").expect("cursor shown");
+    assert!(show > s.rfind("\x1b[?25l").unwrap_or(0));
+    assert!(
+        s.trim_end().ends_with("\x1b[?1049l"),
+        "ends with leaving the alternate screen: {:?}",
+        &s[s.len().saturating_sub(40)..]
+    );
+}
+
+/// Sends a signal with the `kill` command (the crate forbids `unsafe`).
+fn send_signal(pid: i32, sig: i32) -> i32 {
+    let st = std::process::Command::new("kill")
+        .args([format!("-{sig}"), pid.to_string()])
+        .status()
+        .unwrap();
+    if st.success() { 0 } else { 1 }
+}
