@@ -139,7 +139,8 @@ pub struct Lighting {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SurveyConfig {
-    /// Folder where new sessions are made.
+    /// Folder where new sessions are made; a relative path is relative to
+    /// the working folder (unlike `cdf`, which is relative to the profile).
     pub dir: PathBuf,
     pub cameras: u32,
     /// `.cdf` file per camera (index 0 is camera 1); relative to the profile.

@@ -251,10 +251,12 @@ impl Store {
         out
     }
 
-    /// Where sessions live: the profile's `survey.dir`, relative to the
-    /// profile's folder.
+    /// Where sessions live: the profile's `survey.dir`. A relative one is
+    /// taken from the folder the console was started in (where an operator
+    /// expects their survey), not the profile's folder (which may be the
+    /// installed, shared `profiles/`).
     fn survey_dir(&self) -> PathBuf {
-        self.profile.resolve_path(&self.profile.survey.dir)
+        self.profile.survey.dir.clone()
     }
 
     fn cdf_path(&self, camera: u32) -> Option<PathBuf> {
