@@ -106,6 +106,25 @@ impl Console {
         }
     }
 
+    /// Resizes the terminal: the parser first, under its lock, then the pty.
+    /// The console answers SIGWINCH with a clear and a full redraw; bytes it
+    /// wrote for the old size can only reach the parser before that clear,
+    /// so the screen read afterwards is the new size's (resizing the pty
+    /// first let a redraw be parsed at the old size).
+    fn resize(&mut self, rows: u16, cols: u16) {
+        let mut parser = self.parser.lock().unwrap();
+        parser.screen_mut().set_size(rows, cols);
+        self.master
+            .resize(PtySize {
+                rows,
+                cols,
+                pixel_width: 0,
+                pixel_height: 0,
+            })
+            .unwrap();
+        drop(parser);
+    }
+
     fn screen(&self) -> String {
         self.parser.lock().unwrap().screen().contents()
     }
@@ -278,15 +297,7 @@ fn guided_survey_tweak_report_and_quit() {
 fn resize_redraws_for_the_new_size() {
     let mut c = Console::start(100, 30, &[]);
     c.wait_text("choose a session", 10);
-    c.master
-        .resize(PtySize {
-            rows: 24,
-            cols: 80,
-            pixel_width: 0,
-            pixel_height: 0,
-        })
-        .unwrap();
-    c.parser.lock().unwrap().screen_mut().set_size(24, 80);
+    c.resize(24, 80);
     // The console redraws for the new size on its own (SIGWINCH)…
     c.wait("a redraw at 80 x 24", 10, |s| {
         s.lines().nth(23).is_some_and(|l| l.contains("quit")) && s.contains("choose a session")
@@ -300,15 +311,7 @@ fn resize_redraws_for_the_new_size() {
         lines.first().unwrap().contains("1 Survey"),
         "top bar after resize:\n{s}"
     );
-    c.master
-        .resize(PtySize {
-            rows: 40,
-            cols: 120,
-            pixel_width: 0,
-            pixel_height: 0,
-        })
-        .unwrap();
-    c.parser.lock().unwrap().screen_mut().set_size(40, 120);
+    c.resize(40, 120);
     c.send("1");
     let s = c.wait("status bar on the last row", 10, |s| {
         s.lines().count() >= 39 && s.lines().last().is_some_and(|l| l.contains("quit"))
