@@ -95,6 +95,7 @@ fn imgs(dir: &Path) -> Vec<String> {
         .map(|rd| {
             rd.filter_map(Result::ok)
                 .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.ends_with(".img"))
                 .collect()
         })
         .unwrap_or_default();
@@ -145,6 +146,26 @@ fn grab_and_lights_against_vss_sim() {
     assert_eq!(a.comment, "cube3a");
     let e = read_img(&session.join("cube3e.img")).expect("cube3e.img reads");
     assert!(a.image != e.image, "lighting changes the image");
+    // The frames are the session's: in its manifest, and the session checks.
+    let sess = vss::session::Session::inspect(&session).expect("grab made a session");
+    let letters: Vec<char> = sess
+        .load_images(3)
+        .expect("the manifest's images read")
+        .into_iter()
+        .map(|(l, _)| l)
+        .collect();
+    assert_eq!(letters, ['a', 'b', 'e']);
+    assert_eq!(sess.manifest().image(3).map(|r| r.camera), Some(2));
+    let check = vss()
+        .args(["session", "check"])
+        .arg(&session)
+        .output()
+        .expect("vss session check runs");
+    assert!(
+        check.status.success(),
+        "{}",
+        String::from_utf8_lossy(&check.stdout)
+    );
 
     // Existing images are not overwritten without --yes.
     let again = vss()

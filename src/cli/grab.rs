@@ -3,9 +3,14 @@
 //! verify the CRCs, save `NAMEKa.img` atomically. A failed capture saves
 //! nothing of its frame and exits non-zero with the reason; the frames
 //! already saved are kept.
+//!
+//! The images go through the session (`crate::session`): `DIR/NAME` is
+//! opened, or created from the profile, and its lock taken, so a console
+//! surveying the same session is not written under, and every frame lands
+//! in the manifest with the camera and its `.cdf`.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -13,10 +18,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use anyhow::{Context, bail};
 
 use super::Global;
-use crate::formats::img::{ImgFile, write_img};
+use crate::formats::img::ImgFile;
 use crate::formats::names::{SessionName, VssFile};
 use crate::rig::Cell;
 use crate::rig::sim::Faults;
+use crate::session::Session;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -75,8 +81,12 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             );
         }
     }
-    std::fs::create_dir_all(&a.session)
-        .with_context(|| format!("cannot create the session folder {}", a.session.display()))?;
+    let parent = match a.session.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let mut sess = Session::open_or_create(&parent, session.as_str(), &profile)
+        .with_context(|| format!("cannot open the session {}", a.session.display()))?;
     let faults = match &a.sim_faults {
         Some(s) => Faults::parse(s)?,
         None => Faults::default(),
@@ -103,12 +113,15 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     for (letter, _) in &files {
         cell.mask_for(*letter)?;
     }
+    let cdf = profile.cdf_path(a.camera).filter(|p| p.is_file());
+    sess.set_image_info(a.image, a.camera, 1, cdf.as_deref())
+        .context("cannot record the camera in the session")?;
     for (letter, path) in &files {
         let stem = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        capture_one(&mut cell, a.camera, *letter, path, &stem, &cancel).with_context(|| {
+        capture_one(&mut cell, &mut sess, &a, *letter, &stem, &cancel).with_context(|| {
             format!(
                 "capturing {stem} (camera {}, lighting {letter}) failed; nothing of it was saved",
                 a.camera
@@ -120,12 +133,13 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
 
 fn capture_one(
     cell: &mut Cell,
-    camera: u32,
+    sess: &mut Session,
+    a: &Args,
     letter: char,
-    path: &Path,
     stem: &str,
     cancel: &AtomicBool,
 ) -> anyhow::Result<()> {
+    let camera = a.camera;
     let mut err = std::io::stderr();
     let mut last_pct = u64::MAX;
     let mut progress = |done: usize, total: usize| {
@@ -141,7 +155,7 @@ fn capture_one(
     eprintln!();
     let cap = result?;
     let img = ImgFile::new(cap.image).with_comment(stem);
-    write_img(path, &img)?;
+    let path = sess.save_image(a.image, letter, &img)?;
     let on = if cap.lights_on.is_empty() {
         "ambient only".to_string()
     } else {
