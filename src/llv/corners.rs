@@ -129,94 +129,146 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
     i
 }
 
+/// Reusable buffers of [`close_corners_with`], so that a warm pipeline
+/// workspace closes corners without touching the heap.
+#[derive(Clone, Debug, Default)]
+pub struct CornerScratch {
+    ends: Vec<End>,
+    pts: Vec<Point>,
+    /// `(cell, endpoint)` sorted: a cell's endpoints are one contiguous run,
+    /// found by binary search, in place of a hash map of cells.
+    by_cell: Vec<((i64, i64), usize)>,
+    pairs: Vec<(usize, usize)>,
+    parent: Vec<usize>,
+    /// `(root, endpoint)` sorted: each cluster is one run, in root order.
+    clusters: Vec<(usize, usize)>,
+    /// The lines as they were before any move: every cluster decides on
+    /// these, so the result does not depend on the order of the clusters.
+    original: Vec<Segment>,
+    kept: Vec<usize>,
+    idx: Vec<usize>,
+    cands: Vec<(f64, usize, usize, Point)>,
+    used: Vec<usize>,
+}
+
 /// Moves endpoints of different lines that lie within `radius` (px) of each
 /// other to their lines' intersection, when that is within `radius` of each
 /// moved endpoint (module doc for the exact rule). `radius ≤ 0` (or NaN) does
 /// nothing. Lines are neither added nor removed nor reordered (the `Vec` is
 /// the pipeline's contract, leaving room to drop lines a corner swallows).
+/// Allocates its buffers afresh; [`close_corners_with`] reuses them.
 #[allow(clippy::ptr_arg)]
 pub fn close_corners(lines: &mut Vec<Segment>, radius: f64) {
+    close_corners_with(lines, radius, &mut CornerScratch::default());
+}
+
+/// [`close_corners`] with reusable buffers: once they have grown to the
+/// number of lines, it does not allocate.
+#[allow(clippy::ptr_arg)]
+pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerScratch) {
     if radius.is_nan() || radius <= 0.0 || lines.len() < 2 {
         return;
     }
     let min_len = MIN_LENGTH_RADII * radius;
-    let ends: Vec<End> = (0..lines.len())
-        .filter(|&l| lines[l].length() >= min_len)
-        .flat_map(|line| [End { line, b: false }, End { line, b: true }])
-        .filter(|&e| {
-            let p = end_point(lines, e);
-            p.x.is_finite() && p.y.is_finite()
-        })
-        .collect();
-    let pts: Vec<Point> = ends.iter().map(|&e| end_point(lines, e)).collect();
+    s.ends.clear();
+    s.ends.extend(
+        (0..lines.len())
+            .filter(|&l| lines[l].length() >= min_len)
+            .flat_map(|line| [End { line, b: false }, End { line, b: true }])
+            .filter(|&e| {
+                let p = end_point(lines, e);
+                p.x.is_finite() && p.y.is_finite()
+            }),
+    );
+    let ends = &s.ends;
+    s.pts.clear();
+    s.pts.extend(ends.iter().map(|&e| end_point(lines, e)));
+    let pts = &s.pts;
 
     // Close pairs, found through a grid of cells one radius wide so the cost
-    // stays near-linear for the few hundred lines of a real image.
+    // stays near-linear for the few hundred lines of a real image. Each pair
+    // is found once; their order does not matter (clusters do not depend on
+    // it, and the fallback sorts its candidates on a unique key).
     let cell = |p: Point| ((p.x / radius).floor() as i64, (p.y / radius).floor() as i64);
-    let mut order: Vec<usize> = (0..ends.len()).collect();
-    order.sort_by_key(|&k| cell(pts[k]));
-    let mut grid: std::collections::HashMap<(i64, i64), Vec<usize>> =
-        std::collections::HashMap::new();
-    for &k in &order {
-        grid.entry(cell(pts[k])).or_default().push(k);
-    }
-    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    s.by_cell.clear();
+    s.by_cell
+        .extend(pts.iter().enumerate().map(|(k, &p)| (cell(p), k)));
+    s.by_cell.sort_unstable();
+    let by_cell = &s.by_cell;
+    s.pairs.clear();
     for (k, &p) in pts.iter().enumerate() {
         let (cx, cy) = cell(p);
         for gx in cx - 1..=cx + 1 {
             for gy in cy - 1..=cy + 1 {
-                for &m in grid.get(&(gx, gy)).map_or(&[][..], |v| v.as_slice()) {
+                let from = by_cell.partition_point(|&(c, _)| c < (gx, gy));
+                let to = from + by_cell[from..].partition_point(|&(c, _)| c == (gx, gy));
+                for &(_, m) in &by_cell[from..to] {
                     if m > k && ends[m].line != ends[k].line && p.dist(pts[m]) <= radius {
-                        pairs.push((k, m));
+                        s.pairs.push((k, m));
                     }
                 }
             }
         }
     }
-    if pairs.is_empty() {
+    if s.pairs.is_empty() {
         return;
     }
 
-    let mut parent: Vec<usize> = (0..ends.len()).collect();
-    for &(k, m) in &pairs {
-        let (rk, rm) = (find(&mut parent, k), find(&mut parent, m));
+    // Union by smaller index: every cluster's root is its smallest endpoint.
+    s.parent.clear();
+    s.parent.extend(0..ends.len());
+    for &(k, m) in &s.pairs {
+        let (rk, rm) = (find(&mut s.parent, k), find(&mut s.parent, m));
         if rk != rm {
-            parent[rk.max(rm)] = rk.min(rm);
+            s.parent[rk.max(rm)] = rk.min(rm);
         }
     }
-    let mut clusters: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
-    for &(k, m) in &pairs {
-        for e in [k, m] {
-            let r = find(&mut parent, e);
-            let c = clusters.entry(r).or_default();
-            if !c.contains(&e) {
-                c.push(e);
-            }
-        }
+    // An endpoint in no pair is a cluster of one, which the `kept.len() < 2`
+    // test below skips anyway.
+    s.clusters.clear();
+    for e in 0..ends.len() {
+        let r = find(&mut s.parent, e);
+        s.clusters.push((r, e));
     }
+    s.clusters.sort_unstable();
 
-    let original = lines.clone();
-    for (_, mut members) in clusters {
-        members.sort_unstable();
+    s.original.clear();
+    s.original.extend_from_slice(lines);
+    let mut start = 0;
+    while start < s.clusters.len() {
+        let root = s.clusters[start].0;
+        let len = s.clusters[start..].partition_point(|&(r, _)| r == root);
+        let members = &s.clusters[start..start + len];
+        start += len;
         // Drop stubs: lines with both ends in this cluster.
-        let stub = |l: usize, members: &[usize]| {
-            members.iter().filter(|&&k| ends[k].line == l).count() > 1
-        };
-        let kept: Vec<usize> = members
-            .iter()
-            .copied()
-            .filter(|&k| !stub(ends[k].line, &members))
-            .collect();
-        if kept.len() < 2 {
+        let stub = |l: usize| members.iter().filter(|&&(_, k)| ends[k].line == l).count() > 1;
+        s.kept.clear();
+        s.kept.extend(
+            members
+                .iter()
+                .map(|&(_, k)| k)
+                .filter(|&k| !stub(ends[k].line)),
+        );
+        if s.kept.len() < 2 {
             continue;
         }
-        if let Some(p) = cluster_corner(&original, &ends, &pts, &kept, radius) {
-            for &k in &kept {
+        if let Some(p) = cluster_corner(&s.original, ends, pts, &s.kept, radius, &mut s.idx) {
+            for &k in &s.kept {
                 set_end(lines, ends[k], p);
             }
             continue;
         }
-        close_pairs(lines, &original, &ends, &pts, &kept, &pairs, radius);
+        close_pairs(
+            lines,
+            &s.original,
+            ends,
+            pts,
+            &s.kept,
+            &s.pairs,
+            radius,
+            &mut s.cands,
+            &mut s.used,
+        );
     }
 }
 
@@ -231,14 +283,17 @@ fn set_end(lines: &mut [Segment], e: End, p: Point) {
 }
 
 /// Step 2: one corner for the whole cluster, if it fits every endpoint.
+/// `idx` is scratch.
 fn cluster_corner(
     lines: &[Segment],
     ends: &[End],
     pts: &[Point],
     kept: &[usize],
     radius: f64,
+    idx: &mut Vec<usize>,
 ) -> Option<Point> {
-    let idx: Vec<usize> = kept.iter().map(|&k| ends[k].line).collect();
+    idx.clear();
+    idx.extend(kept.iter().map(|&k| ends[k].line));
     let spread = idx.iter().enumerate().any(|(n, &i)| {
         idx[n + 1..]
             .iter()
@@ -247,13 +302,15 @@ fn cluster_corner(
     if !spread {
         return None;
     }
-    let p = least_squares_point(lines, &idx)?;
+    let p = least_squares_point(lines, idx)?;
     kept.iter()
         .all(|&k| pts[k].dist(p) <= radius && keeps_direction(lines, ends[k], p, radius))
         .then_some(p)
 }
 
 /// Step 3: pairwise intersections, cheapest first, each endpoint once.
+/// `cands` and `used` are scratch.
+#[allow(clippy::too_many_arguments)]
 fn close_pairs(
     lines: &mut [Segment],
     original: &[Segment],
@@ -262,8 +319,10 @@ fn close_pairs(
     kept: &[usize],
     pairs: &[(usize, usize)],
     radius: f64,
+    cands: &mut Vec<(f64, usize, usize, Point)>,
+    used: &mut Vec<usize>,
 ) {
-    let mut cands: Vec<(f64, usize, usize, Point)> = Vec::new();
+    cands.clear();
     for &(k, m) in pairs {
         if !kept.contains(&k) || !kept.contains(&m) {
             continue;
@@ -284,9 +343,11 @@ fn close_pairs(
             cands.push((dk + dm, k, m, p));
         }
     }
-    cands.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
-    let mut used: Vec<usize> = Vec::new();
-    for (_, k, m, p) in cands {
+    // Each (k, m) occurs once, so the key is unique and an unstable sort
+    // (which, unlike the stable one, needs no buffer) gives the same order.
+    cands.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    used.clear();
+    for &(_, k, m, p) in cands.iter() {
         if used.contains(&k) || used.contains(&m) {
             continue;
         }

@@ -13,6 +13,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::connect::{ConnectScratch, connect_into};
+use super::corners::{CornerScratch, close_corners_with};
 use super::edges::{PeakScratch, Response, ResponseScratch, peaks_into, response_into};
 use super::image::GreyImage;
 use super::lens::{LensMap, correct_into};
@@ -86,6 +87,7 @@ pub struct Workspace {
     lines: LineScratch,
     connect: ConnectScratch,
     tmp: Vec<Segment>,
+    corners: CornerScratch,
     /// Whether `out` holds the results of a complete run.
     valid: bool,
 }
@@ -196,7 +198,11 @@ impl Workspace {
                 &mut self.connect,
             );
             if p.connect.corner_radius > 0.0 {
-                crate::llv::corners::close_corners(&mut self.out.lines, p.connect.corner_radius);
+                close_corners_with(
+                    &mut self.out.lines,
+                    p.connect.corner_radius,
+                    &mut self.corners,
+                );
             }
             self.out.timings.connect_us = micros(t);
         }
@@ -335,7 +341,7 @@ pub fn lines_from_edges(edges_h: EdgePoints, edges_v: EdgePoints, p: &Params) ->
         &mut ws.connect,
     );
     if p.connect.corner_radius > 0.0 {
-        crate::llv::corners::close_corners(&mut ws.out.lines, p.connect.corner_radius);
+        close_corners_with(&mut ws.out.lines, p.connect.corner_radius, &mut ws.corners);
     }
     ws.out.timings.connect_us = micros(t);
     ws.take_outputs()
