@@ -313,10 +313,17 @@ fn resize_redraws_for_the_new_size() {
     );
     c.resize(40, 120);
     c.send("1");
-    let s = c.wait("status bar on the last row", 10, |s| {
-        s.lines().count() >= 39 && s.lines().last().is_some_and(|l| l.contains("quit"))
-    });
-    assert!(s.contains("choose a session"));
+    // The redraw for 120 x 40 can land before the "1" is read, so wait for
+    // both: the survey screen, drawn at the new size.
+    c.wait(
+        "the survey screen with its status bar on the last row",
+        10,
+        |s| {
+            s.lines().count() >= 39
+                && s.lines().last().is_some_and(|l| l.contains("quit"))
+                && s.contains("choose a session")
+        },
+    );
     c.send("q");
     c.wait_exit(10);
 }
