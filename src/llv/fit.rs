@@ -167,7 +167,10 @@ impl LineFit {
         }
         let (s11, s22, s12) = self.scatter();
         let half = 0.5 * (s11 - s22);
-        let lmax = 0.5 * (s11 + s22) + half.hypot(s12);
+        // `sqrt` of the sum rather than `hypot`: the scatter entries are far
+        // from overflow, and `hypot` is a libm call the extractor made after
+        // every point.
+        let lmax = 0.5 * (s11 + s22) + (half * half + s12 * s12).sqrt();
         let v1 = (s12, lmax - s11);
         let v2 = (lmax - s22, s12);
         let n1 = v1.0 * v1.0 + v1.1 * v1.1;
