@@ -169,13 +169,6 @@ impl Cursor {
     }
 }
 
-/// Floor of a finite `x` as an integer (no libm call; saturating).
-#[inline]
-fn floor_i64(x: f64) -> i64 {
-    let t = x as i64;
-    if (t as f64) > x { t - 1 } else { t }
-}
-
 /// Bitmaps of the points by scan line and rounded `u` (one bit a pixel
 /// column): every point, and the points not yet used. The template scores
 /// and the successor test then read a few bits instead of walking the
@@ -272,8 +265,11 @@ impl Grid {
 
     /// [`has_successor`] from the bitmaps: an unused point with `u` in
     /// `[u − reach, u + reach]` on scan line `row + i`, `reach = i + sw`.
-    /// Columns whose whole pixel lies inside are decided by their bit; the
-    /// one or two columns at each end by the point itself.
+    /// A point's `u` is within ½ px of its column, so the columns
+    /// `iu ± (⌊reach⌋ + 2)` hold every candidate: when their bits are clear
+    /// (most start points on noise) the answer is no, in integer work alone.
+    /// A column whose whole pixel lies inside the reach decides by its bit;
+    /// the ones at the ends by the point itself.
     fn has_successor(
         &self,
         s: &LineScratch,
@@ -289,47 +285,24 @@ impl Grid {
                 return false;
             }
             let reach = i as f64 + sw;
+            let half = reach as i64 + 2;
+            let lo = sp.iu - half;
+            let mut bits = self.window(&self.unused, r, lo, (2 * half + 1) as u32);
             let (a, b) = (sp.u as f64 - reach, sp.u as f64 + reach);
-            // Candidates: round(u) for u in [a, b] lies in [floor a, ceil b].
-            let lo = floor_i64(a);
-            let hi = -floor_i64(-b);
-            let n = (hi - lo + 1) as u32;
-            let bits = self.window(&self.unused, r, lo, n);
-            if bits == 0 {
-                return false;
-            }
-            // Columns c with [c − ½, c + ½] inside [a, b].
-            let mut sure_lo = lo;
-            while (sure_lo as f64) - 0.5 < a {
-                sure_lo += 1;
-            }
-            let mut sure_hi = hi;
-            while (sure_hi as f64) + 0.5 > b {
-                sure_hi -= 1;
-            }
-            if sure_lo <= sure_hi {
-                let k0 = (sure_lo - lo) as u32;
-                let len = (sure_hi - sure_lo + 1) as u32;
-                let mask = if len >= 64 {
-                    u64::MAX
-                } else {
-                    ((1u64 << len) - 1) << k0
-                };
-                if bits & mask != 0 {
-                    return true;
-                }
-            }
-            // The end columns: look at the point.
-            let (rlo, rhi) = (s.row_start[r] as usize, s.row_start[r + 1] as usize);
-            let mut rest = bits;
-            while rest != 0 {
-                let c = lo + rest.trailing_zeros() as i64;
-                rest &= rest - 1;
-                if (sure_lo..=sure_hi).contains(&c) {
+            while bits != 0 {
+                let c = lo + bits.trailing_zeros() as i64;
+                bits &= bits - 1;
+                let (left, right) = (c as f64 - 0.5, c as f64 + 0.5);
+                if right < a || left > b {
                     continue;
                 }
-                let k = rlo + s.points[rlo..rhi].partition_point(|q| q.iu < c);
-                if let Some(q) = s.points[rlo..rhi].get(k - rlo) {
+                if left >= a && right <= b {
+                    return true;
+                }
+                // An end column: look at the point.
+                let (rlo, rhi) = (s.row_start[r] as usize, s.row_start[r + 1] as usize);
+                let line = &s.points[rlo..rhi];
+                if let Some(q) = line.get(line.partition_point(|q| q.iu < c)) {
                     let u = q.u as f64;
                     if q.iu == c && u >= a && u <= b {
                         return true;
@@ -463,7 +436,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
     s.used.resize(total, false);
     let mut grid = std::mem::take(&mut s.grid);
     let sw = p.search_width;
-    let window_fits = sw.is_finite() && sw >= 0.0 && p.max_gap as f64 + sw <= 30.0;
+    let window_fits = sw.is_finite() && sw >= 0.0 && p.max_gap as f64 + sw <= 28.0;
     #[cfg(test)]
     let window_fits = window_fits && !s.walk_only;
     let use_grid = window_fits && grid.build(&s.points, &s.row_start, nrows);
@@ -740,7 +713,9 @@ mod tests {
     /// column the test may look at) still starts the line.
     #[test]
     fn a_successor_at_the_edge_of_the_reach_starts_a_line() {
-        let pts: Vec<(f32, f32)> = (0..30).map(|y| (10.25 + 2.0 * y as f32, y as f32)).collect();
+        let pts: Vec<(f32, f32)> = (0..30)
+            .map(|y| (10.25 + 2.0 * y as f32, y as f32))
+            .collect();
         let p = LineParams {
             search_width: 1.0,
             ..LineParams::default()
