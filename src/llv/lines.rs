@@ -504,6 +504,16 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
                     Some(m) if fit.len() >= 2 => m.x + (r as f64 - m.y) * slope,
                     _ => last.u as f64 + i as f64 * slope,
                 };
+                // No unused point near the prediction at all (how a noise
+                // track usually ends): the bitmap says so without a search.
+                // Every candidate's column is within sw + ½ of `pred`.
+                if use_grid && pred.abs() < 1e9 {
+                    let half = sw as i64 + 2;
+                    let lo = pred as i64 - half;
+                    if grid.window(&grid.unused, r, lo, (2 * half + 1) as u32) == 0 {
+                        continue;
+                    }
+                }
                 let (lo, hi) = (s.row_start[r] as usize, s.row_start[r + 1] as usize);
                 let row = &s.points[lo..hi];
                 let first = row.partition_point(|q| (q.u as f64) < pred - sw);
@@ -567,6 +577,13 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
         }
         let response = resp_sum / fit.len() as f64;
         if response.abs() < p.min_response {
+            continue;
+        }
+        // Projection onto a line never lengthens a segment: a track whose
+        // ends are no further apart than `min_length` (less a hair for
+        // rounding) is dropped before its line is computed.
+        let (du, dv) = (last.u as f64 - sp.u as f64, last.v as f64 - sp.v as f64);
+        if p.min_length > 0.0 && du * du + dv * dv < p.min_length * p.min_length * (1.0 - 1e-9) {
             continue;
         }
         let Some(line) = fit.line() else { continue };
