@@ -1,0 +1,232 @@
+//! The undistortion map ([`LensMap`]), laid out for fast resampling.
+//!
+//! Lens distortion is smooth: along a row of the corrected image the source
+//! of consecutive pixels usually moves by exactly one pixel, on the same
+//! source row, for tens to hundreds of pixels. The map therefore stores
+//! *runs* (output span → first source index, the k-th pixel's source being
+//! `src + k`) plus one byte per pixel for each interpolation fraction. The
+//! resampler then reads contiguous slices of two source rows and the weight
+//! planes, a loop the compiler vectorises, instead of gathering four pixels
+//! through a per-pixel index (8 bytes of map per pixel before, 2 now).
+//!
+//! A fraction can round to a whole pixel (256/256) when the source lies
+//! within 1/512 px of the next pixel column or row; such pixels (a few per
+//! thousand) do not fit a byte and are recomputed afterwards from their exact
+//! entry in `fixups`, so the bulk loop needs no branch for them.
+
+/// Fixed-point steps per pixel of the interpolation weights.
+pub(super) const FRAC: u32 = 256;
+
+/// `Run::src` of a run whose source lies outside the image.
+pub(super) const OUTSIDE: usize = usize::MAX;
+
+/// Consecutive output pixels of one row whose top-left source pixels are
+/// consecutive too (or which are all outside the image).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Run {
+    /// Output index (`y * width + x`) of the first pixel.
+    pub start: usize,
+    pub len: usize,
+    /// Source index of the first pixel's top-left neighbour, or [`OUTSIDE`].
+    /// Always `src + len` ≤ the last-but-one column of a row ≤ the
+    /// last-but-one row, so `src + k + 1 + width` is inside the image.
+    pub src: usize,
+}
+
+/// A pixel whose exact fraction is a whole pixel (256): its bytes in the
+/// fraction planes are placeholders, and its run may imply a different (but
+/// in-bounds) source index.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Fixup {
+    pub out: usize,
+    pub src: usize,
+    pub fx: u16,
+    pub fy: u16,
+}
+
+/// Where each pixel of the corrected image was observed, ready for bilinear
+/// sampling: for output pixel `i = y * width + x`, the top-left source pixel
+/// of its 2 × 2 neighbourhood (or "outside the image") and the offsets from
+/// it in 1/256 px. An identity map (no distortion) holds no arrays at all and
+/// correction costs nothing.
+///
+/// Fixed-point weights keep the per-pixel work to integer multiply-adds (the
+/// 1/256 px quantisation is far below the edge detector's accuracy). See the
+/// module documentation for the layout (about 2 bytes per pixel).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LensMap {
+    pub(super) width: usize,
+    pub(super) height: usize,
+    /// Every output pixel in order, split into runs; the runs of row `y` are
+    /// `runs[row_runs[y]..row_runs[y + 1]]`.
+    pub(super) runs: Vec<Run>,
+    pub(super) row_runs: Vec<usize>,
+    /// Per output pixel, the offsets from the top-left source pixel in
+    /// 1/256 px (0 outside and for fixups).
+    pub(super) fx: Vec<u8>,
+    pub(super) fy: Vec<u8>,
+    /// Pixels whose offset is 256/256, sorted by output index.
+    pub(super) fixups: Vec<Fixup>,
+    /// Whether some pixel's source lies outside the image.
+    pub(super) any_outside: bool,
+}
+
+impl LensMap {
+    /// The map of camera `m` for images of `width × height` pixels.
+    pub fn new(m: &super::CameraModel, width: usize, height: usize) -> LensMap {
+        if m.is_identity() {
+            return LensMap::identity(width, height);
+        }
+        LensMap::from_sources(width, height, |x, y| {
+            m.ideal_to_observed_converged(x as f64, y as f64)
+        })
+    }
+
+    /// A map from any source function `(x, y) → (xs, ys)`.
+    pub fn from_sources(
+        width: usize,
+        height: usize,
+        source: impl Fn(usize, usize) -> (f64, f64),
+    ) -> LensMap {
+        let n = width.saturating_mul(height);
+        if n == 0 {
+            return LensMap::identity(width, height);
+        }
+        let mut map = LensMap {
+            width,
+            height,
+            runs: Vec::new(),
+            row_runs: Vec::with_capacity(height + 1),
+            fx: Vec::with_capacity(n),
+            fy: Vec::with_capacity(n),
+            fixups: Vec::new(),
+            any_outside: false,
+        };
+        let (xmax, ymax) = (
+            width.saturating_sub(1) as f64,
+            height.saturating_sub(1) as f64,
+        );
+        let too_big = width < 2 || height < 2 || n >= u32::MAX as usize;
+        for y in 0..height {
+            map.row_runs.push(map.runs.len());
+            // The open run of this row: `None` for none or an outside run,
+            // else its source row and column offset `x0 - x`.
+            let mut key: Option<(usize, isize)> = None;
+            for x in 0..width {
+                let o = y * width + x;
+                let (xs, ys) = source(x, y);
+                // Inside the hull of the pixel centres, with a sliver of
+                // tolerance for rounding at the exact border.
+                let inside = xs >= -1e-3 && ys >= -1e-3 && xs <= xmax + 1e-3 && ys <= ymax + 1e-3;
+                if !inside || too_big {
+                    map.fx.push(0);
+                    map.fy.push(0);
+                    map.any_outside = true;
+                    match map.runs.last_mut() {
+                        Some(r) if r.src == OUTSIDE && r.start + r.len == o && x > 0 => r.len += 1,
+                        _ => map.runs.push(Run {
+                            start: o,
+                            len: 1,
+                            src: OUTSIDE,
+                        }),
+                    }
+                    key = None;
+                    continue;
+                }
+                let (xc, yc) = (xs.clamp(0.0, xmax), ys.clamp(0.0, ymax));
+                let x0 = (xc as usize).min(width - 2);
+                let y0 = (yc as usize).min(height - 2);
+                let fx = ((xc - x0 as f64) * FRAC as f64).round() as u16;
+                let fy = ((yc - y0 as f64) * FRAC as f64).round() as u16;
+                let fits = fx < FRAC as u16 && fy < FRAC as u16;
+                map.fx.push(if fits { fx as u8 } else { 0 });
+                map.fy.push(if fits { fy as u8 } else { 0 });
+                if !fits {
+                    map.fixups.push(Fixup {
+                        out: o,
+                        src: y0 * width + x0,
+                        fx,
+                        fy,
+                    });
+                }
+                let mine = (y0, x0 as isize - x as isize);
+                // A fixup pixel takes whatever source its run implies, as
+                // long as that keeps the 2 × 2 reads inside the image.
+                let joins = key.is_some_and(|k| {
+                    let x0k = x as isize + k.1;
+                    if fits {
+                        k == mine
+                    } else {
+                        x0k >= 0 && x0k <= width as isize - 2
+                    }
+                });
+                match map.runs.last_mut() {
+                    Some(r) if joins => r.len += 1,
+                    _ => {
+                        map.runs.push(Run {
+                            start: o,
+                            len: 1,
+                            src: y0 * width + x0,
+                        });
+                        key = Some(mine);
+                    }
+                }
+            }
+        }
+        map.row_runs.push(map.runs.len());
+        map
+    }
+
+    /// The identity map of a size (what a `.cdf` without distortion gives).
+    pub fn identity(width: usize, height: usize) -> LensMap {
+        LensMap {
+            width,
+            height,
+            ..LensMap::default()
+        }
+    }
+
+    /// True when correction changes nothing (and the pipeline skips it).
+    pub fn is_identity(&self) -> bool {
+        self.runs.is_empty()
+    }
+
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// The observed position of output pixel `(x, y)` (to 1/256 px);
+    /// `None` outside the image or where the source is outside.
+    pub fn source(&self, x: usize, y: usize) -> Option<(f32, f32)> {
+        if x >= self.width || y >= self.height {
+            return None;
+        }
+        if self.is_identity() {
+            return Some((x as f32, y as f32));
+        }
+        let o = y * self.width + x;
+        let (i, fx, fy) = match self.fixups.binary_search_by_key(&o, |f| f.out) {
+            Ok(k) => {
+                let f = self.fixups.get(k)?;
+                (f.src, f.fx, f.fy)
+            }
+            Err(_) => {
+                let row = self
+                    .runs
+                    .get(*self.row_runs.get(y)?..*self.row_runs.get(y + 1)?)?;
+                let r = row.get(row.partition_point(|r| r.start + r.len <= o))?;
+                if r.src == OUTSIDE {
+                    return None;
+                }
+                let fx = *self.fx.get(o)?;
+                let fy = *self.fy.get(o)?;
+                (r.src + (o - r.start), fx as u16, fy as u16)
+            }
+        };
+        let (x0, y0) = (i % self.width, i / self.width);
+        Some((
+            x0 as f32 + fx as f32 / FRAC as f32,
+            y0 as f32 + fy as f32 / FRAC as f32,
+        ))
+    }
+}
