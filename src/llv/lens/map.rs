@@ -65,8 +65,13 @@ pub struct LensMap {
     /// 1/256 px (0 outside and for fixups).
     pub(super) fx: Vec<u8>,
     pub(super) fy: Vec<u8>,
-    /// Pixels whose offset is 256/256, sorted by output index.
+    /// Pixels with an offset of 256/256 that the runs cannot sample (at
+    /// the last column or row), sorted by output index.
     pub(super) fixups: Vec<Fixup>,
+    /// Pixels with an offset of 256/256 that the runs sample from the next
+    /// column (row) with offset 0: the same value, but a different 2 × 2
+    /// neighbourhood for the validity. Sorted by output index.
+    pub(super) shifted: Vec<Fixup>,
     /// Whether some pixel's source lies outside the image.
     pub(super) any_outside: bool,
 }
@@ -100,6 +105,7 @@ impl LensMap {
             fx: Vec::with_capacity(n),
             fy: Vec::with_capacity(n),
             fixups: Vec::new(),
+            shifted: Vec::new(),
             any_outside: false,
         };
         let (xmax, ymax) = (
@@ -138,16 +144,32 @@ impl LensMap {
                 let y0 = (yc as usize).min(height - 2);
                 let fx = ((xc - x0 as f64) * FRAC as f64).round() as u16;
                 let fy = ((yc - y0 as f64) * FRAC as f64).round() as u16;
-                let fits = fx < FRAC as u16 && fy < FRAC as u16;
+                let exact = Fixup {
+                    out: o,
+                    src: y0 * width + x0,
+                    fx,
+                    fy,
+                };
+                // A whole-pixel fraction samples the next column (row) with
+                // weight 256, which is the same value as sampling from that
+                // column with fraction 0 (only the 2 × 2 neighbourhood, and
+                // so the validity, differs).
+                let whole = FRAC as u16;
+                let (x0, fx) = match fx == whole && x0 + 2 < width {
+                    true => (x0 + 1, 0),
+                    false => (x0, fx),
+                };
+                let (y0, fy) = match fy == whole && y0 + 2 < height {
+                    true => (y0 + 1, 0),
+                    false => (y0, fy),
+                };
+                let fits = fx < whole && fy < whole;
                 map.fx.push(if fits { fx as u8 } else { 0 });
                 map.fy.push(if fits { fy as u8 } else { 0 });
                 if !fits {
-                    map.fixups.push(Fixup {
-                        out: o,
-                        src: y0 * width + x0,
-                        fx,
-                        fy,
-                    });
+                    map.fixups.push(exact);
+                } else if y0 * width + x0 != exact.src {
+                    map.shifted.push(exact);
                 }
                 let mine = (y0, x0 as isize - x as isize);
                 // A fixup pixel takes whatever source its run implies, as
@@ -205,12 +227,12 @@ impl LensMap {
             return Some((x as f32, y as f32));
         }
         let o = y * self.width + x;
-        let (i, fx, fy) = match self.fixups.binary_search_by_key(&o, |f| f.out) {
-            Ok(k) => {
-                let f = self.fixups.get(k)?;
-                (f.src, f.fx, f.fy)
-            }
-            Err(_) => {
+        fn find(list: &[Fixup], o: usize) -> Option<&Fixup> {
+            list.get(list.binary_search_by_key(&o, |f| f.out).ok()?)
+        }
+        let (i, fx, fy) = match find(&self.fixups, o).or_else(|| find(&self.shifted, o)) {
+            Some(f) => (f.src, f.fx, f.fy),
+            None => {
                 let row = self
                     .runs
                     .get(*self.row_runs.get(y)?..*self.row_runs.get(y + 1)?)?;

@@ -44,19 +44,25 @@ fn pixel(p00: u8, p10: u8, p01: u8, p11: u8, fx: u8, fy: u8) -> u8 {
     ((h + (l >> 8) + 128) >> 8) as u8
 }
 
-/// One vector step: `LANES` consecutive output pixels.
+/// `LANES` bytes of `s` from `k`, as an array (the compiler then knows the
+/// length and emits one vector load).
+#[inline(always)]
+fn lanes(s: &[u8], k: usize) -> Option<&[u8; LANES]> {
+    s.get(k..k + LANES)?.try_into().ok()
+}
+
+/// One vector step: `LANES` consecutive output pixels; `a0`, `a1` are the
+/// top row at the pixels' left and right neighbours, `b0`, `b1` the bottom.
 #[inline(always)]
 fn step(
-    a: &[u8; LANES + 1],
-    b: &[u8; LANES + 1],
+    [a0, a1, b0, b1]: [&[u8; LANES]; 4],
     fx: &[u8; LANES],
     fy: &[u8; LANES],
-) -> [u8; LANES] {
-    let mut o = [0u8; LANES];
+    out: &mut [u8; LANES],
+) {
     for j in 0..LANES {
-        o[j] = pixel(a[j], a[j + 1], b[j], b[j + 1], fx[j], fy[j]);
+        out[j] = pixel(a0[j], a1[j], b0[j], b1[j], fx[j], fy[j]);
     }
-    o
 }
 
 /// Resamples one run: `out[k]` from `a[k..k + 2]` (top source row),
@@ -79,18 +85,17 @@ fn run(a: &[u8], b: &[u8], fx: &[u8], fy: &[u8], out: &mut [u8]) {
     let mut k = 0;
     loop {
         let chunks = (
-            a.get(k..k + LANES + 1)
-                .and_then(|s| <&[u8; LANES + 1]>::try_from(s).ok()),
-            b.get(k..k + LANES + 1)
-                .and_then(|s| <&[u8; LANES + 1]>::try_from(s).ok()),
-            fx.get(k..k + LANES)
-                .and_then(|s| <&[u8; LANES]>::try_from(s).ok()),
-            fy.get(k..k + LANES)
-                .and_then(|s| <&[u8; LANES]>::try_from(s).ok()),
-            out.get_mut(k..k + LANES),
+            lanes(a, k),
+            lanes(a, k + 1),
+            lanes(b, k),
+            lanes(b, k + 1),
+            lanes(fx, k),
+            lanes(fy, k),
+            out.get_mut(k..k + LANES)
+                .and_then(|s| <&mut [u8; LANES]>::try_from(s).ok()),
         );
-        if let (Some(a), Some(b), Some(fx), Some(fy), Some(o)) = chunks {
-            o.copy_from_slice(&step(a, b, fx, fy));
+        if let (Some(a0), Some(a1), Some(b0), Some(b1), Some(fx), Some(fy), Some(o)) = chunks {
+            step([a0, a1, b0, b1], fx, fy, o);
         }
         if k + LANES >= n {
             break;
@@ -179,7 +184,7 @@ pub(super) fn masked(smask: &[bool], map: &LensMap, mask: &mut [bool], out: &mut
             *m = a0 & a1 & b0 & b1;
         }
     }
-    for f in &map.fixups {
+    for f in map.fixups.iter().chain(&map.shifted) {
         if let (Some(a), Some(b), Some(m)) = (
             smask.get(f.src..f.src + 2),
             smask.get(f.src + w..f.src + w + 2),
