@@ -237,4 +237,43 @@ mod tests {
         assert!(!c.is_valid(4, h - 1));
         assert!(c.is_valid(w - 2, h - 2));
     }
+
+    #[test]
+    fn an_invalid_source_pixel_invalidates_exactly_the_outputs_that_touch_it() {
+        // Shift by (0.25, 0.5): output (x, y) samples source x..=x+1, y..=y+1.
+        let (w, h) = (45usize, 23usize);
+        let map = LensMap::from_sources(w, h, |x, y| (x as f64 + 0.25, y as f64 + 0.5));
+        let pixels: Vec<u8> = (0..w * h).map(|i| (i * 37 % 256) as u8).collect();
+        let plain = correct(&GreyImage::new(w, h, pixels.clone()).unwrap(), &map).unwrap();
+        // One invalid source pixel, then a scatter of them.
+        let one: Vec<bool> = (0..w * h).map(|i| i != 7 * w + 10).collect();
+        let scatter: Vec<bool> = (0..w * h).map(|i| i * 7919 % 13 != 0).collect();
+        for smask in [one, scatter] {
+            let mut img = GreyImage::new(w, h, pixels.clone()).unwrap();
+            img.set_valid_mask(Some(smask.clone())).unwrap();
+            let c = correct(&img, &map).unwrap();
+            for y in 0..h {
+                for x in 0..w {
+                    let touched_ok = x + 1 < w
+                        && y + 1 < h
+                        && [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]
+                            .iter()
+                            .all(|&(sx, sy)| smask[sy * w + sx]);
+                    assert_eq!(c.is_valid(x, y), touched_ok, "output ({x}, {y})");
+                    let want = if touched_ok { plain.get(x, y) } else { Some(0) };
+                    assert_eq!(c.get(x, y), want, "value at ({x}, {y})");
+                }
+            }
+        }
+        // The single invalid pixel (10, 7) spoils exactly four outputs.
+        let mut img = GreyImage::new(w, h, pixels).unwrap();
+        img.set_valid_mask(Some((0..w * h).map(|i| i != 7 * w + 10).collect()))
+            .unwrap();
+        let c = correct(&img, &map).unwrap();
+        let spoiled: Vec<(usize, usize)> = (0..h - 1)
+            .flat_map(|y| (0..w - 1).map(move |x| (x, y)))
+            .filter(|&(x, y)| !c.is_valid(x, y))
+            .collect();
+        assert_eq!(spoiled, [(9, 6), (10, 6), (9, 7), (10, 7)]);
+    }
 }
