@@ -80,27 +80,57 @@ fn run(a: &[u8], b: &[u8], fx: &[u8], fy: &[u8], out: &mut [u8]) {
         }
         return;
     }
-    // Full steps, then one last step aligned to the end of the run (it
+    let (Some(a0), Some(a1), Some(b0), Some(b1), Some(fx), Some(fy)) = (
+        a.get(..n),
+        a.get(1..n + 1),
+        b.get(..n),
+        b.get(1..n + 1),
+        fx.get(..n),
+        fy.get(..n),
+    ) else {
+        return;
+    };
+    // Whole steps, walking all seven slices in lockstep (no per-step
+    // bounds checks) ...
+    let steps = out
+        .chunks_exact_mut(LANES)
+        .zip(a0.chunks_exact(LANES))
+        .zip(a1.chunks_exact(LANES))
+        .zip(b0.chunks_exact(LANES))
+        .zip(b1.chunks_exact(LANES))
+        .zip(fx.chunks_exact(LANES))
+        .zip(fy.chunks_exact(LANES));
+    for ((((((o, a0), a1), b0), b1), fx), fy) in steps {
+        // Exact chunks: the conversions cannot fail (and compile away).
+        if let (Ok(o), Ok(a0), Ok(a1), Ok(b0), Ok(b1), Ok(fx), Ok(fy)) = (
+            o.try_into(),
+            a0.try_into(),
+            a1.try_into(),
+            b0.try_into(),
+            b1.try_into(),
+            fx.try_into(),
+            fy.try_into(),
+        ) {
+            step([a0, a1, b0, b1], fx, fy, o);
+        }
+    }
+    // ... then one step aligned to the end of the run for the remainder (it
     // recomputes a few pixels with the same result).
-    let mut k = 0;
-    loop {
+    if n % LANES != 0 {
+        let k = n - LANES;
         let chunks = (
-            lanes(a, k),
-            lanes(a, k + 1),
-            lanes(b, k),
-            lanes(b, k + 1),
+            lanes(a0, k),
+            lanes(a1, k),
+            lanes(b0, k),
+            lanes(b1, k),
             lanes(fx, k),
             lanes(fy, k),
-            out.get_mut(k..k + LANES)
+            out.get_mut(k..)
                 .and_then(|s| <&mut [u8; LANES]>::try_from(s).ok()),
         );
         if let (Some(a0), Some(a1), Some(b0), Some(b1), Some(fx), Some(fy), Some(o)) = chunks {
             step([a0, a1, b0, b1], fx, fy, o);
         }
-        if k + LANES >= n {
-            break;
-        }
-        k = (k + LANES).min(n - LANES);
     }
 }
 
