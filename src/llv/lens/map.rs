@@ -10,9 +10,13 @@
 //! through a per-pixel index (8 bytes of map per pixel before, 2 now).
 //!
 //! A fraction can round to a whole pixel (256/256) when the source lies
-//! within 1/512 px of the next pixel column or row; such pixels (a few per
-//! thousand) do not fit a byte and are recomputed afterwards from their exact
-//! entry in `fixups`, so the bulk loop needs no branch for them.
+//! within 1/512 px below the next pixel column or row (about 2 % of the
+//! pixels of a typical camera: wherever the distortion is a hair negative).
+//! Such a pixel samples the same value from the next column (row) with
+//! fraction 0, so the runs do that and `shifted` keeps the exact entry for
+//! the validity, which depends on the true 2 × 2 neighbourhood. Only at the
+//! last column or row is there no next one to use: those few pixels are
+//! recomputed afterwards from `fixups`, so the bulk loop needs no branch.
 
 /// Fixed-point steps per pixel of the interpolation weights.
 pub(super) const FRAC: u32 = 256;
@@ -28,14 +32,15 @@ pub(super) struct Run {
     pub start: usize,
     pub len: usize,
     /// Source index of the first pixel's top-left neighbour, or [`OUTSIDE`].
-    /// Always `src + len` ≤ the last-but-one column of a row ≤ the
-    /// last-but-one row, so `src + k + 1 + width` is inside the image.
+    /// For every `k < len`, source pixel `src + k` lies at most in the
+    /// last-but-one column and row, so `src + k + 1 + width` is inside.
     pub src: usize,
 }
 
-/// A pixel whose exact fraction is a whole pixel (256): its bytes in the
-/// fraction planes are placeholders, and its run may imply a different (but
-/// in-bounds) source index.
+/// The exact entry of a pixel whose fraction is a whole pixel (256): in
+/// `fixups` its bytes in the fraction planes are placeholders and its run
+/// may imply another (in-bounds) source; in `shifted` its run samples the
+/// next column (row) with fraction 0.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) struct Fixup {
     pub out: usize,
