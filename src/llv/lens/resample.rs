@@ -490,6 +490,29 @@ mod tests {
     }
 
     #[test]
+    fn the_16_bit_form_equals_the_reference_for_every_fraction() {
+        // Every (fx, fy) below 256 with the extreme neighbourhoods (where an
+        // overflow would show; the debug build also checks every step) and
+        // random ones.
+        let mut rng = Rng(5);
+        let mut quads: Vec<[u8; 4]> = (0..16u8)
+            .map(|m| [0, 1, 2, 3].map(|b| if m >> b & 1 == 1 { 255 } else { 0 }))
+            .collect();
+        quads.extend((0..48).map(|_| [0; 4].map(|_: u8| rng.below(256) as u8)));
+        for fx in 0..=255u8 {
+            for fy in 0..=255u8 {
+                for &[p00, p10, p01, p11] in &quads {
+                    assert_eq!(
+                        pixel(p00, p10, p01, p11, fx, fy),
+                        exact(p00, p10, p01, p11, fx as u16, fy as u16),
+                        "{p00} {p10} {p01} {p11} at ({fx}, {fy})"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn a_reused_output_is_the_same_as_a_fresh_one() {
         let (w, h) = (37, 53);
         let m = random_camera(w, h, &mut Rng(11));
