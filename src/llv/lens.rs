@@ -12,6 +12,11 @@ use serde::{Deserialize, Serialize};
 use super::LlvError;
 use super::image::GreyImage;
 
+mod map;
+mod resample;
+
+pub use map::LensMap;
+
 /// The intrinsic part of a camera description (`.cdf`): what lens correction
 /// and the synthetic cameras need.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -100,120 +105,6 @@ impl CameraModel {
     }
 }
 
-/// Fixed-point steps per pixel of the interpolation weights.
-const FRAC: u32 = 256;
-
-/// Where each pixel of the corrected image was observed, ready for bilinear
-/// sampling: for output pixel `i = y * width + x`, the index of the top-left
-/// source pixel of its 2 × 2 neighbourhood (`u32::MAX` when the source lies
-/// outside the image) and the offsets from it in 1/256 px. An identity map
-/// (no distortion) holds no arrays at all and correction costs nothing.
-///
-/// Fixed-point weights keep the per-pixel work to integer multiply-adds
-/// (the 1/256 px quantisation is far below the edge detector's accuracy);
-/// 8 bytes per pixel.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct LensMap {
-    width: usize,
-    height: usize,
-    index: Vec<u32>,
-    frac: Vec<[u16; 2]>,
-}
-
-impl LensMap {
-    /// The map of camera `m` for images of `width × height` pixels.
-    pub fn new(m: &CameraModel, width: usize, height: usize) -> LensMap {
-        if m.is_identity() {
-            return LensMap::identity(width, height);
-        }
-        LensMap::from_sources(width, height, |x, y| {
-            m.ideal_to_observed_converged(x as f64, y as f64)
-        })
-    }
-
-    /// A map from any source function `(x, y) → (xs, ys)`.
-    pub fn from_sources(
-        width: usize,
-        height: usize,
-        source: impl Fn(usize, usize) -> (f64, f64),
-    ) -> LensMap {
-        let n = width.saturating_mul(height);
-        let mut map = LensMap {
-            width,
-            height,
-            index: Vec::with_capacity(n),
-            frac: Vec::with_capacity(n),
-        };
-        let (xmax, ymax) = (
-            width.saturating_sub(1) as f64,
-            height.saturating_sub(1) as f64,
-        );
-        let too_big = width < 2 || height < 2 || n >= u32::MAX as usize;
-        for y in 0..height {
-            for x in 0..width {
-                let (xs, ys) = source(x, y);
-                // Inside the hull of the pixel centres, with a sliver of
-                // tolerance for rounding at the exact border.
-                let inside = xs >= -1e-3 && ys >= -1e-3 && xs <= xmax + 1e-3 && ys <= ymax + 1e-3;
-                if !inside || too_big {
-                    map.index.push(u32::MAX);
-                    map.frac.push([0, 0]);
-                    continue;
-                }
-                let (xc, yc) = (xs.clamp(0.0, xmax), ys.clamp(0.0, ymax));
-                let x0 = (xc as usize).min(width - 2);
-                let y0 = (yc as usize).min(height - 2);
-                let fx = ((xc - x0 as f64) * FRAC as f64).round() as u16;
-                let fy = ((yc - y0 as f64) * FRAC as f64).round() as u16;
-                map.index.push((y0 * width + x0) as u32);
-                map.frac.push([fx, fy]);
-            }
-        }
-        map
-    }
-
-    /// The identity map of a size (what a `.cdf` without distortion gives).
-    pub fn identity(width: usize, height: usize) -> LensMap {
-        LensMap {
-            width,
-            height,
-            index: Vec::new(),
-            frac: Vec::new(),
-        }
-    }
-
-    /// True when correction changes nothing (and the pipeline skips it).
-    pub fn is_identity(&self) -> bool {
-        self.index.is_empty()
-    }
-
-    pub fn size(&self) -> (usize, usize) {
-        (self.width, self.height)
-    }
-
-    /// The observed position of output pixel `(x, y)` (to 1/256 px);
-    /// `None` outside the image or where the source is outside.
-    pub fn source(&self, x: usize, y: usize) -> Option<(f32, f32)> {
-        if x >= self.width || y >= self.height {
-            return None;
-        }
-        if self.is_identity() {
-            return Some((x as f32, y as f32));
-        }
-        let i = y * self.width + x;
-        let idx = *self.index.get(i)?;
-        if idx == u32::MAX {
-            return None;
-        }
-        let [fx, fy] = *self.frac.get(i)?;
-        let (x0, y0) = (idx as usize % self.width, idx as usize / self.width);
-        Some((
-            x0 as f32 + fx as f32 / FRAC as f32,
-            y0 as f32 + fy as f32 / FRAC as f32,
-        ))
-    }
-}
-
 /// Lens correction of `img` with `map` (which must have the image's size).
 /// With an identity map the result is a copy of the image.
 pub fn correct(img: &GreyImage, map: &LensMap) -> Result<GreyImage, LlvError> {
@@ -233,49 +124,36 @@ pub fn correct_into(img: &GreyImage, map: &LensMap, out: &mut GreyImage) -> Resu
     }
     let mut mask = out.take_valid_mask().unwrap_or_default();
     let mut data = std::mem::take(out).into_data();
-    data.clear();
-    mask.clear();
     if map.is_identity() {
+        data.clear();
         data.extend_from_slice(img.data());
         let mut o = GreyImage::new(w, h, data)?;
         if let Some(m) = img.valid_mask() {
+            mask.clear();
             mask.extend_from_slice(m);
             o.set_valid_mask(Some(mask))?;
         }
         *out = o;
         return Ok(());
     }
-    let src = img.data();
-    let smask = img.valid_mask();
     let n = w * h;
+    // Every pixel is written below: no need to clear the old contents.
     data.resize(n, 0);
-    // Whether output pixel `k` with source index `i` can be sampled.
-    let valid = |i: u32| -> bool {
-        let i = i as usize;
-        i != u32::MAX as usize
-            && i + w + 1 < n
-            && smask.is_none_or(|m| m[i] && m[i + 1] && m[i + w] && m[i + w + 1])
-    };
-    let mut any_invalid = false;
-    for ((d, &i), &[fx, fy]) in data.iter_mut().zip(&map.index).zip(&map.frac) {
-        if !valid(i) {
-            *d = 0;
-            any_invalid = true;
-            continue;
-        }
-        let i = i as usize;
-        let (p00, p10, p01, p11) = (src[i], src[i + 1], src[i + w], src[i + w + 1]);
-        let (fx, fy) = (fx as i32, fy as i32);
-        let top = p00 as i32 * FRAC as i32 + fx * (p10 as i32 - p00 as i32);
-        let bot = p01 as i32 * FRAC as i32 + fx * (p11 as i32 - p01 as i32);
-        let v = (top * FRAC as i32 + fy * (bot - top) + (FRAC * FRAC / 2) as i32) >> 16;
-        *d = v as u8;
-    }
+    resample::values(img.data(), map, &mut data);
     // The mask only when some pixel is invalid (its buffer is then kept in
     // the output image and reused next time).
-    if any_invalid {
-        mask.extend(map.index.iter().map(|&i| valid(i)));
-    }
+    let any_invalid = match img.valid_mask() {
+        None if map.any_outside => {
+            mask.resize(n, false);
+            resample::map_mask(map, &mut mask);
+            true
+        }
+        None => false,
+        Some(smask) => {
+            mask.resize(n, false);
+            resample::masked(smask, map, &mut mask, &mut data)
+        }
+    };
     let mut o = GreyImage::new(w, h, data)?;
     if any_invalid {
         o.set_valid_mask(Some(mask))?;
@@ -329,7 +207,10 @@ mod tests {
         };
         let map = LensMap::new(&m, 64, 48);
         assert!(map.is_identity());
-        assert_eq!(map.index.capacity() + map.frac.capacity(), 0);
+        assert_eq!(
+            map.runs.capacity() + map.row_runs.capacity() + map.fx.capacity() + map.fy.capacity(),
+            0
+        );
         let img = GreyImage::new(64, 48, (0..64 * 48).map(|i| (i % 251) as u8).collect()).unwrap();
         assert_eq!(correct(&img, &map).unwrap(), img);
         assert!(correct(&img, &LensMap::identity(10, 10)).is_err());
@@ -355,5 +236,44 @@ mod tests {
         assert!(!c.is_valid(w - 1, 3), "source x beyond the last column");
         assert!(!c.is_valid(4, h - 1));
         assert!(c.is_valid(w - 2, h - 2));
+    }
+
+    #[test]
+    fn an_invalid_source_pixel_invalidates_exactly_the_outputs_that_touch_it() {
+        // Shift by (0.25, 0.5): output (x, y) samples source x..=x+1, y..=y+1.
+        let (w, h) = (45usize, 23usize);
+        let map = LensMap::from_sources(w, h, |x, y| (x as f64 + 0.25, y as f64 + 0.5));
+        let pixels: Vec<u8> = (0..w * h).map(|i| (i * 37 % 256) as u8).collect();
+        let plain = correct(&GreyImage::new(w, h, pixels.clone()).unwrap(), &map).unwrap();
+        // One invalid source pixel, then a scatter of them.
+        let one: Vec<bool> = (0..w * h).map(|i| i != 7 * w + 10).collect();
+        let scatter: Vec<bool> = (0..w * h).map(|i| i * 7919 % 13 != 0).collect();
+        for smask in [one, scatter] {
+            let mut img = GreyImage::new(w, h, pixels.clone()).unwrap();
+            img.set_valid_mask(Some(smask.clone())).unwrap();
+            let c = correct(&img, &map).unwrap();
+            for y in 0..h {
+                for x in 0..w {
+                    let touched_ok = x + 1 < w
+                        && y + 1 < h
+                        && [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]
+                            .iter()
+                            .all(|&(sx, sy)| smask[sy * w + sx]);
+                    assert_eq!(c.is_valid(x, y), touched_ok, "output ({x}, {y})");
+                    let want = if touched_ok { plain.get(x, y) } else { Some(0) };
+                    assert_eq!(c.get(x, y), want, "value at ({x}, {y})");
+                }
+            }
+        }
+        // The single invalid pixel (10, 7) spoils exactly four outputs.
+        let mut img = GreyImage::new(w, h, pixels).unwrap();
+        img.set_valid_mask(Some((0..w * h).map(|i| i != 7 * w + 10).collect()))
+            .unwrap();
+        let c = correct(&img, &map).unwrap();
+        let spoiled: Vec<(usize, usize)> = (0..h - 1)
+            .flat_map(|y| (0..w - 1).map(move |x| (x, y)))
+            .filter(|&(x, y)| !c.is_valid(x, y))
+            .collect();
+        assert_eq!(spoiled, [(9, 6), (10, 6), (9, 7), (10, 7)]);
     }
 }
