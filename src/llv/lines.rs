@@ -195,12 +195,14 @@ impl Grid {
             }
             max = max.max(q.iu);
         }
-        self.words = max as usize / 64 + 1;
+        // The columns, and an empty word on either side.
+        self.words = max as usize / 64 + 3;
         self.occupied.resize(nrows * self.words, 0);
         for r in 0..nrows {
             let base = r * self.words;
             for q in &points[row_start[r] as usize..row_start[r + 1] as usize] {
-                let (w, bit) = (base + q.iu as usize / 64, 1u64 << (q.iu % 64));
+                let c = q.iu as usize + 64;
+                let (w, bit) = (base + c / 64, 1u64 << (c % 64));
                 if self.occupied[w] & bit != 0 {
                     self.occupied.clear();
                     return false;
@@ -212,36 +214,30 @@ impl Grid {
         true
     }
 
-    /// Bits `k = 0..n` (`n ≤ 64`) of scan line `r` for columns `lo + k`.
+    /// Bits `k = 0..n` (`n < 64`) of scan line `r` for columns `lo + k`.
+    /// Each scan line has an empty word before and after its columns
+    /// (column `c` is bit `c + 64`), so no window needs a special case at
+    /// the image's sides.
     #[inline]
     fn window(&self, bits: &[u64], r: usize, lo: i64, n: u32) -> u64 {
-        let skip = if lo < 0 { lo.unsigned_abs() } else { 0 };
-        if skip >= n as u64 {
+        let start = lo + 64;
+        if start < 0 {
             return 0;
         }
-        let start = lo.max(0) as u64;
-        let (w, b) = ((start / 64) as usize, (start % 64) as u32);
-        if w >= self.words {
+        let (w, b) = ((start >> 6) as usize, (start & 63) as u32);
+        if w + 1 >= self.words {
             return 0;
         }
-        let row = &bits[r * self.words..(r + 1) * self.words];
-        let mut v = row[w] >> b;
-        if b > 0 && w + 1 < self.words {
-            v |= row[w + 1] << (64 - b);
-        }
-        let cnt = n - skip as u32;
-        let mask = if cnt >= 64 {
-            u64::MAX
-        } else {
-            (1u64 << cnt) - 1
-        };
-        (v & mask) << skip
+        let base = r * self.words + w;
+        let (first, second) = (bits[base], bits[base + 1]);
+        let v = (first >> b) | ((second << 1) << (63 - b));
+        v & ((1u64 << n) - 1)
     }
 
     #[inline]
     fn mark_used(&mut self, r: usize, iu: i64) {
-        let w = r * self.words + iu as usize / 64;
-        self.unused[w] &= !(1u64 << (iu % 64));
+        let c = iu as usize + 64;
+        self.unused[r * self.words + c / 64] &= !(1u64 << (c % 64));
     }
 
     /// The template of §3.1 for a point at column `iu` of scan line `row`.
@@ -279,7 +275,7 @@ impl Grid {
         sw: f64,
     ) -> bool {
         let nrows = s.row_start.len() - 1;
-        (1..=max_gap).any(|i| {
+        for i in 1..=max_gap {
             let r = row + i;
             if r >= nrows {
                 return false;
@@ -288,6 +284,9 @@ impl Grid {
             let half = reach as i64 + 2;
             let lo = sp.iu - half;
             let mut bits = self.window(&self.unused, r, lo, (2 * half + 1) as u32);
+            if bits == 0 {
+                continue;
+            }
             let (a, b) = (sp.u as f64 - reach, sp.u as f64 + reach);
             while bits != 0 {
                 let c = lo + bits.trailing_zeros() as i64;
@@ -309,8 +308,8 @@ impl Grid {
                     }
                 }
             }
-            false
-        })
+        }
+        false
     }
 }
 
