@@ -181,12 +181,17 @@ struct Grid {
     words: usize,
     occupied: Vec<u64>,
     unused: Vec<u64>,
+    /// Per word of `occupied`: the index of the first point at or after
+    /// its first column (points before it on the scan line, plus the scan
+    /// line's start), so a column's point is found without a search.
+    before: Vec<u32>,
 }
 
 impl Grid {
     fn build(&mut self, points: &[ScanPoint], row_start: &[u32], nrows: usize) -> bool {
         self.occupied.clear();
         self.unused.clear();
+        self.before.clear();
         self.words = 0;
         let mut max = 0i64;
         for q in points {
@@ -211,6 +216,14 @@ impl Grid {
             }
         }
         self.unused.extend_from_slice(&self.occupied);
+        self.before.reserve(self.occupied.len());
+        for (&first, row) in row_start.iter().zip(self.occupied.chunks_exact(self.words)) {
+            let mut n = first;
+            for &w in row {
+                self.before.push(n);
+                n += w.count_ones();
+            }
+        }
         true
     }
 
@@ -232,6 +245,15 @@ impl Grid {
         let (first, second) = (bits[base], bits[base + 1]);
         let v = (first >> b) | ((second << 1) << (63 - b));
         v & ((1u64 << n) - 1)
+    }
+
+    /// The index of the point on scan line `r` at column `c` (a set bit).
+    #[inline]
+    fn point_at(&self, r: usize, c: i64) -> usize {
+        let c = (c + 64) as usize;
+        let k = r * self.words + c / 64;
+        let below = self.occupied[k] & ((1u64 << (c % 64)) - 1);
+        self.before[k] as usize + below.count_ones() as usize
     }
 
     #[inline]
@@ -299,13 +321,9 @@ impl Grid {
                     return true;
                 }
                 // An end column: look at the point.
-                let (rlo, rhi) = (s.row_start[r] as usize, s.row_start[r + 1] as usize);
-                let line = &s.points[rlo..rhi];
-                if let Some(q) = line.get(line.partition_point(|q| q.iu < c)) {
-                    let u = q.u as f64;
-                    if q.iu == c && u >= a && u <= b {
-                        return true;
-                    }
+                let u = s.points[self.point_at(r, c)].u as f64;
+                if u >= a && u <= b {
+                    return true;
                 }
             }
         }
@@ -484,6 +502,9 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
         let mut slope = TEMPLATE_SLOPE[template];
         let mut fit = LineFit::new();
         fit.add(Point::new(sp.u as f64, sp.v as f64));
+        // The mean, kept from one added point to the next (the prediction
+        // and the stray test of every scan line tried use it).
+        let mut mean = fit.mean();
         let mut resp_sum = sp.response as f64;
         let mut last = sp;
         let mut row_e = start_row;
@@ -499,19 +520,41 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
                 // not from the last point: a track predicted from its last
                 // point follows any chain that bends by less than the search
                 // width per scan line, round a corner and along the next edge.
-                let pred = match fit.mean() {
+                let pred = match mean {
                     Some(m) if fit.len() >= 2 => m.x + (r as f64 - m.y) * slope,
                     _ => last.u as f64 + i as f64 * slope,
                 };
                 // No unused point near the prediction at all (how a noise
                 // track usually ends): the bitmap says so without a search.
                 // Every candidate's column is within sw + ½ of `pred`.
+                // Otherwise the unused points near it are the window's bits,
+                // in order along the scan line.
                 if use_grid && pred.abs() < 1e9 {
                     let half = sw as i64 + 2;
                     let lo = pred as i64 - half;
-                    if grid.window(&grid.unused, r, lo, (2 * half + 1) as u32) == 0 {
-                        continue;
+                    let mut bits = grid.window(&grid.unused, r, lo, (2 * half + 1) as u32);
+                    let mut best: Option<(f64, usize)> = None;
+                    while bits != 0 {
+                        let c = lo + bits.trailing_zeros() as i64;
+                        bits &= bits - 1;
+                        let idx = grid.point_at(r, c);
+                        let q = &s.points[idx];
+                        let d = q.u as f64 - pred;
+                        if (q.u as f64) < pred - sw || d > sw {
+                            continue;
+                        }
+                        if (q.response > 0.0) != (sp.response > 0.0) {
+                            continue;
+                        }
+                        if best.is_none_or(|(bd, _)| d.abs() < bd) {
+                            best = Some((d.abs(), idx));
+                        }
                     }
+                    if let Some((_, idx)) = best {
+                        found = Some((idx, r));
+                        break;
+                    }
+                    continue;
                 }
                 let (lo, hi) = (s.row_start[r] as usize, s.row_start[r + 1] as usize);
                 let row = &s.points[lo..hi];
@@ -548,7 +591,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
             // axis found after the last point (the fit has not changed
             // since): no trigonometry per point.
             if fit.len() >= STRAY_AFTER {
-                if let (Some((du, dv)), Some(m)) = (axis, fit.mean()) {
+                if let (Some((du, dv)), Some(m)) = (axis, mean) {
                     let q = s.points[idx];
                     let cross = (q.u as f64 - m.x) * dv - (q.v as f64 - m.y) * du;
                     if cross.abs() > STRAY_DISTANCE * (du * du + dv * dv).sqrt() {
@@ -562,6 +605,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
             }
             let q = s.points[idx];
             fit.add(Point::new(q.u as f64, q.v as f64));
+            mean = fit.mean();
             resp_sum += q.response as f64;
             last = q;
             row_e = r;
