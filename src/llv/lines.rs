@@ -34,6 +34,17 @@
 //! - the segment runs from the projection of its first point to that of its
 //!   last; `response` is the mean signed response of its points, `residual`
 //!   their RMS distance from the line.
+//!
+//! Speed: most edge points are noise (the adaptive threshold keeps at
+//! least `M` a scan line), so the cost is in rejecting starts cheaply.
+//! Each point's rounded `u` is kept, and a `Grid` of bitmaps (every
+//! point; the unused ones) answers "is there an unused point near here?"
+//! and the template scores with a few word operations; points are found
+//! from a column by per-word counts instead of binary searches. The bitmaps
+//! are exact only when no two points of a scan line share a column (true of
+//! edge points, one pixel thick); otherwise — a hand-made file — the
+//! extractor walks the scan lines with forward-only `Cursor`s, with the
+//! same result (a test compares both).
 
 use super::fit::LineFit;
 use super::params::LineParams;
