@@ -243,7 +243,10 @@ fn mask_invalid(
 #[derive(Clone, Debug, Default)]
 pub struct PeakScratch {
     hist: Vec<u32>,
-    flags: Vec<u8>,
+    /// Candidate flags of the rows of one region (horizontal scan) or of
+    /// the whole response (vertical scan), `1` for a candidate.
+    flags_h: Vec<u8>,
+    flags_v: Vec<u8>,
     /// Vertical scan: per column, the largest candidate `|E|`, then the
     /// lower limit on `|E|` of a kept peak; the column's histogram offset.
     colmax: Vec<f32>,
@@ -251,13 +254,21 @@ pub struct PeakScratch {
     offset: Vec<u32>,
 }
 
+/// The first pass's test folds "above the floor `T`" and "size ≥ 2"
+/// (smaller sizes never count for the threshold, see [`limit`]) into one
+/// comparison `|E| > t1`: `t1 = T` if `T ≥ 2`, else the largest `f32`
+/// below 2 (so `|E| > t1 ⇔ |E| ≥ 2`). `T` is not NaN here.
+fn first_pass_floor(t: f32) -> f32 {
+    let below_two = f32::from_bits(2f32.to_bits() - 1);
+    if t >= 2.0 { t } else { below_two }
+}
+
 /// Candidates of the first pass: `flags[i] = 1` where `|mid[i]|` is a peak
-/// between `|lo[i]|` and `|hi[i]|` (§2.3) above `t` and of size ≥ 2 (smaller
-/// sizes never count for the threshold, see [`limit`]); returns the largest
-/// such `|E|` (0 if none). Branch-free on eight lanes so it vectorises; NaN
-/// compares false.
+/// between `|lo[i]|` and `|hi[i]|` (§2.3) above `t1` (see
+/// [`first_pass_floor`]); returns the largest such `|E|` (0 if none).
+/// Branch-free on eight lanes so it vectorises; NaN compares false.
 #[inline]
-fn candidates_row(lo: &[f32], mid: &[f32], hi: &[f32], t: f32, flags: &mut [u8]) -> f32 {
+fn candidates_row(lo: &[f32], mid: &[f32], hi: &[f32], t1: f32, flags: &mut [u8]) -> f32 {
     let n = flags.len().min(lo.len()).min(mid.len()).min(hi.len());
     let (flags, lo, mid, hi) = (&mut flags[..n], &lo[..n], &mid[..n], &hi[..n]);
     let mut mx = [0f32; 8];
@@ -266,7 +277,7 @@ fn candidates_row(lo: &[f32], mid: &[f32], hi: &[f32], t: f32, flags: &mut [u8])
     for (((f, m), l), h) in (&mut fc).zip(&mut mc).zip(&mut lc).zip(&mut hc) {
         for k in 0..8 {
             let e0 = m[k].abs();
-            let c = (e0 > l[k].abs()) & (e0 >= h[k].abs()) & (e0 > t) & (e0 >= 2.0);
+            let c = (e0 > l[k].abs()) & (e0 >= h[k].abs()) & (e0 > t1);
             f[k] = u8::from(c);
             let v = if c { e0 } else { 0.0 };
             mx[k] = if v > mx[k] { v } else { mx[k] };
@@ -280,7 +291,7 @@ fn candidates_row(lo: &[f32], mid: &[f32], hi: &[f32], t: f32, flags: &mut [u8])
         .zip(hc.remainder())
     {
         let e0 = m.abs();
-        let c = (e0 > l.abs()) & (e0 >= h.abs()) & (e0 > t) & (e0 >= 2.0);
+        let c = (e0 > l.abs()) & (e0 >= h.abs()) & (e0 > t1);
         *f = u8::from(c);
         if c && e0 > best {
             best = e0;
@@ -296,7 +307,7 @@ fn candidates_cols(
     lo: &[f32],
     mid: &[f32],
     hi: &[f32],
-    t: f32,
+    t1: f32,
     flags: &mut [u8],
     colmax: &mut [f32],
 ) {
@@ -308,29 +319,28 @@ fn candidates_cols(
         .zip(colmax.iter_mut())
     {
         let e0 = m.abs();
-        let c = (e0 > l.abs()) & (e0 >= h.abs()) & (e0 > t) & (e0 >= 2.0);
+        let c = (e0 > l.abs()) & (e0 >= h.abs()) & (e0 > t1);
         *f = u8::from(c);
         let v = if c { e0 } else { 0.0 };
         *cm = if v > *cm { v } else { *cm };
     }
 }
 
-/// The kept peaks of the second pass: a peak above `t` with `|E| ≥ lim`
-/// (i.e. size above the region's threshold, see [`limit`]).
+/// The second pass: keeps the first pass's candidates (`flags`) above the
+/// region's limit (`|E| ≥ lim`, see [`limit`]); every kept peak was a
+/// candidate, since `lim ≥ 2` and the floor test is the same.
 #[inline]
-fn kept_row(lo: &[f32], mid: &[f32], hi: &[f32], t: f32, lim: f32, flags: &mut [u8]) {
-    for (((f, &m), &l), &h) in flags.iter_mut().zip(mid).zip(lo).zip(hi) {
-        let e0 = m.abs();
-        *f = u8::from((e0 > l.abs()) & (e0 >= h.abs()) & (e0 > t) & (e0 >= lim));
+fn kept_row(mid: &[f32], lim: f32, flags: &mut [u8]) {
+    for (f, &m) in flags.iter_mut().zip(mid) {
+        *f &= u8::from(m.abs() >= lim);
     }
 }
 
 /// [`kept_row`] with one limit per column (vertical scan).
 #[inline]
-fn kept_cols(lo: &[f32], mid: &[f32], hi: &[f32], t: f32, lim: &[f32], flags: &mut [u8]) {
-    for ((((f, &m), &l), &h), &g) in flags.iter_mut().zip(mid).zip(lo).zip(hi).zip(lim) {
-        let e0 = m.abs();
-        *f = u8::from((e0 > l.abs()) & (e0 >= h.abs()) & (e0 > t) & (e0 >= g));
+fn kept_cols(mid: &[f32], lim: &[f32], flags: &mut [u8]) {
+    for ((f, &m), &g) in flags.iter_mut().zip(mid).zip(lim) {
+        *f &= u8::from(m.abs() >= g);
     }
 }
 
@@ -359,7 +369,8 @@ fn for_each_flag(flags: &[u8], mut f: impl FnMut(usize)) {
 /// The histogram bin of a peak: its size, `|E|` rounded down, at most 255.
 #[inline]
 fn bin(e0: f32) -> usize {
-    (e0 as usize).min(BINS - 1)
+    // Clamped first, so the conversion needs no saturation (NaN gives 0).
+    e0.min((BINS - 1) as f32) as u32 as usize
 }
 
 /// A region's lower limit on `|E|` for a kept peak, from the histogram of
@@ -381,6 +392,19 @@ fn limit(hist: &mut [u32], mx: f32, m: u32) -> f32 {
     };
     let mut th = tmax;
     let mut sum = 0u32;
+    // Eight bins at a time while the one-by-one walk would not stop inside
+    // them: `sum` stays below `m` and `th` above 1 for all eight steps.
+    while th >= 9 {
+        let s8 = hist[th - 7..=th]
+            .iter()
+            .fold(0u32, |a, &b| a.saturating_add(b));
+        let next = sum.saturating_add(s8);
+        if next >= m {
+            break;
+        }
+        sum = next;
+        th -= 8;
+    }
     while sum < m && th > 1 {
         sum = sum.saturating_add(hist[th]);
         th -= 1;
@@ -434,51 +458,51 @@ pub fn peaks_into(resp: &Response, p: &EdgeParams, out: &mut EdgePoints, s: &mut
         return;
     }
     let t = p.floor as f32;
+    if t.is_nan() {
+        // No `|E| > T` holds: no peak at all.
+        return;
+    }
+    let t1 = first_pass_floor(t);
     let r = p.region_lines.max(1) as usize;
     let m = p.per_region;
-    s.flags.clear();
-    s.flags.resize(w, 0);
     match resp.dir {
-        ScanDir::Horizontal => peaks_h(resp, t, r, m, out, s),
-        ScanDir::Vertical => peaks_v(resp, t, r, m, out, s),
+        ScanDir::Horizontal => peaks_h(resp, t1, r, m, out, s),
+        ScanDir::Vertical => peaks_v(resp, t1, r, m, out, s),
     }
 }
 
-fn peaks_h(resp: &Response, t: f32, r: usize, m: u32, out: &mut EdgePoints, s: &mut PeakScratch) {
+fn peaks_h(resp: &Response, t1: f32, r: usize, m: u32, out: &mut EdgePoints, s: &mut PeakScratch) {
     let w = resp.width;
     if s.hist.len() < BINS {
         s.hist.clear();
         s.hist.resize(BINS, 0);
     }
     let hist = &mut s.hist[..BINS];
-    let flags = &mut s.flags;
+    // Flags of a region's rows: entries 0 and w-1 of each row are never
+    // written, so they stay 0 as long as the width does not change.
+    let rows = r.min(resp.height);
+    if s.flags_h.len() != rows * w {
+        s.flags_h.clear();
+        s.flags_h.resize(rows * w, 0);
+    }
     for (g, region) in resp.data.chunks(w * r).enumerate() {
         let mut mx = 0f32;
-        for row in region.chunks_exact(w) {
-            let top = candidates_row(
-                &row[..w - 2],
-                &row[1..w - 1],
-                &row[2..],
-                t,
-                &mut flags[1..w - 1],
-            );
-            mx = mx.max(top);
+        for (row, flags) in region.chunks_exact(w).zip(s.flags_h.chunks_exact_mut(w)) {
+            let (lo, mid, hi) = (&row[..w - 2], &row[1..w - 1], &row[2..]);
+            mx = mx.max(candidates_row(lo, mid, hi, t1, &mut flags[1..w - 1]));
             for_each_flag(flags, |x| hist[bin(row[x].abs())] += 1);
         }
         let lim = limit(hist, mx, m);
         if lim == f32::INFINITY {
             continue;
         }
-        for (k, row) in region.chunks_exact(w).enumerate() {
+        for (k, (row, flags)) in region
+            .chunks_exact(w)
+            .zip(s.flags_h.chunks_exact_mut(w))
+            .enumerate()
+        {
             let y = (g * r + k) as f32;
-            kept_row(
-                &row[..w - 2],
-                &row[1..w - 1],
-                &row[2..],
-                t,
-                lim,
-                &mut flags[1..w - 1],
-            );
+            kept_row(row, lim, flags);
             for_each_flag(flags, |x| {
                 let (em, e0, ep) = (row[x - 1].abs(), row[x].abs(), row[x + 1].abs());
                 out.points.push(EdgePoint {
@@ -491,7 +515,7 @@ fn peaks_h(resp: &Response, t: f32, r: usize, m: u32, out: &mut EdgePoints, s: &
     }
 }
 
-fn peaks_v(resp: &Response, t: f32, r: usize, m: u32, out: &mut EdgePoints, s: &mut PeakScratch) {
+fn peaks_v(resp: &Response, t1: f32, r: usize, m: u32, out: &mut EdgePoints, s: &mut PeakScratch) {
     let (w, h) = (resp.width, resp.height);
     let nreg = w.div_ceil(r);
     if s.hist.len() != nreg * BINS {
@@ -503,14 +527,21 @@ fn peaks_v(resp: &Response, t: f32, r: usize, m: u32, out: &mut EdgePoints, s: &
     s.colmax.resize(w, 0.0);
     s.offset.clear();
     s.offset.extend((0..w).map(|x| ((x / r) * BINS) as u32));
-    let (hist, flags, colmax) = (&mut s.hist, &mut s.flags, &mut s.colmax);
+    // One row of flags per response row (the first and last are unused);
+    // the first pass writes every flag it reads later.
+    if s.flags_v.len() != w * h {
+        s.flags_v.clear();
+        s.flags_v.resize(w * h, 0);
+    }
+    let (hist, colmax, offset) = (&mut s.hist, &mut s.colmax, &s.offset);
     let data = &resp.data;
-    for y in 1..h - 1 {
+    let mut flag_rows = s.flags_v.chunks_exact_mut(w);
+    flag_rows.next();
+    for (y, flags) in (1..h - 1).zip(&mut flag_rows) {
         let up = &data[(y - 1) * w..y * w];
         let row = &data[y * w..(y + 1) * w];
         let dn = &data[(y + 1) * w..(y + 2) * w];
-        candidates_cols(up, row, dn, t, flags, colmax);
-        let offset = &s.offset;
+        candidates_cols(up, row, dn, t1, flags, colmax);
         for_each_flag(flags, |x| hist[offset[x] as usize + bin(row[x].abs())] += 1);
     }
     s.lim.clear();
@@ -520,11 +551,13 @@ fn peaks_v(resp: &Response, t: f32, r: usize, m: u32, out: &mut EdgePoints, s: &
         s.lim.extend(std::iter::repeat_n(l, cols.len()));
     }
     let lim = &s.lim;
-    for y in 1..h - 1 {
+    let mut flag_rows = s.flags_v.chunks_exact_mut(w);
+    flag_rows.next();
+    for (y, flags) in (1..h - 1).zip(&mut flag_rows) {
         let up = &data[(y - 1) * w..y * w];
         let row = &data[y * w..(y + 1) * w];
         let dn = &data[(y + 1) * w..(y + 2) * w];
-        kept_cols(up, row, dn, t, lim, flags);
+        kept_cols(row, lim, flags);
         let yf = y as f32;
         for_each_flag(flags, |x| {
             let (em, e0, ep) = (up[x].abs(), row[x].abs(), dn[x].abs());
