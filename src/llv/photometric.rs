@@ -297,24 +297,43 @@ fn fused(
                 &mut sum[cols.clone()],
                 &mut s.best_row[cols],
             );
-            let sub = ambient.is_some();
-            for (((&v, &am), o), b) in r.iter().zip(amb).zip(sm.iter_mut()).zip(best.iter_mut()) {
-                let v = if sub { v - am } else { v };
-                let m = v.abs();
-                let cc = m - tau;
-                let add = if cc > 0.0 || cc.is_nan() { cc } else { 0.0 };
-                if i == 0 {
-                    *o = add;
-                    *b = v;
-                } else {
-                    *o += add;
-                    *b = if m > b.abs() { v } else { *b };
-                }
+            match (i == 0, ambient.is_some()) {
+                (true, true) => combine_row::<true, true>(r, amb, tau, sm, best),
+                (true, false) => combine_row::<true, false>(r, amb, tau, sm, best),
+                (false, true) => combine_row::<false, true>(r, amb, tau, sm, best),
+                (false, false) => combine_row::<false, false>(r, amb, tau, sm, best),
             }
         }
         let cols = cols.clone();
         for (o, &b) in sum[cols.clone()].iter_mut().zip(&s.best_row[cols]) {
             *o = if b < 0.0 { -*o } else { *o };
+        }
+    }
+}
+
+/// One image's contribution to one row of the combination, as [`start`]
+/// (`FIRST`) or [`accumulate_diff`] do it, with the ambient response
+/// subtracted when `SUB`. The flags are constants, so the loop has only
+/// selects and vectorises.
+#[inline(always)]
+fn combine_row<const FIRST: bool, const SUB: bool>(
+    r: &[f32],
+    amb: &[f32],
+    tau: f32,
+    sum: &mut [f32],
+    best: &mut [f32],
+) {
+    for (((&v, &am), o), b) in r.iter().zip(amb).zip(sum.iter_mut()).zip(best.iter_mut()) {
+        let v = if SUB { v - am } else { v };
+        let m = v.abs();
+        let cc = m - tau;
+        let add = if cc > 0.0 || cc.is_nan() { cc } else { 0.0 };
+        if FIRST {
+            *o = add;
+            *b = v;
+        } else {
+            *o += add;
+            *b = if m > b.abs() { v } else { *b };
         }
     }
 }
