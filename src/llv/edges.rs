@@ -344,20 +344,27 @@ fn kept_cols(mid: &[f32], lim: &[f32], flags: &mut [u8]) {
     }
 }
 
-/// Calls `f(i)` for every `i` with `flags[i] != 0`, in order, skipping
-/// empty stretches eight bytes at a time.
+/// Calls `f(i)` for every `i` with `flags[i] == 1` (flags are 0 or 1), in
+/// order. Sixty-four flags are packed into one bit mask first (eight bytes
+/// of 0/1 become eight bits with one multiplication), so the loop over set
+/// bits ends — a mispredicted branch — once per 64 pixels, not once per 8.
 #[inline]
 fn for_each_flag(flags: &[u8], mut f: impl FnMut(usize)) {
-    let mut chunks = flags.chunks_exact(8);
+    /// Byte `i` (0 or 1) of a little-endian word lands on bit `56 + i`.
+    const GATHER: u64 = 0x0102_0408_1020_4080;
+    let word = |w: &[u8]| u64::from_le_bytes([w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7]]);
+    let mut chunks = flags.chunks_exact(64);
     let mut base = 0;
     for ch in &mut chunks {
-        let mut word = u64::from_le_bytes([ch[0], ch[1], ch[2], ch[3], ch[4], ch[5], ch[6], ch[7]]);
-        while word != 0 {
-            let bit = word.trailing_zeros() as usize;
-            f(base + bit / 8);
-            word &= !(0xFFu64 << (bit / 8 * 8));
+        let mut bits = 0u64;
+        for (k, w) in ch.chunks_exact(8).enumerate() {
+            bits |= (word(w).wrapping_mul(GATHER) >> 56) << (8 * k);
         }
-        base += 8;
+        while bits != 0 {
+            f(base + bits.trailing_zeros() as usize);
+            bits &= bits - 1;
+        }
+        base += 64;
     }
     for (k, &v) in chunks.remainder().iter().enumerate() {
         if v != 0 {
