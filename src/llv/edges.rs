@@ -204,14 +204,16 @@ fn mask_invalid(
             // Per column, the number of invalid pixels in rows y-A..=y+A.
             counts.clear();
             counts.resize(w, 0);
-            let add = |counts: &mut Vec<u32>, y: usize, sign: bool| {
-                for (c, &m) in counts.iter_mut().zip(&mask[y * w..(y + 1) * w]) {
-                    if !m {
-                        if sign {
-                            *c += 1;
-                        } else {
-                            *c -= 1;
-                        }
+            // Branch-free (selects), so every row's update vectorises.
+            let add = |counts: &mut [u32], y: usize, sign: bool| {
+                let mrow = &mask[y * w..(y + 1) * w];
+                if sign {
+                    for (c, &m) in counts.iter_mut().zip(mrow) {
+                        *c += u32::from(!m);
+                    }
+                } else {
+                    for (c, &m) in counts.iter_mut().zip(mrow) {
+                        *c -= u32::from(!m);
                     }
                 }
             };
@@ -226,9 +228,7 @@ fn mask_invalid(
                     add(counts, y - a - 1, false);
                 }
                 for (d, &c) in data[y * w..(y + 1) * w].iter_mut().zip(counts.iter()) {
-                    if c != 0 {
-                        *d = f32::NAN;
-                    }
+                    *d = if c != 0 { f32::NAN } else { *d };
                 }
             }
         }
