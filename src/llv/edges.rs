@@ -3,8 +3,17 @@
 //! scan, parabolic subpixel positions and the per-region adaptive threshold.
 //!
 //! Exactness: the kernel is applied with integer coefficients (`φ'(t)·A³`
-//! is a whole number), so every sum of 8-bit pixels is exact in `f32` and the
-//! response is rounded once, when it is scaled by `1/A³`.
+//! is a whole number), so every sum of 8-bit pixels is exact (in integer
+//! lanes, [`row`]) and the response is rounded once, when it is scaled by
+//! `1/A³`.
+//!
+//! Speed: the peak finder makes two vectorised passes instead of listing
+//! every candidate (about one pixel in thirteen on a noisy image): the first
+//! histograms candidate sizes per region, the second keeps the candidates at
+//! or above the region's limit. Both walk their flags 64 pixels per bit mask,
+//! since mispredicted branches, not arithmetic, bounded the older code. The
+//! straightforward former implementation is kept in `edges/reference.rs`
+//! (tests only); the tests compare both bit for bit.
 //!
 //! Layout: a [`Response`] is always stored in image order, `data[y·w + x]`,
 //! for both scan directions. The vertical convolution and the vertical peak
@@ -710,7 +719,7 @@ mod tests {
         for (w, h) in [(16, 16), (37, 53), (130, 17), (17, 130), (96, 80)] {
             for masked in [false, true] {
                 let img = random_image(&mut rng, w, h, masked);
-                for a in [3, 4, 7] {
+                for a in 3..=7 {
                     for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
                         response_into(&img, dir, a, &mut resp, &mut rs).unwrap();
                         for (floor, m, r) in [

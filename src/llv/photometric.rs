@@ -619,20 +619,20 @@ mod tests {
     fn the_row_path_equals_the_per_image_path_bit_for_bit() {
         let mut x = 99u64;
         let mut noisy = |lo: u8, hi: u8, at: usize| {
-            let data = (0..70 * 50)
+            let data = (0..150 * 50)
                 .map(|k| {
                     x = x
                         .wrapping_mul(6364136223846793005)
                         .wrapping_add(1442695040888963407);
-                    let v = if k % 70 + k / 70 < at { lo } else { hi };
+                    let v = if k % 150 + k / 150 < at { lo } else { hi };
                     v.saturating_add((x >> 59) as u8)
                 })
                 .collect();
-            GreyImage::new(70, 50, data).unwrap()
+            GreyImage::new(150, 50, data).unwrap()
         };
         let imgs = [noisy(40, 200, 50), noisy(150, 90, 70), noisy(100, 100, 0)];
         let amb = noisy(20, 45, 60);
-        for a in [3, 4, 7] {
+        for a in 3..=7 {
             let p = EdgeParams {
                 half_width: a,
                 ..EdgeParams::default()
