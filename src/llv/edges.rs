@@ -4,7 +4,7 @@
 //!
 //! Exactness: the kernel is applied with integer coefficients (`φ'(t)·A³`
 //! is a whole number), so every sum of 8-bit pixels is exact (in integer
-//! lanes, [`row`]) and the response is rounded once, when it is scaled by
+//! lanes, `edges/row.rs`) and the response is rounded once, when it is scaled by
 //! `1/A³`.
 //!
 //! Speed: the peak finder makes two vectorised passes instead of listing
@@ -118,7 +118,7 @@ pub struct ResponseScratch {
 
 /// [`response`] into reusable buffers.
 ///
-/// Each row goes through the shared row kernel ([`row::lee_row`]): the
+/// Each row goes through the shared row kernel (`row::lee_row`): the
 /// antisymmetry of the kernel halves the work,
 /// `E(x) = Σ_{s=1..A} c_s (Img(x+s) - Img(x-s))` with `c_s = 6 s (A-s)`
 /// (then scaled by `1/A³`); the sums are of whole numbers, exact in
