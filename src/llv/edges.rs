@@ -763,7 +763,20 @@ mod tests {
         let mut rng = Rng(42);
         let cases: [&dyn Fn(&mut Rng) -> f32; 4] = [
             &|r| (r.next() % 200) as f32 / 100.0,
-            &|r| [1.5, 0.0, f32::NAN, 300.0, -1e9, 2.0, 2.0][(r.next() % 7) as usize],
+            &|r| {
+                [
+                    1.5,
+                    0.0,
+                    f32::NAN,
+                    300.0,
+                    -1e9,
+                    2.0,
+                    2.0,
+                    256.0,
+                    -255.5,
+                    256.0,
+                ][(r.next() % 10) as usize]
+            },
             &|r| [f32::INFINITY, 5.0, -3.0, 4.99][(r.next() % 4) as usize],
             &|r| (r.next() % 7) as f32 - 3.0,
         ];

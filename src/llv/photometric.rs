@@ -408,7 +408,7 @@ fn sign(sum: &mut [f32], best: &[f32]) {
 }
 
 /// `τ = factor × median |r|` over the finite responses, estimated on an even
-/// subsample of at most [`MEDIAN_SAMPLES`] values. 0 for a response with no
+/// subsample of at most `MEDIAN_SAMPLES` (4096) values. 0 for a response with no
 /// finite value.
 pub fn noise_level(r: &[f32], factor: f64) -> f32 {
     noise_level_of(r, None, factor, &mut Vec::new())
