@@ -1,12 +1,16 @@
 //! Photometric edges (llv.md §2.6, issue 6): four lit 512 × 512 images of a
 //! synthetic view plus an ambient-only image (noise σ = 5), on one core.
 //! Goal: five images to lines in ≤ 3 ms. Run: `cargo bench --bench photometric`.
+//! `combined_edges_both_directions` is the edge part alone (combined
+//! responses and peaks, warm buffers); the rest of `five_images_to_lines` is
+//! line extraction and CONNECT.
 
 use divan::{Bencher, black_box};
-use vss::llv::photometric::combined_response;
+use vss::llv::edges::{PeakScratch, Response, peaks_into};
+use vss::llv::photometric::{PhotoScratch, combined_response, combined_response_into};
 use vss::llv::pipeline::{Input, Workspace};
 use vss::llv::synth::{self, PointLight, RenderOptions};
-use vss::llv::{GreyImage, Params, ScanDir};
+use vss::llv::{EdgePoints, GreyImage, Params, ScanDir};
 
 fn main() {
     divan::main();
@@ -44,6 +48,34 @@ fn combined_response_both_directions(b: Bencher) {
         for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
             black_box(combined_response(&lit, Some(&amb), dir, &p.edges).expect("same size"));
         }
+    });
+}
+
+/// Warm buffers: the combined responses and their peaks, both directions,
+/// as the pipeline's edge stage runs them.
+#[divan::bench]
+fn combined_edges_both_directions(b: Bencher) {
+    let (lit, amb) = view();
+    let p = Params::default();
+    let mut s = PhotoScratch::default();
+    let mut ps = PeakScratch::default();
+    let (mut rh, mut rv) = (Response::default(), Response::default());
+    let (mut eh, mut ev) = (EdgePoints::default(), EdgePoints::default());
+    b.bench_local(|| {
+        let (lit, amb) = (black_box(&lit), black_box(&amb));
+        combined_response_into(
+            lit,
+            Some(amb),
+            ScanDir::Horizontal,
+            &p.edges,
+            &mut rh,
+            &mut s,
+        )
+        .expect("same size");
+        combined_response_into(lit, Some(amb), ScanDir::Vertical, &p.edges, &mut rv, &mut s)
+            .expect("same size");
+        peaks_into(&rh, &p.edges, &mut eh, &mut ps);
+        peaks_into(&rv, &p.edges, &mut ev, &mut ps);
     });
 }
 

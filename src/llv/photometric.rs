@@ -38,7 +38,7 @@
 //! through [`edges::peaks`]. A pixel with no response (NaN: near the border
 //! or an invalid pixel) in any image has no combined response.
 
-use super::edges::{self, Response, ResponseScratch};
+use super::edges::{self, Response, ResponseScratch, row};
 use super::params::EdgeParams;
 use super::{GreyImage, LlvError, ScanDir};
 
@@ -63,7 +63,6 @@ pub struct PhotoScratch {
     amb_row: Vec<f32>,
     row: Vec<f32>,
     best_row: Vec<f32>,
-    acc: Vec<i16>,
 }
 
 /// The response of several lightings of one view, per §2.6 (module doc).
@@ -207,86 +206,16 @@ fn response_at(img: &[u8], w: usize, x: usize, y: usize, dir: ScanDir, k: &Kerne
 }
 
 /// One output row `y` of one image's response into `row` (length `w`; only
-/// the valid band `a..w-a` is written for the horizontal scan).
-///
-/// For `A ≤ 5` every partial sum `Σ c_s (Img(x+s) − Img(x−s))` is a whole
-/// number below 2¹⁵ (Σ c_s · 255 ≤ 30 600), so it is accumulated in `i16`
-/// (eight lanes per SSE2 register, no float conversion per tap) and
-/// converted once; the integer is exact either way, so the result is the
-/// same bit for bit as the `f32` accumulation used for wider kernels.
-fn response_row(
-    img: &[u8],
-    w: usize,
-    y: usize,
-    dir: ScanDir,
-    kern: &Kernel,
-    row: &mut [f32],
-    acc: &mut Vec<i16>,
-) {
-    let (a, c, scale) = (kern.a, kern.c(), kern.scale);
-    if a <= 5 {
-        let (lo, n) = match dir {
-            ScanDir::Horizontal => (a, w - 2 * a),
-            ScanDir::Vertical => (0, w),
-        };
-        acc.clear();
-        acc.resize(n, 0);
-        for (k, &cs) in c.iter().enumerate() {
-            if cs == 0.0 {
-                continue;
-            }
-            let (s, ci) = (k + 1, cs as i16);
-            let (hi, lo_src) = match dir {
-                ScanDir::Horizontal => {
-                    let src = &img[y * w..(y + 1) * w];
-                    (&src[a + s..a + s + n], &src[a - s..a - s + n])
-                }
-                ScanDir::Vertical => (
-                    &img[(y + s) * w..(y + s + 1) * w],
-                    &img[(y - s) * w..(y - s + 1) * w],
-                ),
-            };
-            for ((o, &h), &l) in acc.iter_mut().zip(hi).zip(lo_src) {
-                *o = o.wrapping_add(ci.wrapping_mul(h as i16 - l as i16));
-            }
-        }
-        for (o, &v) in row[lo..lo + n].iter_mut().zip(acc.iter()) {
-            *o = v as f32 * scale;
-        }
-        return;
-    }
+/// the valid band `a..w-a` is written for the horizontal scan), through the
+/// row kernel `edges::response_into` uses, so both paths agree bit for bit.
+fn response_row(img: &[u8], w: usize, y: usize, dir: ScanDir, a: usize, out: &mut [f32]) {
     match dir {
         ScanDir::Horizontal => {
-            let src = &img[y * w..(y + 1) * w];
-            let o = &mut row[a..w - a];
-            let n = o.len();
-            o.fill(0.0);
-            for (k, &cs) in c.iter().enumerate() {
-                let s = k + 1;
-                let right = &src[a + s..a + s + n];
-                let left = &src[a - s..a - s + n];
-                for ((o, &r), &l) in o.iter_mut().zip(right).zip(left) {
-                    *o += cs * (r as f32 - l as f32);
-                }
-            }
-            for v in o.iter_mut() {
-                *v *= scale;
+            if let (Some(src), Some(o)) = (img.get(y * w..(y + 1) * w), out.get_mut(a..w - a)) {
+                row::lee_row(&row::Taps::horizontal(src, a), a, o);
             }
         }
-        ScanDir::Vertical => {
-            row.fill(0.0);
-            for (k, &cs) in c.iter().enumerate() {
-                let s = k + 1;
-                let below = &img[(y + s) * w..(y + s + 1) * w];
-                let above = &img[(y - s) * w..(y - s + 1) * w];
-                for ((o, &b), &t) in row.iter_mut().zip(below).zip(above) {
-                    *o += cs * (b as f32 - t as f32);
-                }
-            }
-            for v in row.iter_mut() {
-                *v *= scale;
-            }
-        }
+        ScanDir::Vertical => row::lee_row(&row::Taps::vertical(img, w, y, a), a, out),
     }
 }
 
@@ -308,8 +237,21 @@ fn fused(
     out.width = w;
     out.height = h;
     out.dir = dir;
-    out.data.clear();
-    out.data.resize(w * h, f32::NAN);
+    if out.data.len() != w * h {
+        out.data.clear();
+        out.data.resize(w * h, f32::NAN);
+    }
+    // No response outside the valid band; the band is written below.
+    for (y, orow) in out.data.chunks_exact_mut(w).enumerate() {
+        match dir {
+            ScanDir::Horizontal => {
+                orow[..a].fill(f32::NAN);
+                orow[w - a..].fill(f32::NAN);
+            }
+            ScanDir::Vertical if y < a || y + a >= h => orow.fill(f32::NAN),
+            ScanDir::Vertical => {}
+        }
+    }
     // The valid band: x in a..w-a (horizontal) or y in a..h-a (vertical).
     let inside = |x: usize, y: usize| match dir {
         ScanDir::Horizontal => x >= a && x + a < w,
@@ -342,11 +284,11 @@ fn fused(
     };
     for y in rows {
         if let Some(m) = ambient {
-            response_row(m.data(), w, y, dir, &kern, &mut s.amb_row, &mut s.acc);
+            response_row(m.data(), w, y, dir, a, &mut s.amb_row);
         }
         let sum = &mut out.data[y * w..(y + 1) * w];
         for (i, img) in images.iter().enumerate() {
-            response_row(img.data(), w, y, dir, &kern, &mut s.row, &mut s.acc);
+            response_row(img.data(), w, y, dir, a, &mut s.row);
             let tau = s.taus[i];
             let cols = cols.clone();
             let (r, amb, sm, best) = (
@@ -355,24 +297,43 @@ fn fused(
                 &mut sum[cols.clone()],
                 &mut s.best_row[cols],
             );
-            let sub = ambient.is_some();
-            for (((&v, &am), o), b) in r.iter().zip(amb).zip(sm.iter_mut()).zip(best.iter_mut()) {
-                let v = if sub { v - am } else { v };
-                let m = v.abs();
-                let cc = m - tau;
-                let add = if cc > 0.0 || cc.is_nan() { cc } else { 0.0 };
-                if i == 0 {
-                    *o = add;
-                    *b = v;
-                } else {
-                    *o += add;
-                    *b = if m > b.abs() { v } else { *b };
-                }
+            match (i == 0, ambient.is_some()) {
+                (true, true) => combine_row::<true, true>(r, amb, tau, sm, best),
+                (true, false) => combine_row::<true, false>(r, amb, tau, sm, best),
+                (false, true) => combine_row::<false, true>(r, amb, tau, sm, best),
+                (false, false) => combine_row::<false, false>(r, amb, tau, sm, best),
             }
         }
         let cols = cols.clone();
         for (o, &b) in sum[cols.clone()].iter_mut().zip(&s.best_row[cols]) {
             *o = if b < 0.0 { -*o } else { *o };
+        }
+    }
+}
+
+/// One image's contribution to one row of the combination, as [`start`]
+/// (`FIRST`) or [`accumulate_diff`] do it, with the ambient response
+/// subtracted when `SUB`. The flags are constants, so the loop has only
+/// selects and vectorises.
+#[inline(always)]
+fn combine_row<const FIRST: bool, const SUB: bool>(
+    r: &[f32],
+    amb: &[f32],
+    tau: f32,
+    sum: &mut [f32],
+    best: &mut [f32],
+) {
+    for (((&v, &am), o), b) in r.iter().zip(amb).zip(sum.iter_mut()).zip(best.iter_mut()) {
+        let v = if SUB { v - am } else { v };
+        let m = v.abs();
+        let cc = m - tau;
+        let add = if cc > 0.0 || cc.is_nan() { cc } else { 0.0 };
+        if FIRST {
+            *o = add;
+            *b = v;
+        } else {
+            *o += add;
+            *b = if m > b.abs() { v } else { *b };
         }
     }
 }
@@ -447,7 +408,7 @@ fn sign(sum: &mut [f32], best: &[f32]) {
 }
 
 /// `τ = factor × median |r|` over the finite responses, estimated on an even
-/// subsample of at most [`MEDIAN_SAMPLES`] values. 0 for a response with no
+/// subsample of at most `MEDIAN_SAMPLES` (4096) values. 0 for a response with no
 /// finite value.
 pub fn noise_level(r: &[f32], factor: f64) -> f32 {
     noise_level_of(r, None, factor, &mut Vec::new())
@@ -658,20 +619,20 @@ mod tests {
     fn the_row_path_equals_the_per_image_path_bit_for_bit() {
         let mut x = 99u64;
         let mut noisy = |lo: u8, hi: u8, at: usize| {
-            let data = (0..70 * 50)
+            let data = (0..150 * 50)
                 .map(|k| {
                     x = x
                         .wrapping_mul(6364136223846793005)
                         .wrapping_add(1442695040888963407);
-                    let v = if k % 70 + k / 70 < at { lo } else { hi };
+                    let v = if k % 150 + k / 150 < at { lo } else { hi };
                     v.saturating_add((x >> 59) as u8)
                 })
                 .collect();
-            GreyImage::new(70, 50, data).unwrap()
+            GreyImage::new(150, 50, data).unwrap()
         };
         let imgs = [noisy(40, 200, 50), noisy(150, 90, 70), noisy(100, 100, 0)];
         let amb = noisy(20, 45, 60);
-        for a in [3, 4, 7] {
+        for a in 3..=7 {
             let p = EdgeParams {
                 half_width: a,
                 ..EdgeParams::default()

@@ -19,6 +19,7 @@ use super::image::GreyImage;
 use super::lens::{LensMap, correct_into};
 use super::lines::{LineScratch, extract_into};
 use super::params::{Params, Stage};
+use super::photometric::{PhotoScratch, combined_response_into};
 use super::{EdgePoints, LlvError, ScanDir, Segment};
 
 /// Wall-clock time of each stage of one run, in microseconds (0 for a
@@ -83,6 +84,8 @@ pub struct Workspace {
     out: StageOutputs,
     ambient_corrected: GreyImage,
     response: ResponseScratch,
+    /// Buffers of the several-lightings combination (llv.md §2.6).
+    photo: PhotoScratch,
     peaks: PeakScratch,
     lines: LineScratch,
     connect: ConnectScratch,
@@ -258,16 +261,12 @@ impl Workspace {
             )?;
         } else {
             let ep = &self.out.params.edges;
-            let h = crate::llv::photometric::combined_response(
-                images,
-                ambient,
-                ScanDir::Horizontal,
-                ep,
-            )?;
-            let v =
-                crate::llv::photometric::combined_response(images, ambient, ScanDir::Vertical, ep)?;
-            self.out.response_h = h;
-            self.out.response_v = v;
+            for (dir, out) in [
+                (ScanDir::Horizontal, &mut self.out.response_h),
+                (ScanDir::Vertical, &mut self.out.response_v),
+            ] {
+                combined_response_into(images, ambient, dir, ep, out, &mut self.photo)?;
+            }
         }
         Ok(())
     }

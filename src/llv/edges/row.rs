@@ -1,0 +1,210 @@
+//! The Lee convolution of one output row, shared by the single-image
+//! response ([`super::response_into`]) and the photometric combination
+//! (`photometric.rs`), so both compute the same `f32` bit for bit.
+//!
+//! By antisymmetry, `E = (Σ_{s=1..A-1} c_s (hi_s − lo_s)) / A³` with
+//! `c_s = 6 s (A − s)` (`c_A = 0`), where `hi_s`/`lo_s` are the pixels `s`
+//! steps after/before along the scan. Each output is computed in registers
+//! over all taps (the half-width is a const generic, so the tap loop is
+//! unrolled) in blocks of [`BLK`] outputs, then scaled once. The integer sum
+//! is exact, so it is the same whatever the lane type:
+//! - `A ≤ 5`: `Σ c_s · 255 ≤ 30 600 < 2¹⁵`, so `i16` lanes (eight per SSE2
+//!   register, no widening per tap);
+//! - `A = 6, 7`: up to `336 · 255`, so `i32` lanes.
+//!
+//! `(sum as f32) · (1/A³)` is then one rounding, the same as the former
+//! `f32` accumulation of whole numbers followed by the same scaling.
+
+/// Outputs per block: eight SSE2 registers of `i16` accumulators; fewer
+/// outputs per block spend as much on slicing the taps as on arithmetic.
+const BLK: usize = 64;
+
+/// The source rows of one output row: tap `s` (1..A) reads `hi[s][j]` and
+/// `lo[s][j]` for output `j`. Entries past `A` (and index 0) are unused.
+#[derive(Clone, Copy)]
+pub(crate) struct Taps<'a> {
+    pub hi: [&'a [u8]; 8],
+    pub lo: [&'a [u8]; 8],
+}
+
+impl<'a> Taps<'a> {
+    /// Horizontal scan: output `j` is pixel `x = j + a` of `row`, so tap `s`
+    /// reads `row[j + a ± s]`. Needs `row.len() > 2a`.
+    pub fn horizontal(row: &'a [u8], a: usize) -> Self {
+        let mut t = Taps {
+            hi: [&[]; 8],
+            lo: [&[]; 8],
+        };
+        for s in 1..=a.min(7) {
+            t.hi[s] = row.get(a + s..).unwrap_or(&[]);
+            t.lo[s] = row.get(a - s..).unwrap_or(&[]);
+        }
+        t
+    }
+
+    /// Vertical scan at row `y` of a `w`-wide image `px`: tap `s` reads rows
+    /// `y ± s`. Needs `a ≤ y < h − a`.
+    pub fn vertical(px: &'a [u8], w: usize, y: usize, a: usize) -> Self {
+        let mut t = Taps {
+            hi: [&[]; 8],
+            lo: [&[]; 8],
+        };
+        for s in 1..=a.min(7) {
+            t.hi[s] = px.get((y + s) * w..(y + s + 1) * w).unwrap_or(&[]);
+            t.lo[s] = px.get((y - s) * w..(y - s + 1) * w).unwrap_or(&[]);
+        }
+        t
+    }
+
+    /// Whether every tap covers `n` outputs (so the kernels cannot index
+    /// out of range).
+    fn covers(&self, a: usize, n: usize) -> bool {
+        (1..a).all(|s| self.hi[s].len() >= n && self.lo[s].len() >= n)
+    }
+}
+
+/// Writes the Lee response with half-width `a` (3–7) of every output of
+/// `out` (its length is the number of outputs). Leaves `out` untouched if
+/// the taps are too short (a caller's bug, never reached from the stages).
+pub(crate) fn lee_row(taps: &Taps, a: usize, out: &mut [f32]) {
+    if !taps.covers(a, out.len()) {
+        debug_assert!(false, "taps shorter than the output row");
+        return;
+    }
+    match a {
+        3 => row_i16::<3>(taps, out),
+        4 => row_i16::<4>(taps, out),
+        5 => row_i16::<5>(taps, out),
+        6 => row_i32::<6>(taps, out),
+        7 => row_i32::<7>(taps, out),
+        _ => debug_assert!(false, "half-width {a} outside 3..=7"),
+    }
+}
+
+/// `c_s = 6 s (A − s)` for `s = 0..8` (only `1..A` is used).
+const fn coef(a: usize, s: usize) -> i32 {
+    if s == 0 || s >= a {
+        0
+    } else {
+        (6 * s * (a - s)) as i32
+    }
+}
+
+fn scale(a: usize) -> f32 {
+    1.0 / (a * a * a) as f32
+}
+
+/// One output, exactly: the fallback for rows shorter than a block.
+#[inline]
+fn one(taps: &Taps, a: usize, j: usize) -> f32 {
+    let mut acc = 0i32;
+    for s in 1..a {
+        acc += coef(a, s) * (i32::from(taps.hi[s][j]) - i32::from(taps.lo[s][j]));
+    }
+    acc as f32 * scale(a)
+}
+
+fn row_i16<const A: usize>(taps: &Taps, out: &mut [f32]) {
+    let n = out.len();
+    let sc = scale(A);
+    #[inline(always)]
+    fn block<const A: usize>(taps: &Taps, i: usize, out: &mut [f32], sc: f32) {
+        let mut acc = [0i16; BLK];
+        for s in 1..A {
+            let c = coef(A, s) as i16;
+            let h = &taps.hi[s][i..i + BLK];
+            let l = &taps.lo[s][i..i + BLK];
+            for ((o, &h), &l) in acc.iter_mut().zip(h).zip(l) {
+                *o = o.wrapping_add(c.wrapping_mul(h as i16 - l as i16));
+            }
+        }
+        for (o, &v) in out[i..i + BLK].iter_mut().zip(&acc) {
+            *o = v as f32 * sc;
+        }
+    }
+    if n < BLK {
+        for (j, o) in out.iter_mut().enumerate() {
+            *o = one(taps, A, j);
+        }
+        return;
+    }
+    let mut i = 0;
+    while i + BLK <= n {
+        block::<A>(taps, i, out, sc);
+        i += BLK;
+    }
+    if i < n {
+        // The last, overlapping block: recomputed outputs are identical.
+        block::<A>(taps, n - BLK, out, sc);
+    }
+}
+
+fn row_i32<const A: usize>(taps: &Taps, out: &mut [f32]) {
+    let n = out.len();
+    let sc = scale(A);
+    #[inline(always)]
+    fn block<const A: usize>(taps: &Taps, i: usize, out: &mut [f32], sc: f32) {
+        let mut acc = [0i32; BLK];
+        for s in 1..A {
+            let c = coef(A, s);
+            let h = &taps.hi[s][i..i + BLK];
+            let l = &taps.lo[s][i..i + BLK];
+            for ((o, &h), &l) in acc.iter_mut().zip(h).zip(l) {
+                *o += c * (i32::from(h) - i32::from(l));
+            }
+        }
+        for (o, &v) in out[i..i + BLK].iter_mut().zip(&acc) {
+            *o = v as f32 * sc;
+        }
+    }
+    if n < BLK {
+        for (j, o) in out.iter_mut().enumerate() {
+            *o = one(taps, A, j);
+        }
+        return;
+    }
+    let mut i = 0;
+    while i + BLK <= n {
+        block::<A>(taps, i, out, sc);
+        i += BLK;
+    }
+    if i < n {
+        block::<A>(taps, n - BLK, out, sc);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_equal_the_tap_by_tap_float_sum_for_every_length() {
+        let mut x = 7u64;
+        let src: Vec<u8> = (0..200)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                x as u8
+            })
+            .collect();
+        for a in 3..=7 {
+            for len in 2 * a + 1..=200 {
+                let row = &src[..len];
+                let n = len - 2 * a;
+                let mut out = vec![f32::NAN; n];
+                lee_row(&Taps::horizontal(row, a), a, &mut out);
+                for (j, &v) in out.iter().enumerate() {
+                    let x = j + a;
+                    let mut want = 0f32;
+                    for s in 1..=a {
+                        let c = (6 * s * (a - s)) as f32;
+                        want += c * (row[x + s] as f32 - row[x - s] as f32);
+                    }
+                    want *= 1.0 / (a * a * a) as f32;
+                    assert_eq!(v.to_bits(), want.to_bits(), "a={a} len={len} j={j}");
+                }
+            }
+        }
+    }
+}
