@@ -191,7 +191,9 @@ impl Cursor {
 struct Grid {
     words: usize,
     occupied: Vec<u64>,
-    unused: Vec<u64>,
+    /// The unused points, by polarity ([`polarity`]): a track only takes
+    /// points of its start's polarity, so only those can continue it.
+    unused: [Vec<u64>; 2],
     /// Per word of `occupied`: the index of the first point at or after
     /// its first column (points before it on the scan line, plus the scan
     /// line's start), so a column's point is found without a search.
@@ -201,7 +203,8 @@ struct Grid {
 impl Grid {
     fn build(&mut self, points: &[ScanPoint], row_start: &[u32], nrows: usize) -> bool {
         self.occupied.clear();
-        self.unused.clear();
+        self.unused[0].clear();
+        self.unused[1].clear();
         self.before.clear();
         self.words = 0;
         let mut max = 0i64;
@@ -226,7 +229,15 @@ impl Grid {
                 self.occupied[w] |= bit;
             }
         }
-        self.unused.extend_from_slice(&self.occupied);
+        for u in &mut self.unused {
+            u.resize(self.occupied.len(), 0);
+        }
+        for r in 0..nrows {
+            for q in &points[row_start[r] as usize..row_start[r + 1] as usize] {
+                let c = q.iu as usize + 64;
+                self.unused[polarity(q.response)][r * self.words + c / 64] |= 1u64 << (c % 64);
+            }
+        }
         self.before.reserve(self.occupied.len());
         for (&first, row) in row_start.iter().zip(self.occupied.chunks_exact(self.words)) {
             let mut n = first;
@@ -268,9 +279,9 @@ impl Grid {
     }
 
     #[inline]
-    fn mark_used(&mut self, r: usize, iu: i64) {
-        let c = iu as usize + 64;
-        self.unused[r * self.words + c / 64] &= !(1u64 << (c % 64));
+    fn mark_used(&mut self, r: usize, q: &ScanPoint) {
+        let c = q.iu as usize + 64;
+        self.unused[polarity(q.response)][r * self.words + c / 64] &= !(1u64 << (c % 64));
     }
 
     /// The template of §3.1 for a point at column `iu` of scan line `row`.
@@ -292,7 +303,8 @@ impl Grid {
         best_template(&score)
     }
 
-    /// [`has_successor`] from the bitmaps: an unused point with `u` in
+    /// [`has_successor`] from the bitmaps, sharper: an unused point of the
+    /// start's polarity (the only kind a track takes) with `u` in
     /// `[u − reach, u + reach]` on scan line `row + i`, `reach = i + sw`.
     /// A point's `u` is within ½ px of its column, so the columns
     /// `iu ± (⌊reach⌋ + 2)` hold every candidate: when their bits are clear
@@ -316,7 +328,8 @@ impl Grid {
             let reach = i as f64 + sw;
             let half = reach as i64 + 2;
             let lo = sp.iu - half;
-            let mut bits = self.window(&self.unused, r, lo, (2 * half + 1) as u32);
+            let unused = &self.unused[polarity(sp.response)];
+            let mut bits = self.window(unused, r, lo, (2 * half + 1) as u32);
             if bits == 0 {
                 continue;
             }
@@ -340,6 +353,13 @@ impl Grid {
         }
         false
     }
+}
+
+/// Which of a track's two polarities a point has: 1 for a positive
+/// response (dark → light), 0 otherwise (as the extractor compares them).
+#[inline]
+fn polarity(response: f32) -> usize {
+    usize::from(response > 0.0)
 }
 
 /// The template with the largest score, ties in [`TEMPLATE_PREFERENCE`].
@@ -484,7 +504,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
         s.used[start] = true;
         let sp = s.points[start];
         let template = if use_grid {
-            grid.mark_used(start_row, sp.iu);
+            grid.mark_used(start_row, &sp);
             if !grid.has_successor(s, &sp, start_row, p.max_gap as usize, sw) {
                 continue;
             }
@@ -543,7 +563,8 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
                 if use_grid && pred.abs() < 1e9 {
                     let half = sw as i64 + 2;
                     let lo = pred as i64 - half;
-                    let mut bits = grid.window(&grid.unused, r, lo, (2 * half + 1) as u32);
+                    let unused = &grid.unused[polarity(sp.response)];
+                    let mut bits = grid.window(unused, r, lo, (2 * half + 1) as u32);
                     let mut best: Option<(f64, usize)> = None;
                     while bits != 0 {
                         let c = lo + bits.trailing_zeros() as i64;
@@ -612,7 +633,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
             }
             s.used[idx] = true;
             if use_grid {
-                grid.mark_used(r, s.points[idx].iu);
+                grid.mark_used(r, &s.points[idx]);
             }
             let q = s.points[idx];
             fit.add(Point::new(q.u as f64, q.v as f64));
