@@ -355,6 +355,34 @@ impl Grid {
     }
 }
 
+/// Of the candidate points `near` (unused, in order along the scan line),
+/// the one nearest the prediction `pred` within `±sw` that has the start's
+/// polarity (ties: the first, the smaller `u`). A straight edge keeps its
+/// polarity along its length; chains of noise points alternate.
+fn nearest(
+    points: &[ScanPoint],
+    near: impl Iterator<Item = usize>,
+    pred: f64,
+    sw: f64,
+    start_response: f32,
+) -> Option<usize> {
+    let mut best: Option<(f64, usize)> = None;
+    for idx in near {
+        let q = &points[idx];
+        let d = q.u as f64 - pred;
+        if (q.u as f64) < pred - sw || d > sw {
+            continue;
+        }
+        if polarity(q.response) != polarity(start_response) {
+            continue;
+        }
+        if best.is_none_or(|(bd, _)| d.abs() < bd) {
+            best = Some((d.abs(), idx));
+        }
+    }
+    best.map(|(_, idx)| idx)
+}
+
 /// Which of a track's two polarities a point has: 1 for a positive
 /// response (dark → light), 0 otherwise (as the extractor compares them).
 #[inline]
@@ -565,52 +593,25 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
                     let lo = pred as i64 - half;
                     let unused = &grid.unused[polarity(sp.response)];
                     let mut bits = grid.window(unused, r, lo, (2 * half + 1) as u32);
-                    let mut best: Option<(f64, usize)> = None;
-                    while bits != 0 {
-                        let c = lo + bits.trailing_zeros() as i64;
-                        bits &= bits - 1;
-                        let idx = grid.point_at(r, c);
-                        let q = &s.points[idx];
-                        let d = q.u as f64 - pred;
-                        if (q.u as f64) < pred - sw || d > sw {
-                            continue;
-                        }
-                        if (q.response > 0.0) != (sp.response > 0.0) {
-                            continue;
-                        }
-                        if best.is_none_or(|(bd, _)| d.abs() < bd) {
-                            best = Some((d.abs(), idx));
-                        }
-                    }
-                    if let Some((_, idx)) = best {
+                    let near = std::iter::from_fn(|| {
+                        (bits != 0).then(|| {
+                            let c = lo + bits.trailing_zeros() as i64;
+                            bits &= bits - 1;
+                            grid.point_at(r, c)
+                        })
+                    });
+                    if let Some(idx) = nearest(&s.points, near, pred, sw, sp.response) {
                         found = Some((idx, r));
                         break;
                     }
                     continue;
                 }
                 let (lo, hi) = (s.row_start[r] as usize, s.row_start[r + 1] as usize);
-                let row = &s.points[lo..hi];
-                let first = row.partition_point(|q| (q.u as f64) < pred - sw);
-                let mut best: Option<(f64, usize)> = None;
-                for (k, q) in row[first..].iter().enumerate() {
-                    let d = q.u as f64 - pred;
-                    if d > sw {
-                        break;
-                    }
-                    let idx = lo + first + k;
-                    if s.used[idx] {
-                        continue;
-                    }
-                    // A straight edge keeps its polarity along its length;
-                    // chains of noise points alternate.
-                    if (q.response > 0.0) != (sp.response > 0.0) {
-                        continue;
-                    }
-                    if best.is_none_or(|(bd, _)| d.abs() < bd) {
-                        best = Some((d.abs(), idx));
-                    }
-                }
-                if let Some((_, idx)) = best {
+                let first = lo + s.points[lo..hi].partition_point(|q| (q.u as f64) < pred - sw);
+                let near = (first..hi)
+                    .take_while(|&k| s.points[k].u as f64 - pred <= sw)
+                    .filter(|&k| !s.used[k]);
+                if let Some(idx) = nearest(&s.points, near, pred, sw, sp.response) {
                     found = Some((idx, r));
                     break;
                 }
