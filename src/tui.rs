@@ -158,8 +158,10 @@ fn run_loop(
                 dirty |= !matches!(msg, Msg::Tick);
                 let cmds = app.update(msg);
                 workers.dispatch(cmds);
-                // Take whatever else is waiting before drawing again.
+                // Take whatever else is waiting before drawing again (a key
+                // queued behind a tick must still mark the screen dirty).
                 while let Ok(msg) = rx.try_recv() {
+                    dirty |= !matches!(msg, Msg::Tick);
                     let cmds = app.update(msg);
                     workers.dispatch(cmds);
                     if app.quit {
