@@ -43,8 +43,8 @@
 //! from a column by per-word counts instead of binary searches. The bitmaps
 //! are exact only when no two points of a scan line share a column (true of
 //! edge points, one pixel thick); otherwise — a hand-made file — the
-//! extractor walks the scan lines with forward-only `Cursor`s, with the
-//! same result (a test compares both).
+//! extractor walks the scan lines with binary searches, with the same
+//! result (a test compares both).
 
 use super::fit::LineFit;
 use super::params::LineParams;
@@ -131,8 +131,6 @@ pub struct LineScratch {
     used: Vec<bool>,
     /// The scan line of each input point (`u32::MAX`: not finite).
     rows: Vec<u32>,
-    /// Cursors on the next `max_gap` scan lines (see [`has_successor`]).
-    next: Vec<Cursor>,
     grid: Grid,
     /// Tests: never use the [`Grid`] (to compare both ways).
     #[cfg(test)]
@@ -144,40 +142,6 @@ pub fn extract(e: &EdgePoints, p: &LineParams) -> Vec<Segment> {
     let mut out = Vec::new();
     extract_into(e, p, &mut out, &mut LineScratch::default());
     out
-}
-
-/// A forward-only position on one scan line near the current start point:
-/// the first point at or beyond a threshold that grows with the start
-/// point's `u`. Start points are visited in order along each scan line, so
-/// the cursors step instead of searching (binary searches were a third of
-/// the extractor's time). `idx == end` on an empty or absent line.
-#[derive(Clone, Copy, Debug, Default)]
-struct Cursor {
-    idx: usize,
-    end: usize,
-}
-
-impl Cursor {
-    /// The cursor at the start of scan line `r` (empty outside `0..nrows`).
-    fn at_line(row_start: &[u32], r: i64, nrows: usize) -> Cursor {
-        if r < 0 || r as usize >= nrows {
-            return Cursor::default();
-        }
-        let r = r as usize;
-        Cursor {
-            idx: row_start[r] as usize,
-            end: row_start[r + 1] as usize,
-        }
-    }
-
-    /// Steps to the first point with `u ≥ t` (`t` never decreases).
-    #[inline]
-    fn advance(&mut self, points: &[ScanPoint], t: f64) -> usize {
-        while self.idx < self.end && (points[self.idx].u as f64) < t {
-            self.idx += 1;
-        }
-        self.idx
-    }
 }
 
 /// Bitmaps of the points by scan line and rounded `u` (one bit a pixel
@@ -224,6 +188,7 @@ impl Grid {
                 let (w, bit) = (base + c / 64, 1u64 << (c % 64));
                 if self.occupied[w] & bit != 0 {
                     self.occupied.clear();
+                    self.words = 0;
                     return false;
                 }
                 self.occupied[w] |= bit;
@@ -401,16 +366,29 @@ fn best_template(score: &[u32; 4]) -> usize {
     best
 }
 
-/// Which template fits the neighbourhood of point `sp` best (§3.1), with
-/// `lines[j + 2]` the cursor on scan line `row + j`.
-fn template_of(points: &[ScanPoint], sp: &ScanPoint, lines: &mut [Cursor; 5]) -> usize {
+/// The points of scan line `r` from the first with `u ≥ t` to the line's
+/// end (indices into `s.points`); empty outside `0..nrows`.
+fn from_u(s: &LineScratch, r: i64, nrows: usize, t: f64) -> std::ops::Range<usize> {
+    if r < 0 || r as usize >= nrows {
+        return 0..0;
+    }
+    let (lo, hi) = (
+        s.row_start[r as usize] as usize,
+        s.row_start[r as usize + 1] as usize,
+    );
+    lo + s.points[lo..hi].partition_point(|q| (q.u as f64) < t)..hi
+}
+
+/// Which template fits the neighbourhood of point `sp` on scan line `row`
+/// best (§3.1), by walking the scan lines (what the `Grid` answers when
+/// it is exact).
+fn template_of(s: &LineScratch, sp: &ScanPoint, row: usize, nrows: usize) -> usize {
     let iu = sp.iu;
     let mut score = [0u32; 4];
-    for (j, c) in lines.iter_mut().enumerate() {
+    for (j, r) in (row as i64 - 2..=row as i64 + 2).enumerate() {
         // Every point below `iu - 3` rounds below `iu - 2`; rounded `u` is
         // sorted along the scan line like `u` itself.
-        let first = c.advance(points, iu.saturating_sub(3) as f64);
-        for q in &points[first..c.end] {
+        for q in &s.points[from_u(s, r, nrows, iu.saturating_sub(3) as f64)] {
             let i = q.iu.saturating_sub(iu);
             if i < -2 {
                 continue;
@@ -427,23 +405,19 @@ fn template_of(points: &[ScanPoint], sp: &ScanPoint, lines: &mut [Cursor; 5]) ->
 }
 
 /// Whether an unused point lies where any initial prediction (slope -1, 0
-/// or 1) could find it on the next `max_gap` scan lines, with `next[i - 1]`
-/// the cursor on scan line `row + i`.
+/// or 1) could find it on the next `max_gap` scan lines, by walking them.
 fn has_successor(
-    points: &[ScanPoint],
-    used: &[bool],
+    s: &LineScratch,
     sp: &ScanPoint,
-    next: &mut [Cursor],
-    sw: f64,
+    row: usize,
+    nrows: usize,
+    p: &LineParams,
 ) -> bool {
-    next.iter_mut().enumerate().any(|(k, c)| {
-        let reach = (k + 1) as f64 + sw;
-        let first = c.advance(points, sp.u as f64 - reach);
-        points[first..c.end]
-            .iter()
-            .zip(&used[first..c.end])
-            .take_while(|(q, _)| q.u as f64 <= sp.u as f64 + reach)
-            .any(|(_, &u)| !u)
+    (1..=p.max_gap as usize).any(|i| {
+        let reach = i as f64 + p.search_width;
+        from_u(s, (row + i) as i64, nrows, sp.u as f64 - reach)
+            .take_while(|&k| s.points[k].u as f64 <= sp.u as f64 + reach)
+            .any(|k| !s.used[k])
     })
 }
 
@@ -519,9 +493,6 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
 
     let min_angle = p.min_scan_angle_deg.to_radians();
     let mut start_row = 0;
-    let mut cursor_row = usize::MAX;
-    let mut around = [Cursor::default(); 5];
-    let mut next = std::mem::take(&mut s.next);
     for start in 0..total {
         while s.row_start[start_row + 1] as usize <= start {
             start_row += 1;
@@ -538,25 +509,13 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
             }
             grid.template(start_row, sp.iu, nrows)
         } else {
-            if cursor_row != start_row {
-                // A new scan line: the cursors start at the lines around it.
-                cursor_row = start_row;
-                for (j, c) in around.iter_mut().enumerate() {
-                    *c = Cursor::at_line(&s.row_start, start_row as i64 + j as i64 - 2, nrows);
-                }
-                next.clear();
-                next.extend(
-                    (1..=p.max_gap as i64)
-                        .map(|i| Cursor::at_line(&s.row_start, start_row as i64 + i, nrows)),
-                );
-            }
-            if !has_successor(&s.points, &s.used, &sp, &mut next, sw) {
+            if !has_successor(s, &sp, start_row, nrows, p) {
                 // No unused point within reach of any template's prediction:
                 // no line can start here (the same result, without the
                 // templates).
                 continue;
             }
-            template_of(&s.points, &sp, &mut around)
+            template_of(s, &sp, start_row, nrows)
         };
         let mut slope = TEMPLATE_SLOPE[template];
         let mut fit = LineFit::new();
@@ -606,9 +565,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
                     }
                     continue;
                 }
-                let (lo, hi) = (s.row_start[r] as usize, s.row_start[r + 1] as usize);
-                let first = lo + s.points[lo..hi].partition_point(|q| (q.u as f64) < pred - sw);
-                let near = (first..hi)
+                let near = from_u(s, r as i64, nrows, pred - sw)
                     .take_while(|&k| s.points[k].u as f64 - pred <= sw)
                     .filter(|&k| !s.used[k]);
                 if let Some(idx) = nearest(&s.points, near, pred, sw, sp.response) {
@@ -682,7 +639,6 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
             shadow: false,
         });
     }
-    s.next = next;
     s.grid = grid;
 }
 
@@ -736,13 +692,7 @@ mod tests {
                     .find(|q| q.u == 50.0 && q.v == 50.0)
                     .unwrap();
                 let nrows = s.row_start.len() - 1;
-                let mut around =
-                    [0, 1, 2, 3, 4].map(|j| Cursor::at_line(&s.row_start, 48 + j as i64, nrows));
-                assert_eq!(
-                    template_of(&s.points, &sp, &mut around),
-                    want,
-                    "{dir:?} ({du},{dv})"
-                );
+                assert_eq!(template_of(&s, &sp, 50, nrows), want, "{dir:?} ({du},{dv})");
                 let mut grid = Grid::default();
                 assert!(grid.build(&s.points, &s.row_start, nrows));
                 assert_eq!(grid.template(50, sp.iu, nrows), want, "grid {dir:?}");
@@ -840,6 +790,7 @@ mod tests {
             z ^ (z >> 31)
         };
         let mut unit = move || (next() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut gridded = 0;
         for case in 0..40 {
             let (w, h) = (40 + case * 7, 30 + case * 5);
             let mut pts: Vec<EdgePoint> = Vec::new();
@@ -877,6 +828,9 @@ mod tests {
                 }
             }
             pts.sort_by(|a, b| a.y.total_cmp(&b.y).then(a.x.total_cmp(&b.x)));
+            // One point per pixel, as edge points are (else the grid is not
+            // used at all).
+            pts.dedup_by_key(|q| (q.y, q.x.round()));
             if case % 5 == 4 {
                 // A point shifted left of the image: the grid is not used.
                 pts[0].x = -3.2;
@@ -895,7 +849,24 @@ mod tests {
                         ..LineParams::default()
                     };
                     let (mut fast, mut walk) = (Vec::new(), Vec::new());
-                    extract_into(&e, &p, &mut fast, &mut LineScratch::default());
+                    let mut fs = LineScratch::default();
+                    extract_into(&e, &p, &mut fast, &mut fs);
+                    gridded += usize::from(fs.grid.words > 0);
+                    if sw == 2.0 && fs.grid.words > 0 {
+                        // The two ways of scoring the templates agree at
+                        // every point.
+                        let nrows = fs.row_start.len() - 1;
+                        for r in 0..nrows {
+                            for k in fs.row_start[r] as usize..fs.row_start[r + 1] as usize {
+                                let q = fs.points[k];
+                                assert_eq!(
+                                    fs.grid.template(r, q.iu, nrows),
+                                    template_of(&fs, &q, r, nrows),
+                                    "case {case} {dir:?} row {r} point {k}"
+                                );
+                            }
+                        }
+                    }
                     let mut s = LineScratch {
                         walk_only: true,
                         ..LineScratch::default()
@@ -908,5 +879,9 @@ mod tests {
                 }
             }
         }
+        // 40 cases × 2 directions × 3 widths; the grid is refused only when
+        // scanning along rows in the 8 cases with a point left of the image
+        // (scanning along columns, that point is on no scan line).
+        assert_eq!(gridded, 40 * 6 - 8 * 3, "cases that used the grid");
     }
 }
