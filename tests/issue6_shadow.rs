@@ -14,6 +14,7 @@
 
 use vss::llv::pipeline::{self, Input};
 use vss::llv::shadow::{ShadowParams, flag_shadows};
+use vss::llv::synth::rng::SplitMix64;
 use vss::llv::{GreyImage, Params, Point, Segment};
 
 const W: usize = 256;
@@ -46,19 +47,9 @@ fn render(d: (f64, f64), seed: u64) -> GreyImage {
 }
 
 fn render_polygon(hull: &[(f64, f64)], seed: u64) -> GreyImage {
-    let mut s = seed;
-    let mut noise = || {
-        // SplitMix64 → sum of four uniforms: near-Gaussian, σ ≈ 2.9 grey levels.
-        let mut acc = 0.0;
-        for _ in 0..4 {
-            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = s;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            acc += ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-        }
-        acc * 5.0
-    };
+    let mut rng = SplitMix64::new(seed);
+    // Sum of four uniforms: near-Gaussian, σ ≈ 2.9 grey levels.
+    let mut noise = || (0..4).map(|_| rng.uniform() - 0.5).sum::<f64>() * 5.0;
     let mut data = Vec::with_capacity(W * W);
     for y in 0..W {
         for x in 0..W {

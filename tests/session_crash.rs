@@ -10,8 +10,9 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 use vss::formats::{edgefile, img, lines};
+use vss::llv::synth::rng::SplitMix64;
 use vss::session::Session;
-use vss::session::torture::{SplitMix, consistent_edges, consistent_image, consistent_lines};
+use vss::session::torture::{below, consistent_edges, consistent_image, consistent_lines};
 
 const PROFILE: &str = r#"
 name = "torture"
@@ -90,7 +91,7 @@ fn killed_saves_leave_complete_files_and_a_passing_check() {
         String::from_utf8_lossy(&st.stderr)
     );
     let dir = tmp.path().join("tort");
-    let mut rng = SplitMix(0x5eed);
+    let mut rng = SplitMix64::new(0x5eed);
     let mut saves = 0;
     for round in 0..30 {
         let mut child = vss()
@@ -113,7 +114,7 @@ fn killed_saves_leave_complete_files_and_a_passing_check() {
             "saved 1",
             "round {round}: the child cannot save"
         );
-        std::thread::sleep(Duration::from_millis(20 + rng.below(200)));
+        std::thread::sleep(Duration::from_millis(20 + below(&mut rng, 200)));
         child.kill().unwrap(); // SIGKILL on Unix
         child.wait().unwrap();
         let mut rest = String::new();

@@ -596,6 +596,7 @@ pub fn detect(img: &GreyImage, dir: ScanDir, p: &EdgeParams) -> Result<EdgePoint
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::llv::synth::rng::SplitMix64;
 
     fn img_from(w: usize, h: usize, f: impl Fn(usize, usize) -> u8) -> GreyImage {
         let mut d = Vec::with_capacity(w * h);
@@ -607,27 +608,20 @@ mod tests {
         GreyImage::new(w, h, d).unwrap()
     }
 
-    /// xorshift64: seeded test data.
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            self.0
-        }
-    }
-
     /// A random scene: a few steps of random height and direction, noise of
     /// random amplitude, optionally a validity mask with random invalid
     /// blobs and a few scattered invalid pixels.
-    fn random_image(rng: &mut Rng, w: usize, h: usize, masked: bool) -> GreyImage {
+    fn random_image(rng: &mut SplitMix64, w: usize, h: usize, masked: bool) -> GreyImage {
         let (x0, y0) = (
-            (rng.next() % w as u64) as i64,
-            (rng.next() % h as u64) as i64,
+            (rng.next_u64() % w as u64) as i64,
+            (rng.next_u64() % h as u64) as i64,
         );
-        let (lv0, lv1, lv2) = (rng.next() % 256, rng.next() % 256, rng.next() % 256);
-        let noise = 1 + rng.next() % 40;
+        let (lv0, lv1, lv2) = (
+            rng.next_u64() % 256,
+            rng.next_u64() % 256,
+            rng.next_u64() % 256,
+        );
+        let noise = 1 + rng.next_u64() % 40;
         let mut img = img_from(w, h, |x, y| {
             let (x, y) = (x as i64, y as i64);
             let base = if x + y / 3 < x0 {
@@ -643,8 +637,8 @@ mod tests {
         if masked {
             let mut mask = vec![true; w * h];
             for _ in 0..3 {
-                let (cx, cy) = (rng.next() % w as u64, rng.next() % h as u64);
-                let rad = 1 + rng.next() % 6;
+                let (cx, cy) = (rng.next_u64() % w as u64, rng.next_u64() % h as u64);
+                let rad = 1 + rng.next_u64() % 6;
                 for y in 0..h as u64 {
                     for x in 0..w as u64 {
                         if x.abs_diff(cx).pow(2) + y.abs_diff(cy).pow(2) <= rad * rad {
@@ -654,7 +648,7 @@ mod tests {
                 }
             }
             for _ in 0..4 {
-                mask[(rng.next() % (w * h) as u64) as usize] = false;
+                mask[(rng.next_u64() % (w * h) as u64) as usize] = false;
             }
             img.set_valid_mask(Some(mask)).unwrap();
         }
@@ -663,9 +657,9 @@ mod tests {
 
     /// Deterministic noise in `-amp..=amp` at a pixel.
     fn rng_at(x: u64, y: u64, amp: u64) -> i64 {
-        let mut r = Rng((x << 32 | y) ^ 0x9E37_79B9_7F4A_7C15);
-        r.next();
-        (r.next() % (2 * amp + 1)) as i64 - amp as i64
+        let mut r = SplitMix64::new((x << 32 | y) ^ 0x9E37_79B9_7F4A_7C15);
+        r.next_u64();
+        (r.next_u64() % (2 * amp + 1)) as i64 - amp as i64
     }
 
     fn same_bits(a: &[f32], b: &[f32]) -> bool {
@@ -684,7 +678,7 @@ mod tests {
 
     #[test]
     fn fast_responses_equal_the_reference_bit_for_bit() {
-        let mut rng = Rng(0x1234_5678_9ABC_DEF1);
+        let mut rng = SplitMix64::new(0x1234_5678_9ABC_DEF1);
         let (mut fast, mut slow) = (Response::default(), Response::default());
         let (mut fs, mut ss) = (
             ResponseScratch::default(),
@@ -710,7 +704,7 @@ mod tests {
 
     #[test]
     fn fast_peaks_equal_the_reference_point_for_point() {
-        let mut rng = Rng(0xDEAD_BEEF_0BAD_F00D);
+        let mut rng = SplitMix64::new(0xDEAD_BEEF_0BAD_F00D);
         let mut resp = Response::default();
         let mut rs = ResponseScratch::default();
         let (mut fast, mut slow) = (EdgePoints::default(), EdgePoints::default());
@@ -760,9 +754,9 @@ mod tests {
         // Hand-made responses: sizes 0 and 1 only, huge values, infinities,
         // NaN holes, ties.
         let (w, h) = (23, 19);
-        let mut rng = Rng(42);
-        let cases: [&dyn Fn(&mut Rng) -> f32; 4] = [
-            &|r| (r.next() % 200) as f32 / 100.0,
+        let mut rng = SplitMix64::new(42);
+        let cases: [&dyn Fn(&mut SplitMix64) -> f32; 4] = [
+            &|r| (r.next_u64() % 200) as f32 / 100.0,
             &|r| {
                 [
                     1.5,
@@ -775,10 +769,10 @@ mod tests {
                     256.0,
                     -255.5,
                     256.0,
-                ][(r.next() % 10) as usize]
+                ][(r.next_u64() % 10) as usize]
             },
-            &|r| [f32::INFINITY, 5.0, -3.0, 4.99][(r.next() % 4) as usize],
-            &|r| (r.next() % 7) as f32 - 3.0,
+            &|r| [f32::INFINITY, 5.0, -3.0, 4.99][(r.next_u64() % 4) as usize],
+            &|r| (r.next_u64() % 7) as f32 - 3.0,
         ];
         for f in cases {
             for dir in [ScanDir::Horizontal, ScanDir::Vertical] {

@@ -780,16 +780,8 @@ mod tests {
     /// gives the same segments, bit for bit, with and without them.
     #[test]
     fn the_grid_gives_the_same_segments_as_walking_the_scan_lines() {
-        let mut state = 0x1234_5678_9abc_def0u64;
-        let mut next = move || {
-            // SplitMix64.
-            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            z ^ (z >> 31)
-        };
-        let mut unit = move || (next() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut rng = crate::llv::synth::rng::SplitMix64::new(0x1234_5678_9abc_def0);
+        let mut unit = move || rng.uniform();
         let mut gridded = 0;
         for case in 0..40 {
             let (w, h) = (40 + case * 7, 30 + case * 5);

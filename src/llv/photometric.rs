@@ -441,13 +441,8 @@ mod tests {
     #[test]
     fn weights_are_the_optimum_of_all_3_pow_n_choices() {
         // Brute force over every weight vector for random responses.
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % 2001) as f32 / 10.0 - 100.0
-        };
+        let mut rng = crate::llv::synth::rng::SplitMix64::new(0x9E37_79B9_7F4A_7C15);
+        let mut next = || (rng.next_u64() % 2001) as f32 / 10.0 - 100.0;
         for _ in 0..200 {
             let n = 4;
             let r: Vec<f32> = (0..n).map(|_| next()).collect();

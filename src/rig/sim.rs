@@ -17,6 +17,7 @@ use std::thread::JoinHandle;
 use serialport::TTYPort;
 
 use super::RigError;
+use crate::llv::synth::rng::SplitMix64;
 use crate::profile::Profile;
 
 mod board;
@@ -26,31 +27,12 @@ mod vsg;
 
 pub use faults::{Faults, FaultsError};
 
-/// A tiny seeded generator (SplitMix64): the simulator must repeat a run.
-#[derive(Clone, Debug)]
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    pub fn new(seed: u64) -> Self {
-        SplitMix64(seed)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    pub fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Standard normal (Box–Muller).
-    pub fn gauss(&mut self) -> f64 {
-        let u1 = self.next_f64().max(1e-300);
-        let u2 = self.next_f64();
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    }
+/// Standard normal by Box–Muller, one value per two uniforms (the
+/// simulator's noise; its frames must repeat bit for bit for a seed).
+fn gauss(rng: &mut SplitMix64) -> f64 {
+    let u1 = rng.uniform().max(1e-300);
+    let u2 = rng.uniform();
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
 /// One light of the simulated cell.
@@ -185,7 +167,7 @@ impl Scene {
             .iter()
             .map(|&v| {
                 let n = if sigma > 0.0 {
-                    rng.gauss() * sigma
+                    gauss(&mut rng) * sigma
                 } else {
                     0.0
                 };

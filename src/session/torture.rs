@@ -12,27 +12,16 @@ use std::path::Path;
 
 use super::{OutputSet, Session, SessionError};
 use crate::formats::img::ImgFile;
+use crate::llv::synth::rng::SplitMix64;
 use crate::llv::{EdgePoint, EdgePoints, GreyImage, Params, Point, ScanDir, Segment};
 
 /// Image size of the torture survey: big enough that a write takes a while.
 pub const SIZE: (usize, usize) = (160, 120);
 
-/// A tiny deterministic generator (SplitMix64).
-#[derive(Clone, Debug)]
-pub struct SplitMix(pub u64);
-
-impl SplitMix {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `0..n` (n > 0).
-    pub fn below(&mut self, n: u64) -> u64 {
-        self.next_u64() % n.max(1)
-    }
+/// Uniform in `0..n` (`n > 0`) as the torture runs draw it: the generator's
+/// next value modulo `n`.
+pub fn below(rng: &mut SplitMix64, n: u64) -> u64 {
+    rng.next_u64() % n.max(1)
 }
 
 /// Grey image of iteration `v`: every pixel `v % 256`, comment `v=<v>`.
@@ -103,27 +92,27 @@ pub fn run(
     limit: u64,
     progress: &mut dyn FnMut(u64),
 ) -> Result<(), SessionError> {
-    let mut rng = SplitMix(seed);
+    let mut rng = SplitMix64::new(seed);
     let mut s = Session::open_take_over(dir)?;
     let letters = s.letters();
     let images = s.manifest().session.planned_images.max(1);
     progress(0);
     for i in 1..=limit {
-        let k = 1 + rng.below(u64::from(images)) as u32;
-        match rng.below(10) {
+        let k = 1 + below(&mut rng, u64::from(images)) as u32;
+        match below(&mut rng, 10) {
             0..=3 => {
                 let letter = letters
-                    .get(rng.below(letters.len() as u64) as usize)
+                    .get(below(&mut rng, letters.len() as u64) as usize)
                     .copied()
                     .unwrap_or('a');
                 s.save_image(k, letter, &image_for(rng.next_u64()))?;
             }
             4..=6 => {
-                let n = 1 + rng.below(400) as usize;
+                let n = 1 + below(&mut rng, 400) as usize;
                 let eh = edges_for(n, ScanDir::Horizontal);
                 let ev = edges_for(n + 1, ScanDir::Vertical);
-                let raw = lines_for(1 + rng.below(60) as usize);
-                let lines = lines_for(1 + rng.below(30) as usize);
+                let raw = lines_for(1 + below(&mut rng, 60) as usize);
+                let lines = lines_for(1 + below(&mut rng, 30) as usize);
                 let set = OutputSet {
                     edges_h: Some(&eh),
                     edges_v: Some(&ev),
@@ -134,7 +123,7 @@ pub fn run(
                 s.save_output_set(k, &set, &Params::default())?;
             }
             7 | 8 => {
-                let n = 1 + rng.below(30) as usize;
+                let n = 1 + below(&mut rng, 30) as usize;
                 s.record_edit(k, &format!("delete {n}"), &lines_for(n))?;
             }
             _ => {

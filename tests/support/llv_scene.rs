@@ -7,27 +7,12 @@
 #![allow(dead_code)]
 
 use vss::llv::GreyImage;
+use vss::llv::synth::rng::SplitMix64;
 
-/// SplitMix64: tiny, seeded, good enough for test noise.
-pub struct SplitMix64(pub u64);
-
-impl SplitMix64 {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Approximately normal (Irwin–Hall of 4), unit variance.
-    pub fn normal(&mut self) -> f64 {
-        let s: f64 = (0..4).map(|_| self.unit()).sum();
-        (s - 2.0) * 3f64.sqrt()
-    }
+/// Approximately normal (Irwin–Hall of 4), unit variance: test noise.
+fn normal(rng: &mut SplitMix64) -> f64 {
+    let s: f64 = (0..4).map(|_| rng.uniform()).sum();
+    (s - 2.0) * 3f64.sqrt()
 }
 
 /// Convex polygons in unit coordinates (0..1 across the image) and grey level.
@@ -77,7 +62,7 @@ pub fn scene(w: usize, h: usize, sigma: f64, seed: u64) -> GreyImage {
             )
         })
         .collect();
-    let mut rng = SplitMix64(seed);
+    let mut rng = SplitMix64::new(seed);
     let mut d = Vec::with_capacity(w * h);
     for y in 0..h {
         for x in 0..w {
@@ -98,7 +83,7 @@ pub fn scene(w: usize, h: usize, sigma: f64, seed: u64) -> GreyImage {
                 let cover = (inside + 0.5).clamp(0.0, 1.0);
                 v = v * (1.0 - cover) + g * cover;
             }
-            v += sigma * rng.normal();
+            v += sigma * normal(&mut rng);
             d.push(v.round().clamp(0.0, 255.0) as u8);
         }
     }

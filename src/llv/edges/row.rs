@@ -179,15 +179,8 @@ mod tests {
 
     #[test]
     fn rows_equal_the_tap_by_tap_float_sum_for_every_length() {
-        let mut x = 7u64;
-        let src: Vec<u8> = (0..200)
-            .map(|_| {
-                x ^= x << 13;
-                x ^= x >> 7;
-                x ^= x << 17;
-                x as u8
-            })
-            .collect();
+        let mut rng = crate::llv::synth::rng::SplitMix64::new(7);
+        let src: Vec<u8> = (0..200).map(|_| rng.next_u64() as u8).collect();
         for a in 3..=7 {
             for len in 2 * a + 1..=200 {
                 let row = &src[..len];

@@ -236,6 +236,7 @@ mod tests {
     use super::super::{CameraModel, correct};
     use super::*;
     use crate::llv::GreyImage;
+    use crate::llv::synth::rng::SplitMix64;
 
     /// Today's straightforward implementation, kept as the reference: a
     /// per-pixel source index (`u32::MAX` outside) and 1/256 px offsets,
@@ -325,38 +326,25 @@ mod tests {
         }
     }
 
-    /// SplitMix64: deterministic test data without the `rand` crate.
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            z ^ (z >> 31)
-        }
-        fn below(&mut self, n: u64) -> u64 {
-            self.next() % n
-        }
-        fn unit(&mut self) -> f64 {
-            (self.next() >> 11) as f64 / (1u64 << 53) as f64
-        }
+    /// Uniform in `0..n`: the generator's next value modulo `n`.
+    fn below(rng: &mut SplitMix64, n: u64) -> u64 {
+        rng.next_u64() % n
     }
 
     /// A random image; bytes often at the extremes 0 and 255 (the bounds of
     /// the 16-bit arithmetic), with a random validity mask when `masked`.
     fn random_image(w: usize, h: usize, seed: u64, masked: bool) -> GreyImage {
-        let mut rng = Rng(seed);
+        let mut rng = SplitMix64::new(seed);
         let data = (0..w * h)
-            .map(|_| match rng.below(4) {
+            .map(|_| match below(&mut rng, 4) {
                 0 => 0,
                 1 => 255,
-                _ => rng.below(256) as u8,
+                _ => below(&mut rng, 256) as u8,
             })
             .collect();
         let mut img = GreyImage::new(w, h, data).unwrap();
         if masked {
-            let mask = (0..w * h).map(|_| rng.below(10) != 0).collect();
+            let mask = (0..w * h).map(|_| below(&mut rng, 10) != 0).collect();
             img.set_valid_mask(Some(mask)).unwrap();
         }
         img
@@ -364,9 +352,9 @@ mod tests {
 
     /// A random camera scaled to the image, distorting by several pixels,
     /// barrel or pincushion.
-    fn random_camera(w: usize, h: usize, rng: &mut Rng) -> CameraModel {
+    fn random_camera(w: usize, h: usize, rng: &mut SplitMix64) -> CameraModel {
         let s = 512.0 / w.max(h) as f64;
-        let mut c = |scale: f64| (rng.unit() * 2.0 - 1.0) * scale;
+        let mut c = |scale: f64| (rng.uniform() * 2.0 - 1.0) * scale;
         CameraModel {
             cx: w as f64 / 2.0 + c(5.0),
             cy: h as f64 / 2.0 + c(5.0),
@@ -383,8 +371,9 @@ mod tests {
     fn jitter_source(w: usize, h: usize, seed: u64) -> impl Fn(usize, usize) -> (f64, f64) + Copy {
         let (xmax, ymax) = (w as f64 - 1.0, h as f64 - 1.0);
         move |x, y| {
-            let mut rng = Rng(seed ^ ((y * w + x) as u64).wrapping_mul(0x2545_f491_4f6c_dd1d));
-            let pick = |v: f64, max: f64, rng: &mut Rng| match rng.below(12) {
+            let mut rng =
+                SplitMix64::new(seed ^ ((y * w + x) as u64).wrapping_mul(0x2545_f491_4f6c_dd1d));
+            let pick = |v: f64, max: f64, rng: &mut SplitMix64| match below(rng, 12) {
                 0 => v.floor() + 0.999,
                 1 => v.floor() + 255.5 / 256.0,
                 2 => v.floor() + 255.49 / 256.0,
@@ -393,7 +382,7 @@ mod tests {
                 5 => max + 1e-3,
                 6 => max + 5e-4,
                 7 => max,
-                8 => rng.unit() * (max + 4.0) - 2.0,
+                8 => rng.uniform() * (max + 4.0) - 2.0,
                 _ => v,
             };
             let (dx, dy) = (
@@ -401,7 +390,7 @@ mod tests {
                 -0.4 + 0.2 * (x as f64 / w as f64),
             );
             let (xs, ys) = (x as f64 + dx, y as f64 + dy);
-            if rng.below(3) == 0 {
+            if below(&mut rng, 3) == 0 {
                 (pick(xs, xmax, &mut rng), pick(ys, ymax, &mut rng))
             } else {
                 (xs, ys)
@@ -452,12 +441,12 @@ mod tests {
 
     #[test]
     fn matches_the_reference_on_camera_maps() {
-        let mut rng = Rng(7);
+        let mut rng = SplitMix64::new(7);
         for (w, h) in SIZES {
             for k in 0..4 {
                 let m = random_camera(w, h, &mut rng);
                 let src = |x: usize, y: usize| m.ideal_to_observed_converged(x as f64, y as f64);
-                check(w, h, src, rng.next() + k);
+                check(w, h, src, rng.next_u64() + k);
             }
         }
     }
@@ -494,11 +483,11 @@ mod tests {
         // Every (fx, fy) below 256 with the extreme neighbourhoods (where an
         // overflow would show; the debug build also checks every step) and
         // random ones.
-        let mut rng = Rng(5);
+        let mut rng = SplitMix64::new(5);
         let mut quads: Vec<[u8; 4]> = (0..16u8)
             .map(|m| [0, 1, 2, 3].map(|b| if m >> b & 1 == 1 { 255 } else { 0 }))
             .collect();
-        quads.extend((0..48).map(|_| [0; 4].map(|_: u8| rng.below(256) as u8)));
+        quads.extend((0..48).map(|_| [0; 4].map(|_: u8| below(&mut rng, 256) as u8)));
         for fx in 0..=255u8 {
             for fy in 0..=255u8 {
                 for &[p00, p10, p01, p11] in &quads {
@@ -515,7 +504,7 @@ mod tests {
     #[test]
     fn a_reused_output_is_the_same_as_a_fresh_one() {
         let (w, h) = (37, 53);
-        let m = random_camera(w, h, &mut Rng(11));
+        let m = random_camera(w, h, &mut SplitMix64::new(11));
         let map = LensMap::new(&m, w, h);
         let mut out = GreyImage::filled(64, 64, 77).unwrap();
         for seed in 0..4 {

@@ -5,7 +5,7 @@
 
 use std::time::Duration;
 
-use super::SplitMix64;
+use crate::llv::synth::rng::SplitMix64;
 
 /// The faults asked for; the default is a clean line.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -177,10 +177,10 @@ impl FaultState {
                 return Outgoing::SendThenUnplug(out);
             }
             self.sent += 1;
-            if drop > 0.0 && self.rng.next_f64() < drop {
+            if drop > 0.0 && self.rng.uniform() < drop {
                 continue;
             }
-            if corrupt > 0.0 && self.rng.next_f64() < corrupt {
+            if corrupt > 0.0 && self.rng.uniform() < corrupt {
                 let flip = (self.rng.next_u64() % 255) as u8 + 1;
                 out.push(b ^ flip);
                 continue;
