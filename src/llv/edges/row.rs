@@ -104,11 +104,31 @@ fn one(taps: &Taps, a: usize, j: usize) -> f32 {
     acc as f32 * scale(a)
 }
 
-fn row_i16<const A: usize>(taps: &Taps, out: &mut [f32]) {
+/// Runs `block(i, out)` on blocks of [`BLK`] outputs starting at `i` that
+/// cover the row, the last one overlapping its predecessor (recomputed
+/// outputs are identical); rows shorter than a block go output by output.
+#[inline(always)]
+fn by_blocks(taps: &Taps, a: usize, out: &mut [f32], mut block: impl FnMut(usize, &mut [f32])) {
     let n = out.len();
+    if n < BLK {
+        for (j, o) in out.iter_mut().enumerate() {
+            *o = one(taps, a, j);
+        }
+        return;
+    }
+    let mut i = 0;
+    while i + BLK <= n {
+        block(i, out);
+        i += BLK;
+    }
+    if i < n {
+        block(n - BLK, out);
+    }
+}
+
+fn row_i16<const A: usize>(taps: &Taps, out: &mut [f32]) {
     let sc = scale(A);
-    #[inline(always)]
-    fn block<const A: usize>(taps: &Taps, i: usize, out: &mut [f32], sc: f32) {
+    by_blocks(taps, A, out, |i, out| {
         let mut acc = [0i16; BLK];
         for s in 1..A {
             let c = coef(A, s) as i16;
@@ -121,29 +141,12 @@ fn row_i16<const A: usize>(taps: &Taps, out: &mut [f32]) {
         for (o, &v) in out[i..i + BLK].iter_mut().zip(&acc) {
             *o = v as f32 * sc;
         }
-    }
-    if n < BLK {
-        for (j, o) in out.iter_mut().enumerate() {
-            *o = one(taps, A, j);
-        }
-        return;
-    }
-    let mut i = 0;
-    while i + BLK <= n {
-        block::<A>(taps, i, out, sc);
-        i += BLK;
-    }
-    if i < n {
-        // The last, overlapping block: recomputed outputs are identical.
-        block::<A>(taps, n - BLK, out, sc);
-    }
+    });
 }
 
 fn row_i32<const A: usize>(taps: &Taps, out: &mut [f32]) {
-    let n = out.len();
     let sc = scale(A);
-    #[inline(always)]
-    fn block<const A: usize>(taps: &Taps, i: usize, out: &mut [f32], sc: f32) {
+    by_blocks(taps, A, out, |i, out| {
         let mut acc = [0i32; BLK];
         for s in 1..A {
             let c = coef(A, s);
@@ -156,21 +159,7 @@ fn row_i32<const A: usize>(taps: &Taps, out: &mut [f32]) {
         for (o, &v) in out[i..i + BLK].iter_mut().zip(&acc) {
             *o = v as f32 * sc;
         }
-    }
-    if n < BLK {
-        for (j, o) in out.iter_mut().enumerate() {
-            *o = one(taps, A, j);
-        }
-        return;
-    }
-    let mut i = 0;
-    while i + BLK <= n {
-        block::<A>(taps, i, out, sc);
-        i += BLK;
-    }
-    if i < n {
-        block::<A>(taps, n - BLK, out, sc);
-    }
+    });
 }
 
 #[cfg(test)]
