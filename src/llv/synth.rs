@@ -24,12 +24,15 @@ pub mod straight;
 mod truth;
 
 pub use geom::{Face, Polyhedron, V3, look_at};
+pub use render::{finish, render_exact};
 pub use scenes::{CELL_LIGHT_NAMES, cell_cameras, cell_lights, cell_scene, l_bracket, test_scenes};
 pub use score::{Metrics, Tally, score, score_all};
-pub use truth::{MARGIN as TRUTH_MARGIN, MIN_PIECE as TRUTH_MIN_PIECE};
+pub use truth::{
+    MARGIN as TRUTH_MARGIN, MIN_PIECE as TRUTH_MIN_PIECE, visible_edges as true_edges,
+};
 
 use super::lens::CameraModel;
-use super::{GreyImage, Point, Segment};
+use super::{GreyImage, Point};
 
 /// What the cameras look at: objects standing on an optional floor plate, in
 /// front of a uniform background (what a ray sees when it hits nothing).
@@ -108,40 +111,8 @@ impl Default for RenderOptions {
 /// module doc and `render.rs` for the sampling). A camera of zero size gives
 /// a 1 × 1 black image.
 pub fn render(scene: &Scene, cam: &Camera, lights: &[PointLight], o: &RenderOptions) -> GreyImage {
-    let exact = render::render_exact(scene, cam, lights, o);
-    render::finish(exact, cam.width, cam.height, o)
-}
-
-/// The noise-free, unblurred, unclamped render (grey levels, row-major), for
-/// callers that add their own noise per frame (the simulated grabber).
-pub fn render_exact(
-    scene: &Scene,
-    cam: &Camera,
-    lights: &[PointLight],
-    o: &RenderOptions,
-) -> Vec<f64> {
-    render::render_exact(scene, cam, lights, o)
-}
-
-/// Blur, noise (`o.seed`) and quantisation of a [`render_exact`] result.
-pub fn finish(exact: Vec<f64>, width: usize, height: usize, o: &RenderOptions) -> GreyImage {
-    render::finish(exact, width, height, o)
-}
-
-/// The true visible edges of the image `render` gives, in ideal
-/// (undistorted) pixels: polygon edges clipped against nearer faces,
-/// silhouettes included, without the pieces whose noise-free contrast is
-/// below `min_contrast` grey levels, those within [`TRUTH_MARGIN`] px of the
-/// image border and those shorter than [`TRUTH_MIN_PIECE`] px.
-/// `Segment.response` holds the edge's mean contrast (grey levels).
-pub fn true_edges(
-    scene: &Scene,
-    cam: &Camera,
-    lights: &[PointLight],
-    o: &RenderOptions,
-    min_contrast: f64,
-) -> Vec<Segment> {
-    truth::visible_edges(scene, cam, lights, o, min_contrast)
+    let exact = render_exact(scene, cam, lights, o);
+    finish(exact, cam.width, cam.height, o)
 }
 
 /// The true projected vertices (ideal px) where two or more of

@@ -21,7 +21,8 @@ use crate::llv::GreyImage;
 /// Samples per side in an edge pixel.
 const SS: usize = 16;
 
-/// The noise-free, unblurred, unclamped image (grey levels, row-major).
+/// The noise-free, unblurred, unclamped render (grey levels, row-major), for
+/// callers that add their own noise per frame (the simulated grabber).
 pub fn render_exact(
     scene: &Scene,
     cam: &Camera,
@@ -175,7 +176,7 @@ pub fn blur(img: &mut [f64], w: usize, h: usize, sigma: f64) {
     }
 }
 
-/// Blur, noise and 8-bit quantisation of an exact render.
+/// Blur, noise (`o.seed`) and 8-bit quantisation of a [`render_exact`] result.
 pub fn finish(mut img: Vec<f64>, w: usize, h: usize, o: &RenderOptions) -> GreyImage {
     blur(&mut img, w, h, o.blur_sigma);
     let mut rng = SplitMix64::new(o.seed);

@@ -2,6 +2,7 @@
 //! and the true edges against the rendered pixels.
 
 use super::*;
+use crate::llv::Segment;
 
 fn one_cube() -> (Scene, Camera, Vec<PointLight>) {
     let scene = Scene {

@@ -65,7 +65,12 @@ impl Walker<'_> {
     }
 }
 
-/// The visible edges and their ideal-pixel endpoints, per the module doc.
+/// The true visible edges of the image `render` gives (`synth::true_edges`),
+/// in ideal (undistorted) pixels: polygon edges clipped against nearer
+/// faces, silhouettes included, without the pieces whose noise-free
+/// contrast is below `min_contrast` grey levels, those within [`MARGIN`] px
+/// of the image border and those shorter than [`MIN_PIECE`] px.
+/// `Segment.response` holds the edge's mean contrast (grey levels).
 pub fn visible_edges(
     scene: &Scene,
     cam: &Camera,
