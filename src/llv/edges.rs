@@ -79,6 +79,19 @@ impl Default for Response {
 }
 
 impl Response {
+    /// Sets the size and direction for a fill that writes every value it
+    /// needs; the buffer is only (re)allocated, as NaN, when the pixel count
+    /// changes, so a warm buffer is reused as it is.
+    pub(crate) fn reshape(&mut self, w: usize, h: usize, dir: ScanDir) {
+        self.width = w;
+        self.height = h;
+        self.dir = dir;
+        if self.data.len() != w * h {
+            self.data.clear();
+            self.data.resize(w * h, f32::NAN);
+        }
+    }
+
     /// The response at `(x, y)`; `None` outside the image or where NaN.
     pub fn get(&self, x: usize, y: usize) -> Option<f32> {
         if x >= self.width || y >= self.height {
@@ -143,13 +156,7 @@ pub fn response_into(
             actual: px.len(),
         });
     }
-    out.width = w;
-    out.height = h;
-    out.dir = dir;
-    if out.data.len() != w * h {
-        out.data.clear();
-        out.data.resize(w * h, f32::NAN);
-    }
+    out.reshape(w, h, dir);
     match dir {
         ScanDir::Horizontal => {
             for (row, orow) in px.chunks_exact(w).zip(out.data.chunks_exact_mut(w)) {

@@ -234,13 +234,7 @@ fn fused(
 ) {
     let (w, h) = images[0].size();
     let kern = Kernel::new(a);
-    out.width = w;
-    out.height = h;
-    out.dir = dir;
-    if out.data.len() != w * h {
-        out.data.clear();
-        out.data.resize(w * h, f32::NAN);
-    }
+    out.reshape(w, h, dir);
     // No response outside the valid band; the band is written below.
     for (y, orow) in out.data.chunks_exact_mut(w).enumerate() {
         match dir {
