@@ -113,6 +113,32 @@ fn new_show_check_and_bad_names() {
     assert!(text(&o).contains("not a session folder"), "{}", text(&o));
 }
 
+/// A session made without `--dir` goes under the profile's `survey.dir`;
+/// show, check and redo find it there by its name alone, as the README
+/// writes them, from the folder vss runs in.
+#[test]
+fn a_bare_session_name_is_found_under_the_survey_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let profile = PROFILE.replace("[survey]\n", "[survey]\ndir = \"surveys\"\n");
+    std::fs::write(d.join("p.toml"), profile).unwrap();
+    std::fs::write(d.join("cam1.cdf"), CDF).unwrap();
+    std::fs::write(d.join("cam2.cdf"), CDF).unwrap();
+    let o = vss(&["--profile", "p.toml", "session", "new", "cube"], d);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(d.join("surveys/cube/cube.toml").is_file(), "{}", text(&o));
+    for args in [&["show", "cube"][..], &["check", "cube"][..]] {
+        let mut a = vec!["--profile", "p.toml", "session"];
+        a.extend_from_slice(args);
+        let o = vss(&a, d);
+        assert!(o.status.success(), "{args:?}: {}", text(&o));
+    }
+    // A name that is nowhere is still reported as missing.
+    let o = vss(&["--profile", "p.toml", "session", "check", "hull"], d);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("hull"), "{}", text(&o));
+}
+
 #[test]
 fn nonsense_manifest_is_reported_and_not_overwritten() {
     let dir = tempfile::tempdir().unwrap();

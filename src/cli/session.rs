@@ -64,14 +64,14 @@ pub enum Cmd {
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     match a.command {
         Cmd::New { name, dir } => new(g, &name, dir),
-        Cmd::Show { dir } => show(&dir),
-        Cmd::Check { dir, strict } => check(&dir, strict),
+        Cmd::Show { dir } => show(&session_dir(g, dir)),
+        Cmd::Check { dir, strict } => check(&session_dir(g, dir), strict),
         Cmd::Redo {
             dir,
             image,
             from,
             take_over,
-        } => redo(g, &dir, image, &from, take_over),
+        } => redo(g, &session_dir(g, dir), image, &from, take_over),
         Cmd::Torture { dir, seed, limit } => {
             use std::io::Write as _;
             let mut out = std::io::stdout().lock();
@@ -89,6 +89,26 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             })?;
             Ok(ExitCode::SUCCESS)
         }
+    }
+}
+
+/// The session folder an argument names: the path itself when it is a
+/// folder, else a bare session name under the profile's `survey.dir`
+/// (where `vss session new NAME` and the console make them), so
+/// `vss session check cube` works from the folder vss runs in. Anything
+/// else is returned unchanged, for the session to report as missing.
+fn session_dir(g: &Global, dir: PathBuf) -> PathBuf {
+    let bare = dir.components().count() == 1
+        && matches!(
+            dir.components().next(),
+            Some(std::path::Component::Normal(_))
+        );
+    if dir.is_dir() || !bare {
+        return dir;
+    }
+    match profile(g) {
+        Ok((p, _)) if p.survey.dir.join(&dir).is_dir() => p.survey.dir.join(&dir),
+        _ => dir,
     }
 }
 
