@@ -48,7 +48,10 @@
 
 use super::fit::LineFit;
 use super::params::LineParams;
-use super::{EdgePoints, Point, ScanDir, Segment};
+use super::{EdgePoint, EdgePoints, Point, ScanDir, Segment};
+
+#[cfg(test)]
+mod reference;
 
 /// Largest `|du/dv|` used for the prediction.
 const MAX_SLOPE: f64 = 8.0;
@@ -97,6 +100,35 @@ const TEMPLATE_SLOPE: [f64; 4] = [0.0, 1.0, 0.0, -1.0];
 /// Order in which tied templates are preferred.
 const TEMPLATE_PREFERENCE: [usize; 4] = [2, 1, 3, 0];
 
+/// Template scores of one row of the 5 × 5 neighbourhood, by the bits of
+/// its columns (bit `i` for column `i - 2`): byte `t` is the score of
+/// template `t` (at most 8, so the bytes of five rows never carry).
+const ROW_SCORES: [[u32; 32]; 5] = row_scores();
+
+const fn row_scores() -> [[u32; 32]; 5] {
+    let mut table = [[0u32; 32]; 5];
+    let mut j = 0;
+    while j < 5 {
+        let mut bits = 0;
+        while bits < 32 {
+            let mut t = 0;
+            while t < 4 {
+                let mut i = 0;
+                while i < 5 {
+                    if bits >> i & 1 != 0 {
+                        table[j][bits] += (TEMPLATES[t][j][i] as u32) << (8 * t);
+                    }
+                    i += 1;
+                }
+                t += 1;
+            }
+            bits += 1;
+        }
+        j += 1;
+    }
+    table
+}
+
 /// One edge point in scan coordinates, with `u` rounded once for the
 /// templates (`round(u) as i64`; the scan line, `round(v)`, is where the
 /// point is filed).
@@ -122,6 +154,58 @@ fn round_i64(x: f32) -> i64 {
     if x < 0.0 { -r } else { r }
 }
 
+/// [`round_i64`] of a finite `u`, shorter for the usual `u > -½`: there
+/// `u + ½` is exact in `f64` and positive, and truncating it rounds.
+#[inline]
+fn round_u(u: f32) -> i64 {
+    let t = u as f64 + 0.5;
+    if t > 0.0 && t < 1e15 {
+        t as i64
+    } else {
+        round_i64(u)
+    }
+}
+
+/// The scan line of a point at scan coordinates `(u, v)`: `round(v)`, if
+/// both are finite and it is in `0..10⁷`. As in [`round_u`], `v + ½` is
+/// exact; it is in `(0, 10⁷)` exactly when `round(v)` is in range.
+#[inline]
+fn row_of(u: f32, v: f32) -> Option<usize> {
+    let t = v as f64 + 0.5;
+    (u.is_finite() && t > 0.0 && t < 1e7).then_some(t as usize)
+}
+
+/// What the successor test needs of scan line `row + i` ahead of a start
+/// (`i = 1..=max_gap`), the same for every start: the reach `i + sw`, and
+/// in the start's [`Grid::around`] window, the columns `iu ± (⌊reach⌋ + 2)`
+/// that can hold a point within it and those of them that lie within it
+/// wherever in its pixel the start is.
+#[derive(Clone, Copy, Debug, Default)]
+struct Reach {
+    reach: f64,
+    /// Columns `iu + d`, `|d| ≤ ⌊reach⌋ + 2`, as bits `32 + d`.
+    near: u64,
+    /// The columns of `near` with `|d| + 1 ≤ reach`: the pixel is within
+    /// `u ± reach` for any `u` within ½ of `iu` (exactly, so by monotone
+    /// rounding also in `f64`).
+    inner: u64,
+}
+
+impl Reach {
+    fn new(i: u32, sw: f64) -> Self {
+        let reach = i as f64 + sw;
+        let half = reach as i64 + 2;
+        let (mut near, mut inner) = (0, 0);
+        for d in -half..=half {
+            near |= 1u64 << (32 + d);
+            if (d.abs() + 1) as f64 <= reach {
+                inner |= 1u64 << (32 + d);
+            }
+        }
+        Reach { reach, near, inner }
+    }
+}
+
 /// Reusable buffers of the extractor.
 #[derive(Clone, Debug, Default)]
 pub struct LineScratch {
@@ -129,8 +213,10 @@ pub struct LineScratch {
     /// `row_start[r]..row_start[r + 1]` are the points of scan line `r`.
     row_start: Vec<u32>,
     used: Vec<bool>,
-    /// The scan line of each input point (`u32::MAX`: not finite).
+    /// The scan line of each input point (`u32::MAX`: not finite), when
+    /// the input is not in scan order.
     rows: Vec<u32>,
+    reach: Vec<Reach>,
     grid: Grid,
     /// Tests: never use the [`Grid`] (to compare both ways).
     #[cfg(test)]
@@ -158,57 +244,51 @@ struct Grid {
     /// The unused points, by polarity ([`polarity`]): a track only takes
     /// points of its start's polarity, so only those can continue it.
     unused: [Vec<u64>; 2],
-    /// Per word of `occupied`: the index of the first point at or after
-    /// its first column (points before it on the scan line, plus the scan
-    /// line's start), so a column's point is found without a search.
-    before: Vec<u32>,
+    /// Per word of `occupied` that has a bit set: the index of its first
+    /// point, so a column's point is found without a search (other words:
+    /// anything).
+    first: Vec<u32>,
 }
 
 impl Grid {
-    fn build(&mut self, points: &[ScanPoint], row_start: &[u32], nrows: usize) -> bool {
-        self.occupied.clear();
-        self.unused[0].clear();
-        self.unused[1].clear();
-        self.before.clear();
-        self.words = 0;
-        let mut max = 0i64;
-        for q in points {
-            if !(0..1 << 20).contains(&q.iu) {
-                return false;
-            }
-            max = max.max(q.iu);
-        }
+    /// Builds the bitmaps of `points`, filed by scan line and in order
+    /// along each, whose rounded `u` are all in `0..=max_iu`, `max_iu <
+    /// 2²⁰`; false (and no grid) when two points of a scan line share a
+    /// column.
+    fn build(
+        &mut self,
+        points: &[ScanPoint],
+        row_start: &[u32],
+        nrows: usize,
+        max_iu: i64,
+    ) -> bool {
         // The columns, and an empty word on either side.
-        self.words = max as usize / 64 + 3;
-        self.occupied.resize(nrows * self.words, 0);
-        for r in 0..nrows {
+        self.words = max_iu as usize / 64 + 3;
+        let len = nrows * self.words;
+        self.occupied.clear();
+        self.occupied.resize(len, 0);
+        for u in &mut self.unused {
+            u.clear();
+            u.resize(len, 0);
+        }
+        if self.first.len() < len {
+            self.first.resize(len, 0);
+        }
+        for (r, ends) in row_start.windows(2).enumerate().take(nrows) {
             let base = r * self.words;
-            for q in &points[row_start[r] as usize..row_start[r + 1] as usize] {
+            for (k, q) in (ends[0]..ends[1]).zip(&points[ends[0] as usize..ends[1] as usize]) {
                 let c = q.iu as usize + 64;
                 let (w, bit) = (base + c / 64, 1u64 << (c % 64));
-                if self.occupied[w] & bit != 0 {
-                    self.occupied.clear();
+                let occupied = self.occupied[w];
+                if occupied & bit != 0 {
                     self.words = 0;
                     return false;
                 }
-                self.occupied[w] |= bit;
-            }
-        }
-        for u in &mut self.unused {
-            u.resize(self.occupied.len(), 0);
-        }
-        for r in 0..nrows {
-            for q in &points[row_start[r] as usize..row_start[r + 1] as usize] {
-                let c = q.iu as usize + 64;
-                self.unused[polarity(q.response)][r * self.words + c / 64] |= 1u64 << (c % 64);
-            }
-        }
-        self.before.reserve(self.occupied.len());
-        for (&first, row) in row_start.iter().zip(self.occupied.chunks_exact(self.words)) {
-            let mut n = first;
-            for &w in row {
-                self.before.push(n);
-                n += w.count_ones();
+                if occupied == 0 {
+                    self.first[w] = k;
+                }
+                self.occupied[w] = occupied | bit;
+                self.unused[polarity(q.response)][w] |= bit;
             }
         }
         true
@@ -240,7 +320,7 @@ impl Grid {
         let c = (c + 64) as usize;
         let k = r * self.words + c / 64;
         let below = self.occupied[k] & ((1u64 << (c % 64)) - 1);
-        self.before[k] as usize + below.count_ones() as usize
+        self.first[k] as usize + below.count_ones() as usize
     }
 
     #[inline]
@@ -249,23 +329,26 @@ impl Grid {
         self.unused[polarity(q.response)][r * self.words + c / 64] &= !(1u64 << (c % 64));
     }
 
-    /// The template of §3.1 for a point at column `iu` of scan line `row`.
+    /// The template of §3.1 for a point at column `iu` of scan line `row`:
+    /// each row's five bits look up all four scores at once.
     fn template(&self, row: usize, iu: i64, nrows: usize) -> usize {
-        let mut score = [0u32; 4];
-        for (j, r) in (row as i64 - 2..=row as i64 + 2).enumerate() {
-            if r < 0 || r as usize >= nrows {
-                continue;
-            }
-            let mut bits = self.window(&self.occupied, r as usize, iu - 2, 5);
-            while bits != 0 {
-                let i = bits.trailing_zeros() as usize;
-                for (t, sc) in score.iter_mut().enumerate() {
-                    *sc += u32::from(TEMPLATES[t][j][i]);
-                }
-                bits &= bits - 1;
+        let mut packed = 0;
+        for (j, scores) in ROW_SCORES.iter().enumerate() {
+            let r = (row + j).wrapping_sub(2);
+            if r < nrows {
+                packed += scores[(self.around(&self.occupied, r, iu) >> 30 & 31) as usize];
             }
         }
-        best_template(&score)
+        best_template(&packed.to_le_bytes().map(u32::from))
+    }
+
+    /// The 64 bits of scan line `r` around column `iu` (in the grid):
+    /// bit `k` for column `iu - 32 + k`.
+    #[inline]
+    fn around(&self, bits: &[u64], r: usize, iu: i64) -> u64 {
+        let start = iu as usize + 32;
+        let (w, b) = (r * self.words + start / 64, start % 64);
+        (bits[w] >> b) | ((bits[w + 1] << 1) << (63 - b))
     }
 
     /// [`has_successor`] from the bitmaps, sharper: an unused point of the
@@ -274,33 +357,35 @@ impl Grid {
     /// A point's `u` is within ½ px of its column, so the columns
     /// `iu ± (⌊reach⌋ + 2)` hold every candidate: when their bits are clear
     /// (most start points on noise) the answer is no, in integer work alone.
-    /// A column whose whole pixel lies inside the reach decides by its bit;
-    /// the ones at the ends by the point itself.
+    /// A column whose whole pixel lies inside the reach decides by its bit
+    /// (the `inner` ones of [`Reach`], whatever the start's `u`); the ones
+    /// at the ends by the point itself.
     fn has_successor(
         &self,
-        s: &LineScratch,
+        points: &[ScanPoint],
+        reach: &[Reach],
         sp: &ScanPoint,
         row: usize,
-        max_gap: usize,
-        sw: f64,
+        nrows: usize,
     ) -> bool {
-        let nrows = s.row_start.len() - 1;
-        for i in 1..=max_gap {
-            let r = row + i;
-            if r >= nrows {
-                return false;
-            }
-            let reach = i as f64 + sw;
-            let half = reach as i64 + 2;
-            let lo = sp.iu - half;
-            let unused = &self.unused[polarity(sp.response)];
-            let mut bits = self.window(unused, r, lo, (2 * half + 1) as u32);
-            if bits == 0 {
-                continue;
-            }
-            let (a, b) = (sp.u as f64 - reach, sp.u as f64 + reach);
+        let unused = &self.unused[polarity(sp.response)];
+        let (mut near, mut inner) = (0, 0);
+        for (r, rc) in (row + 1..nrows).zip(reach) {
+            let bits = self.around(unused, r, sp.iu);
+            near |= bits & rc.near;
+            inner |= bits & rc.inner;
+        }
+        if near == 0 {
+            return false;
+        }
+        if inner != 0 {
+            return true;
+        }
+        for (r, rc) in (row + 1..nrows).zip(reach) {
+            let mut bits = self.around(unused, r, sp.iu) & rc.near;
+            let (a, b) = (sp.u as f64 - rc.reach, sp.u as f64 + rc.reach);
             while bits != 0 {
-                let c = lo + bits.trailing_zeros() as i64;
+                let c = sp.iu - 32 + bits.trailing_zeros() as i64;
                 bits &= bits - 1;
                 let (left, right) = (c as f64 - 0.5, c as f64 + 0.5);
                 if right < a || left > b {
@@ -310,7 +395,7 @@ impl Grid {
                     return true;
                 }
                 // An end column: look at the point.
-                let u = s.points[self.point_at(r, c)].u as f64;
+                let u = points[self.point_at(r, c)].u as f64;
                 if u >= a && u <= b {
                     return true;
                 }
@@ -421,67 +506,110 @@ fn has_successor(
     })
 }
 
+impl LineScratch {
+    /// Files the points of `e` by scan line, in order along each (points
+    /// that are not finite, or whose scan line is not in `0..10⁷`, are
+    /// left out), and returns the number of scan lines. Input already in
+    /// the scan frame's lexical order (EdgeH, or a file) is taken as it
+    /// comes, in one pass; otherwise a counting sort by scan line keeps the
+    /// order along the scan of the input (and sorts EdgeV column by
+    /// column), and a scan line out of order along the scan is sorted.
+    fn file(&mut self, e: &EdgePoints, vertical: bool) -> usize {
+        let scan = |q: &EdgePoint| {
+            let (u, v) = if vertical { (q.y, q.x) } else { (q.x, q.y) };
+            let point = ScanPoint {
+                u,
+                v,
+                response: q.response,
+                iu: 0,
+            };
+            (point, row_of(u, v))
+        };
+        self.points.clear();
+        self.row_start.clear();
+        let mut last = (0, f32::NEG_INFINITY);
+        let mut in_order = true;
+        for q in &e.points {
+            let (mut point, Some(r)) = scan(q) else {
+                continue;
+            };
+            if (r, point.u) < last {
+                in_order = false;
+                break;
+            }
+            last = (r, point.u);
+            if r >= self.row_start.len() {
+                self.row_start.resize(r + 1, self.points.len() as u32);
+            }
+            point.iu = round_u(point.u);
+            self.points.push(point);
+        }
+        if in_order {
+            let nrows = self.row_start.len();
+            self.row_start.push(self.points.len() as u32);
+            return nrows;
+        }
+        // Counting sort: `row_start[r + 2]` counts scan line `r`.
+        self.row_start.clear();
+        self.rows.clear();
+        for q in &e.points {
+            let r = match scan(q).1 {
+                Some(r) => {
+                    if r + 2 >= self.row_start.len() {
+                        self.row_start.resize(r + 3, 0);
+                    }
+                    self.row_start[r + 2] += 1;
+                    r as u32
+                }
+                None => u32::MAX,
+            };
+            self.rows.push(r);
+        }
+        let nrows = self.row_start.len().saturating_sub(2);
+        self.row_start.resize(nrows + 2, 0);
+        for r in 2..nrows + 2 {
+            self.row_start[r] += self.row_start[r - 1];
+        }
+        let total = self.row_start[nrows + 1] as usize;
+        self.points.clear();
+        self.points.resize(total, ScanPoint::default());
+        for (q, &r) in e.points.iter().zip(&self.rows) {
+            if r != u32::MAX {
+                let mut point = scan(q).0;
+                point.iu = round_u(point.u);
+                let slot = &mut self.row_start[r as usize + 1];
+                self.points[*slot as usize] = point;
+                *slot += 1;
+            }
+        }
+        self.row_start.truncate(nrows + 1);
+        // Within a scan line, order by u (the input may come from a file).
+        for r in 0..nrows {
+            let (lo, hi) = (self.row_start[r] as usize, self.row_start[r + 1] as usize);
+            let row = &mut self.points[lo..hi];
+            if !row.windows(2).all(|w| w[0].u <= w[1].u) {
+                row.sort_unstable_by(|a, b| a.u.total_cmp(&b.u));
+            }
+        }
+        nrows
+    }
+}
+
+/// The scan line of each point in turn, from the scan lines' starts.
+fn row_of_point(row_start: &[u32]) -> impl Iterator<Item = usize> + '_ {
+    row_start
+        .windows(2)
+        .enumerate()
+        .flat_map(|(r, ends)| std::iter::repeat_n(r, (ends[1] - ends[0]) as usize))
+}
+
 /// [`extract`] into reusable buffers; appends nothing else to `out` (it is
 /// cleared first).
 pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &mut LineScratch) {
     out.clear();
     let vertical = e.dir == Some(ScanDir::Vertical);
-    // Scan lines: counting sort by scan line keeps the order along the scan
-    // of the lexically ordered input (and sorts EdgeV column by column).
-    let row_of = |u: f32, v: f32| -> Option<usize> {
-        if !(u.is_finite() && v.is_finite()) {
-            return None;
-        }
-        let r = round_i64(v);
-        (0..10_000_000).contains(&r).then_some(r as usize)
-    };
-    let to_scan = |x: f32, y: f32| if vertical { (y, x) } else { (x, y) };
-    s.rows.clear();
-    s.rows.extend(e.points.iter().map(|q| {
-        let (u, v) = to_scan(q.x, q.y);
-        row_of(u, v).map_or(u32::MAX, |r| r as u32)
-    }));
-    let nrows = s
-        .rows
-        .iter()
-        .filter(|&&r| r != u32::MAX)
-        .max()
-        .map_or(0, |&r| r as usize + 1);
-    s.row_start.clear();
-    s.row_start.resize(nrows + 2, 0);
-    for &r in &s.rows {
-        if r != u32::MAX {
-            s.row_start[r as usize + 2] += 1;
-        }
-    }
-    for r in 2..nrows + 2 {
-        s.row_start[r] += s.row_start[r - 1];
-    }
-    let total = s.row_start[nrows + 1] as usize;
-    s.points.clear();
-    s.points.resize(total, ScanPoint::default());
-    for (q, &r) in e.points.iter().zip(&s.rows) {
-        if r != u32::MAX {
-            let (u, v) = to_scan(q.x, q.y);
-            let slot = &mut s.row_start[r as usize + 1];
-            s.points[*slot as usize] = ScanPoint {
-                u,
-                v,
-                response: q.response,
-                iu: round_i64(u),
-            };
-            *slot += 1;
-        }
-    }
-    s.row_start.truncate(nrows + 1);
-    // Within a scan line, order by u (the input may come from a file).
-    for r in 0..nrows {
-        let (lo, hi) = (s.row_start[r] as usize, s.row_start[r + 1] as usize);
-        let row = &mut s.points[lo..hi];
-        if !row.windows(2).all(|w| w[0].u <= w[1].u) {
-            row.sort_unstable_by(|a, b| a.u.total_cmp(&b.u));
-        }
-    }
+    let nrows = s.file(e, vertical);
+    let total = s.points.len();
     s.used.clear();
     s.used.resize(total, false);
     let mut grid = std::mem::take(&mut s.grid);
@@ -489,14 +617,19 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
     let window_fits = sw.is_finite() && sw >= 0.0 && p.max_gap as f64 + sw <= 28.0;
     #[cfg(test)]
     let window_fits = window_fits && !s.walk_only;
-    let use_grid = window_fits && grid.build(&s.points, &s.row_start, nrows);
+    // Every rounded `u` in `0..2²⁰` (so in the grid's columns); the largest.
+    let columns = s.points.iter().try_fold(0, |max, q| {
+        (0..1 << 20).contains(&q.iu).then(|| max.max(q.iu))
+    });
+    let use_grid = window_fits
+        && columns.is_some_and(|max_iu| grid.build(&s.points, &s.row_start, nrows, max_iu));
+    s.reach.clear();
+    if use_grid {
+        s.reach.extend((1..=p.max_gap).map(|i| Reach::new(i, sw)));
+    }
 
     let min_angle = p.min_scan_angle_deg.to_radians();
-    let mut start_row = 0;
-    for start in 0..total {
-        while s.row_start[start_row + 1] as usize <= start {
-            start_row += 1;
-        }
+    for (start, start_row) in (0..total).zip(row_of_point(&s.row_start)) {
         if s.used[start] {
             continue;
         }
@@ -504,7 +637,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
         let sp = s.points[start];
         let template = if use_grid {
             grid.mark_used(start_row, &sp);
-            if !grid.has_successor(s, &sp, start_row, p.max_gap as usize, sw) {
+            if !grid.has_successor(&s.points, &s.reach, &sp, start_row, nrows) {
                 continue;
             }
             grid.template(start_row, sp.iu, nrows)
@@ -694,7 +827,7 @@ mod tests {
                 let nrows = s.row_start.len() - 1;
                 assert_eq!(template_of(&s, &sp, 50, nrows), want, "{dir:?} ({du},{dv})");
                 let mut grid = Grid::default();
-                assert!(grid.build(&s.points, &s.row_start, nrows));
+                assert!(grid.build(&s.points, &s.row_start, nrows, 200));
                 assert_eq!(grid.template(50, sp.iu, nrows), want, "grid {dir:?}");
             }
         }
@@ -773,6 +906,133 @@ mod tests {
         let mut walk = Vec::new();
         extract_into(&e, &p, &mut walk, &mut s);
         assert_eq!(segs, walk);
+    }
+
+    /// The segments' bits, to compare NaN responses too.
+    fn bits(segs: &[Segment]) -> Vec<[u64; 6]> {
+        segs.iter()
+            .map(|s| {
+                assert!(!s.shadow);
+                [s.a.x, s.a.y, s.b.x, s.b.y, s.response, s.residual].map(f64::to_bits)
+            })
+            .collect()
+    }
+
+    /// The extractor gives the segments of the one before the speed work
+    /// (`reference.rs`), bit for bit and in the same order, on edge-point-like
+    /// sets (noise and lines) and on what a file may hold: points sharing a
+    /// column, negative or huge `u`, unsorted input, points and responses
+    /// that are not finite, odd parameters.
+    #[test]
+    fn the_same_segments_as_the_reference_extractor_bit_for_bit() {
+        let mut rng = crate::llv::synth::rng::SplitMix64::new(0x5eed_11e5);
+        let mut s = LineScratch::default();
+        let (mut out, mut segments, mut gridded) = (Vec::new(), 0, 0);
+        for case in 0..400 {
+            let (w, h) = (20 + rng.below(300), 20 + rng.below(200));
+            let mut pts: Vec<EdgePoint> = Vec::new();
+            let noise = 1 + rng.below(12);
+            for y in 0..h {
+                for _ in 0..rng.below(noise) {
+                    pts.push(EdgePoint {
+                        x: (rng.uniform() * w as f64) as f32,
+                        y: y as f32,
+                        response: rng.range(-20.0, 20.0) as f32,
+                    });
+                }
+            }
+            for _ in 0..rng.below(8) {
+                let (x0, slope) = (rng.uniform() * w as f64, rng.range(-3.0, 3.0));
+                let (y0, y1) = (rng.below(h), rng.below(h));
+                let sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+                let jitter = [0.0, 0.3, 1.0][rng.below(3)];
+                for y in y0.min(y1)..y0.max(y1) {
+                    if rng.uniform() < 0.1 {
+                        continue;
+                    }
+                    let x = x0 + slope * (y - y0) as f64 + rng.range(-jitter, jitter);
+                    pts.push(EdgePoint {
+                        x: x as f32,
+                        y: y as f32,
+                        response: (sign * rng.range(3.0, 50.0)) as f32,
+                    });
+                }
+            }
+            pts.sort_by(|a, b| a.y.total_cmp(&b.y).then(a.x.total_cmp(&b.x)));
+            let kind = case % 8;
+            if kind < 4 {
+                // Edge points: one a pixel.
+                pts.dedup_by_key(|q| (q.y, q.x.round()));
+            }
+            if kind == 1 && !pts.is_empty() {
+                // Something odd in a file.
+                for _ in 0..1 + rng.below(3) {
+                    let k = rng.below(pts.len());
+                    let odd = [
+                        f32::NAN,
+                        f32::INFINITY,
+                        -f32::INFINITY,
+                        -3.2,
+                        -0.5,
+                        -0.49,
+                        0.5,
+                        1.5e6,
+                        3e9,
+                        1e7,
+                        9_999_999.5,
+                        -2e9,
+                    ][rng.below(12)];
+                    match rng.below(3) {
+                        0 => pts[k].x = odd,
+                        1 => pts[k].y = odd,
+                        _ => pts[k].response = odd,
+                    }
+                }
+            }
+            if kind == 2 {
+                // Scan order of EdgeV (column by column).
+                pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+            }
+            if kind == 3 || kind == 5 {
+                // Unsorted.
+                for k in (1..pts.len()).rev() {
+                    pts.swap(k, rng.below(k + 1));
+                }
+            }
+            if kind == 6 {
+                // Subpixel rows, some shared columns and equal `u`.
+                for q in &mut pts {
+                    q.y += rng.range(-0.6, 0.6) as f32;
+                    if rng.uniform() < 0.05 {
+                        q.x = q.x.round();
+                    }
+                }
+            }
+            let p = LineParams {
+                max_gap: [3, 3, 3, 1, 2, 5, 0, 30][rng.below(8)],
+                search_width: [2.0, 2.0, 1.0, 3.5, 0.0, 2.7, 26.0, f64::NAN][rng.below(8)],
+                min_length: [8.0, 8.0, 0.0, 3.0][rng.below(4)],
+                min_scan_angle_deg: [22.5, 22.5, 0.0, 60.0][rng.below(4)],
+                min_response: [6.0, 0.0, 0.0, 15.0][rng.below(4)],
+            };
+            for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
+                let e = EdgePoints {
+                    dir: Some(dir),
+                    width: w,
+                    height: h,
+                    points: pts.clone(),
+                };
+                let want = reference::extract(&e, &p);
+                extract_into(&e, &p, &mut out, &mut s);
+                assert_eq!(bits(&out), bits(&want), "case {case} {dir:?} {p:?}");
+                segments += out.len();
+                gridded += usize::from(s.grid.words > 0);
+            }
+        }
+        assert!(
+            segments > 2000 && gridded > 300,
+            "{segments} segments, {gridded} gridded"
+        );
     }
 
     /// The bitmaps are a shortcut, not a change: on noise with lines
