@@ -159,11 +159,20 @@ fn round_i64(x: f32) -> i64 {
 #[inline]
 fn round_u(u: f32) -> i64 {
     let t = u as f64 + 0.5;
-    if t > 0.0 && t < 1e15 {
-        t as i64
+    if t > 0.0 && t < 4e9 {
+        // (`as u32`: the shorter saturating conversion on x86-64.)
+        t as u32 as i64
     } else {
         round_i64(u)
     }
+}
+
+/// The whole number nearest `x` (ties to even), `|x| < 2⁵¹`: adding
+/// 1.5 · 2⁵² leaves it in the low bits, without a saturating conversion.
+#[inline]
+fn round_f64(x: f64) -> i64 {
+    const MAGIC: f64 = 6_755_399_441_055_744.0;
+    (x + MAGIC).to_bits() as i64 - MAGIC.to_bits() as i64
 }
 
 /// The scan line of a point at scan coordinates `(u, v)`: `round(v)`, if
@@ -172,7 +181,7 @@ fn round_u(u: f32) -> i64 {
 #[inline]
 fn row_of(u: f32, v: f32) -> Option<usize> {
     let t = v as f64 + 0.5;
-    (u.is_finite() && t > 0.0 && t < 1e7).then_some(t as usize)
+    (u.is_finite() && t > 0.0 && t < 1e7).then_some(t as u32 as usize)
 }
 
 /// What the successor test needs of scan line `row + i` ahead of a start
@@ -248,6 +257,10 @@ struct Grid {
     /// point, so a column's point is found without a search (other words:
     /// anything).
     first: Vec<u32>,
+    /// The columns a track searches for its next point, `±(⌊sw⌋ + 2)`
+    /// around the one nearest the prediction, as [`Grid::around`] bits:
+    /// every point within `sw` of the prediction is on one of them.
+    search: u64,
 }
 
 impl Grid {
@@ -294,26 +307,6 @@ impl Grid {
         true
     }
 
-    /// Bits `k = 0..n` (`n < 64`) of scan line `r` for columns `lo + k`.
-    /// Each scan line has an empty word before and after its columns
-    /// (column `c` is bit `c + 64`), so no window needs a special case at
-    /// the image's sides.
-    #[inline]
-    fn window(&self, bits: &[u64], r: usize, lo: i64, n: u32) -> u64 {
-        let start = lo + 64;
-        if start < 0 {
-            return 0;
-        }
-        let (w, b) = ((start >> 6) as usize, (start & 63) as u32);
-        if w + 1 >= self.words {
-            return 0;
-        }
-        let base = r * self.words + w;
-        let (first, second) = (bits[base], bits[base + 1]);
-        let v = (first >> b) | ((second << 1) << (63 - b));
-        v & ((1u64 << n) - 1)
-    }
-
     /// The index of the point on scan line `r` at column `c` (a set bit).
     #[inline]
     fn point_at(&self, r: usize, c: i64) -> usize {
@@ -342,13 +335,25 @@ impl Grid {
         best_template(&packed.to_le_bytes().map(u32::from))
     }
 
-    /// The 64 bits of scan line `r` around column `iu` (in the grid):
-    /// bit `k` for column `iu - 32 + k`.
+    /// The 64 bits of scan line `r` around column `centre`: bit `k` for
+    /// column `centre - 32 + k`. `centre` must be a point's column (or in
+    /// `-32..=max_centre`).
     #[inline]
-    fn around(&self, bits: &[u64], r: usize, iu: i64) -> u64 {
-        let start = iu as usize + 32;
+    fn around(&self, bits: &[u64], r: usize, centre: i64) -> u64 {
+        let start = (centre + 32) as usize;
         let (w, b) = (r * self.words + start / 64, start % 64);
         (bits[w] >> b) | ((bits[w + 1] << 1) << (63 - b))
+    }
+
+    /// [`Grid::around`] any column: no bits far off the grid's columns.
+    #[inline]
+    fn around_any(&self, bits: &[u64], r: usize, centre: i64) -> u64 {
+        let max_centre = (self.words as i64 - 1) * 64 - 33;
+        if (-32..=max_centre).contains(&centre) {
+            self.around(bits, r, centre)
+        } else {
+            0
+        }
     }
 
     /// [`has_successor`] from the bitmaps, sharper: an unused point of the
@@ -525,82 +530,205 @@ impl LineScratch {
             };
             (point, row_of(u, v))
         };
-        self.points.clear();
-        self.row_start.clear();
-        let mut last = (0, f32::NEG_INFINITY);
+        // Local vectors: their lengths stay in registers.
+        let mut points = std::mem::take(&mut self.points);
+        let mut row_start = std::mem::take(&mut self.row_start);
+        points.clear();
+        row_start.clear();
+        let (mut last_row, mut last_u) = (0, f32::NEG_INFINITY);
         let mut in_order = true;
         for q in &e.points {
             let (mut point, Some(r)) = scan(q) else {
                 continue;
             };
-            if (r, point.u) < last {
+            if r < last_row || (r == last_row && point.u < last_u) {
                 in_order = false;
                 break;
             }
-            last = (r, point.u);
-            if r >= self.row_start.len() {
-                self.row_start.resize(r + 1, self.points.len() as u32);
+            (last_row, last_u) = (r, point.u);
+            if r >= row_start.len() {
+                row_start.resize(r + 1, points.len() as u32);
             }
             point.iu = round_u(point.u);
-            self.points.push(point);
+            points.push(point);
         }
-        if in_order {
-            let nrows = self.row_start.len();
-            self.row_start.push(self.points.len() as u32);
-            return nrows;
-        }
-        // Counting sort: `row_start[r + 2]` counts scan line `r`.
-        self.row_start.clear();
-        self.rows.clear();
-        for q in &e.points {
-            let r = match scan(q).1 {
-                Some(r) => {
-                    if r + 2 >= self.row_start.len() {
-                        self.row_start.resize(r + 3, 0);
-                    }
-                    self.row_start[r + 2] += 1;
-                    r as u32
-                }
-                None => u32::MAX,
-            };
-            self.rows.push(r);
-        }
-        let nrows = self.row_start.len().saturating_sub(2);
-        self.row_start.resize(nrows + 2, 0);
-        for r in 2..nrows + 2 {
-            self.row_start[r] += self.row_start[r - 1];
-        }
-        let total = self.row_start[nrows + 1] as usize;
-        self.points.clear();
-        self.points.resize(total, ScanPoint::default());
-        for (q, &r) in e.points.iter().zip(&self.rows) {
-            if r != u32::MAX {
-                let mut point = scan(q).0;
-                point.iu = round_u(point.u);
-                let slot = &mut self.row_start[r as usize + 1];
-                self.points[*slot as usize] = point;
-                *slot += 1;
-            }
-        }
-        self.row_start.truncate(nrows + 1);
-        // Within a scan line, order by u (the input may come from a file).
-        for r in 0..nrows {
-            let (lo, hi) = (self.row_start[r] as usize, self.row_start[r + 1] as usize);
-            let row = &mut self.points[lo..hi];
-            if !row.windows(2).all(|w| w[0].u <= w[1].u) {
-                row.sort_unstable_by(|a, b| a.u.total_cmp(&b.u));
-            }
-        }
+        let nrows = if in_order {
+            let nrows = row_start.len();
+            row_start.push(points.len() as u32);
+            nrows
+        } else {
+            let mut rows = std::mem::take(&mut self.rows);
+            let nrows = counting_sort(e, &scan, &mut points, &mut row_start, &mut rows);
+            self.rows = rows;
+            nrows
+        };
+        self.points = points;
+        self.row_start = row_start;
         nrows
     }
 }
 
-/// The scan line of each point in turn, from the scan lines' starts.
-fn row_of_point(row_start: &[u32]) -> impl Iterator<Item = usize> + '_ {
-    row_start
-        .windows(2)
-        .enumerate()
-        .flat_map(|(r, ends)| std::iter::repeat_n(r, (ends[1] - ends[0]) as usize))
+/// [`LineScratch::file`] of input out of scan order: a counting sort by
+/// scan line (`rows`: each input point's, `u32::MAX` for none), then a sort
+/// of any scan line out of order along the scan.
+fn counting_sort(
+    e: &EdgePoints,
+    scan: &impl Fn(&EdgePoint) -> (ScanPoint, Option<usize>),
+    points: &mut Vec<ScanPoint>,
+    row_start: &mut Vec<u32>,
+    rows: &mut Vec<u32>,
+) -> usize {
+    // `row_start[r + 2]` counts scan line `r` first.
+    row_start.clear();
+    rows.clear();
+    rows.extend(e.points.iter().map(|q| match scan(q).1 {
+        Some(r) => {
+            if r + 2 >= row_start.len() {
+                row_start.resize(r + 3, 0);
+            }
+            row_start[r + 2] += 1;
+            r as u32
+        }
+        None => u32::MAX,
+    }));
+    let nrows = row_start.len().saturating_sub(2);
+    row_start.resize(nrows + 2, 0);
+    for r in 2..nrows + 2 {
+        row_start[r] += row_start[r - 1];
+    }
+    let total = row_start[nrows + 1] as usize;
+    points.clear();
+    points.resize(total, ScanPoint::default());
+    for (q, &r) in e.points.iter().zip(rows.iter()) {
+        if r != u32::MAX {
+            let mut point = scan(q).0;
+            point.iu = round_u(point.u);
+            let slot = &mut row_start[r as usize + 1];
+            points[*slot as usize] = point;
+            *slot += 1;
+        }
+    }
+    row_start.truncate(nrows + 1);
+    // Within a scan line, order by u (the input may come from a file).
+    for r in 0..nrows {
+        let (lo, hi) = (row_start[r] as usize, row_start[r + 1] as usize);
+        let row = &mut points[lo..hi];
+        if !row.windows(2).all(|w| w[0].u <= w[1].u) {
+            row.sort_unstable_by(|a, b| a.u.total_cmp(&b.u));
+        }
+    }
+    nrows
+}
+
+/// Follows a line from start point `sp` on scan line `start_row` with the
+/// initial slope of `template`, marking the points it takes used; returns
+/// their fit, the sum of their responses and the last point.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn track(
+    s: &mut LineScratch,
+    grid: &mut Grid,
+    use_grid: bool,
+    p: &LineParams,
+    sp: &ScanPoint,
+    start_row: usize,
+    nrows: usize,
+    template: usize,
+) -> (LineFit, f64, ScanPoint) {
+    let sw = p.search_width;
+    let mut slope = TEMPLATE_SLOPE[template];
+    let mut fit = LineFit::new();
+    fit.add(Point::new(sp.u as f64, sp.v as f64));
+    // The mean, kept from one added point to the next (the prediction
+    // and the stray test of every scan line tried use it).
+    let mut mean = fit.mean();
+    let mut resp_sum = sp.response as f64;
+    let mut last = *sp;
+    let mut row_e = start_row;
+    let mut axis: Option<(f64, f64)> = None;
+    loop {
+        let mut found = None;
+        // (Not `1..=max_gap`: an inclusive range costs more per step.)
+        for i in 1..p.max_gap as usize + 1 {
+            let r = row_e + i;
+            if r >= nrows {
+                break;
+            }
+            // Once two points are in, predict from the fitted line itself,
+            // not from the last point: a track predicted from its last
+            // point follows any chain that bends by less than the search
+            // width per scan line, round a corner and along the next edge.
+            let pred = match mean {
+                Some(m) if fit.len() >= 2 => m.x + (r as f64 - m.y) * slope,
+                _ => last.u as f64 + i as f64 * slope,
+            };
+            // No unused point near the prediction at all (how a noise
+            // track usually ends): the bitmap says so without a search.
+            // Every candidate's column is within sw + ½ of `pred`.
+            // Otherwise the unused points near it are the window's bits,
+            // in order along the scan line.
+            if use_grid && pred.abs() < 1e9 {
+                // The columns within ⌊sw⌋ + 2 of the one nearest `pred`.
+                let centre = round_f64(pred);
+                let unused = &grid.unused[polarity(sp.response)];
+                let mut bits = grid.around_any(unused, r, centre) & grid.search;
+                let near = std::iter::from_fn(|| {
+                    (bits != 0).then(|| {
+                        let c = centre - 32 + bits.trailing_zeros() as i64;
+                        bits &= bits - 1;
+                        grid.point_at(r, c)
+                    })
+                });
+                if let Some(idx) = nearest(&s.points, near, pred, sw, sp.response) {
+                    found = Some((idx, r));
+                    break;
+                }
+                continue;
+            }
+            let near = from_u(s, r as i64, nrows, pred - sw)
+                .take_while(|&k| s.points[k].u as f64 - pred <= sw)
+                .filter(|&k| !s.used[k]);
+            if let Some(idx) = nearest(&s.points, near, pred, sw, sp.response) {
+                found = Some((idx, r));
+                break;
+            }
+        }
+        let Some((idx, r)) = found else { break };
+        // A track that is well established stops where the next point
+        // leaves its line: at a shallow corner (two edges at up to ~35°
+        // meet within the search window) or where a shadow edge branches.
+        // The distance from the line through the mean along the major
+        // axis found after the last point (the fit has not changed
+        // since): no trigonometry per point.
+        if fit.len() >= STRAY_AFTER {
+            if let (Some((du, dv)), Some(m)) = (axis, mean) {
+                let q = s.points[idx];
+                let cross = (q.u as f64 - m.x) * dv - (q.v as f64 - m.y) * du;
+                if cross.abs() > STRAY_DISTANCE * (du * du + dv * dv).sqrt() {
+                    break;
+                }
+            }
+        }
+        s.used[idx] = true;
+        if use_grid {
+            grid.mark_used(r, &s.points[idx]);
+        }
+        let q = s.points[idx];
+        fit.add(Point::new(q.u as f64, q.v as f64));
+        mean = fit.mean();
+        resp_sum += q.response as f64;
+        last = q;
+        row_e = r;
+        axis = fit.major_axis();
+        if let Some((du, dv)) = axis {
+            slope = if dv.abs() * MAX_SLOPE > du.abs() {
+                du / dv
+            } else {
+                MAX_SLOPE * du.signum() * dv.signum()
+            };
+        }
+    }
+    (fit, resp_sum, last)
 }
 
 /// [`extract`] into reusable buffers; appends nothing else to `out` (it is
@@ -626,151 +754,66 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
     s.reach.clear();
     if use_grid {
         s.reach.extend((1..=p.max_gap).map(|i| Reach::new(i, sw)));
+        grid.search = Reach::new(0, sw).near;
     }
 
     let min_angle = p.min_scan_angle_deg.to_radians();
-    for (start, start_row) in (0..total).zip(row_of_point(&s.row_start)) {
-        if s.used[start] {
-            continue;
-        }
-        s.used[start] = true;
-        let sp = s.points[start];
-        let template = if use_grid {
-            grid.mark_used(start_row, &sp);
-            if !grid.has_successor(&s.points, &s.reach, &sp, start_row, nrows) {
+    for start_row in 0..nrows {
+        for start in s.row_start[start_row] as usize..s.row_start[start_row + 1] as usize {
+            if s.used[start] {
                 continue;
             }
-            grid.template(start_row, sp.iu, nrows)
-        } else {
-            if !has_successor(s, &sp, start_row, nrows, p) {
-                // No unused point within reach of any template's prediction:
-                // no line can start here (the same result, without the
-                // templates).
-                continue;
-            }
-            template_of(s, &sp, start_row, nrows)
-        };
-        let mut slope = TEMPLATE_SLOPE[template];
-        let mut fit = LineFit::new();
-        fit.add(Point::new(sp.u as f64, sp.v as f64));
-        // The mean, kept from one added point to the next (the prediction
-        // and the stray test of every scan line tried use it).
-        let mut mean = fit.mean();
-        let mut resp_sum = sp.response as f64;
-        let mut last = sp;
-        let mut row_e = start_row;
-        let mut axis: Option<(f64, f64)> = None;
-        loop {
-            let mut found = None;
-            for i in 1..=p.max_gap as usize {
-                let r = row_e + i;
-                if r >= nrows {
-                    break;
-                }
-                // Once two points are in, predict from the fitted line itself,
-                // not from the last point: a track predicted from its last
-                // point follows any chain that bends by less than the search
-                // width per scan line, round a corner and along the next edge.
-                let pred = match mean {
-                    Some(m) if fit.len() >= 2 => m.x + (r as f64 - m.y) * slope,
-                    _ => last.u as f64 + i as f64 * slope,
-                };
-                // No unused point near the prediction at all (how a noise
-                // track usually ends): the bitmap says so without a search.
-                // Every candidate's column is within sw + ½ of `pred`.
-                // Otherwise the unused points near it are the window's bits,
-                // in order along the scan line.
-                if use_grid && pred.abs() < 1e9 {
-                    let half = sw as i64 + 2;
-                    let lo = pred as i64 - half;
-                    let unused = &grid.unused[polarity(sp.response)];
-                    let mut bits = grid.window(unused, r, lo, (2 * half + 1) as u32);
-                    let near = std::iter::from_fn(|| {
-                        (bits != 0).then(|| {
-                            let c = lo + bits.trailing_zeros() as i64;
-                            bits &= bits - 1;
-                            grid.point_at(r, c)
-                        })
-                    });
-                    if let Some(idx) = nearest(&s.points, near, pred, sw, sp.response) {
-                        found = Some((idx, r));
-                        break;
-                    }
+            s.used[start] = true;
+            let sp = s.points[start];
+            let template = if use_grid {
+                grid.mark_used(start_row, &sp);
+                if !grid.has_successor(&s.points, &s.reach, &sp, start_row, nrows) {
                     continue;
                 }
-                let near = from_u(s, r as i64, nrows, pred - sw)
-                    .take_while(|&k| s.points[k].u as f64 - pred <= sw)
-                    .filter(|&k| !s.used[k]);
-                if let Some(idx) = nearest(&s.points, near, pred, sw, sp.response) {
-                    found = Some((idx, r));
-                    break;
+                grid.template(start_row, sp.iu, nrows)
+            } else {
+                if !has_successor(s, &sp, start_row, nrows, p) {
+                    // No unused point within reach of any template's prediction:
+                    // no line can start here (the same result, without the
+                    // templates).
+                    continue;
                 }
+                template_of(s, &sp, start_row, nrows)
+            };
+            let (fit, resp_sum, last) =
+                track(s, &mut grid, use_grid, p, &sp, start_row, nrows, template);
+            let response = resp_sum / fit.len() as f64;
+            if response.abs() < p.min_response {
+                continue;
             }
-            let Some((idx, r)) = found else { break };
-            // A track that is well established stops where the next point
-            // leaves its line: at a shallow corner (two edges at up to ~35°
-            // meet within the search window) or where a shadow edge branches.
-            // The distance from the line through the mean along the major
-            // axis found after the last point (the fit has not changed
-            // since): no trigonometry per point.
-            if fit.len() >= STRAY_AFTER {
-                if let (Some((du, dv)), Some(m)) = (axis, mean) {
-                    let q = s.points[idx];
-                    let cross = (q.u as f64 - m.x) * dv - (q.v as f64 - m.y) * du;
-                    if cross.abs() > STRAY_DISTANCE * (du * du + dv * dv).sqrt() {
-                        break;
-                    }
-                }
+            // Projection onto a line never lengthens a segment: a track whose
+            // ends are no further apart than `min_length` (less a hair for
+            // rounding) is dropped before its line is computed.
+            let (du, dv) = (last.u as f64 - sp.u as f64, last.v as f64 - sp.v as f64);
+            if p.min_length > 0.0 && du * du + dv * dv < p.min_length * p.min_length * (1.0 - 1e-9)
+            {
+                continue;
             }
-            s.used[idx] = true;
-            if use_grid {
-                grid.mark_used(r, &s.points[idx]);
+            let Some(line) = fit.line() else { continue };
+            let a = line.project(Point::new(sp.u as f64, sp.v as f64));
+            let b = line.project(Point::new(last.u as f64, last.v as f64));
+            if a.dist(b) <= p.min_length {
+                continue;
             }
-            let q = s.points[idx];
-            fit.add(Point::new(q.u as f64, q.v as f64));
-            mean = fit.mean();
-            resp_sum += q.response as f64;
-            last = q;
-            row_e = r;
-            axis = fit.major_axis();
-            if let Some((du, dv)) = axis {
-                slope = if dv.abs() * MAX_SLOPE > du.abs() {
-                    du / dv
-                } else {
-                    MAX_SLOPE * du.signum() * dv.signum()
-                };
+            // Angle between the line and the scan direction (u axis).
+            let scan_angle = line.a.abs().atan2(line.b.abs());
+            if scan_angle <= min_angle {
+                continue;
             }
+            let swap = |q: Point| if vertical { Point::new(q.y, q.x) } else { q };
+            out.push(Segment {
+                a: swap(a),
+                b: swap(b),
+                response,
+                residual: fit.rms_residual(),
+                shadow: false,
+            });
         }
-        let response = resp_sum / fit.len() as f64;
-        if response.abs() < p.min_response {
-            continue;
-        }
-        // Projection onto a line never lengthens a segment: a track whose
-        // ends are no further apart than `min_length` (less a hair for
-        // rounding) is dropped before its line is computed.
-        let (du, dv) = (last.u as f64 - sp.u as f64, last.v as f64 - sp.v as f64);
-        if p.min_length > 0.0 && du * du + dv * dv < p.min_length * p.min_length * (1.0 - 1e-9) {
-            continue;
-        }
-        let Some(line) = fit.line() else { continue };
-        let a = line.project(Point::new(sp.u as f64, sp.v as f64));
-        let b = line.project(Point::new(last.u as f64, last.v as f64));
-        if a.dist(b) <= p.min_length {
-            continue;
-        }
-        // Angle between the line and the scan direction (u axis).
-        let scan_angle = line.a.abs().atan2(line.b.abs());
-        if scan_angle <= min_angle {
-            continue;
-        }
-        let swap = |q: Point| if vertical { Point::new(q.y, q.x) } else { q };
-        out.push(Segment {
-            a: swap(a),
-            b: swap(b),
-            response,
-            residual: fit.rms_residual(),
-            shadow: false,
-        });
     }
     s.grid = grid;
 }
