@@ -268,6 +268,7 @@ impl Grid {
     /// along each, whose rounded `u` are all in `0..=max_iu`, `max_iu <
     /// 2²⁰`; false (and no grid) when two points of a scan line share a
     /// column.
+    #[inline(never)]
     fn build(
         &mut self,
         points: &[ScanPoint],
@@ -342,7 +343,8 @@ impl Grid {
     fn around(&self, bits: &[u64], r: usize, centre: i64) -> u64 {
         let start = (centre + 32) as usize;
         let (w, b) = (r * self.words + start / 64, start % 64);
-        (bits[w] >> b) | ((bits[w + 1] << 1) << (63 - b))
+        let pair = &bits[w..w + 2];
+        (pair[0] >> b) | ((pair[1] << 1) << (63 - b))
     }
 
     /// [`Grid::around`] any column: no bits far off the grid's columns.
@@ -469,9 +471,28 @@ fn from_u(s: &LineScratch, r: i64, nrows: usize, t: f64) -> std::ops::Range<usiz
     lo + s.points[lo..hi].partition_point(|q| (q.u as f64) < t)..hi
 }
 
+/// [`nearest`] unused point to `pred` on scan line `r`, by a binary search
+/// (what the `Grid` answers when it is exact). Out of line: it keeps the
+/// grid's loop small.
+#[inline(never)]
+fn walk_nearest(
+    s: &LineScratch,
+    r: usize,
+    nrows: usize,
+    pred: f64,
+    sw: f64,
+    start_response: f32,
+) -> Option<usize> {
+    let near = from_u(s, r as i64, nrows, pred - sw)
+        .take_while(|&k| s.points[k].u as f64 - pred <= sw)
+        .filter(|&k| !s.used[k]);
+    nearest(&s.points, near, pred, sw, start_response)
+}
+
 /// Which template fits the neighbourhood of point `sp` on scan line `row`
 /// best (§3.1), by walking the scan lines (what the `Grid` answers when
 /// it is exact).
+#[inline(never)]
 fn template_of(s: &LineScratch, sp: &ScanPoint, row: usize, nrows: usize) -> usize {
     let iu = sp.iu;
     let mut score = [0u32; 4];
@@ -496,6 +517,7 @@ fn template_of(s: &LineScratch, sp: &ScanPoint, row: usize, nrows: usize) -> usi
 
 /// Whether an unused point lies where any initial prediction (slope -1, 0
 /// or 1) could find it on the next `max_gap` scan lines, by walking them.
+#[inline(never)]
 fn has_successor(
     s: &LineScratch,
     sp: &ScanPoint,
@@ -519,6 +541,7 @@ impl LineScratch {
     /// comes, in one pass; otherwise a counting sort by scan line keeps the
     /// order along the scan of the input (and sorts EdgeV column by
     /// column), and a scan line out of order along the scan is sorted.
+    #[inline(never)]
     fn file(&mut self, e: &EdgePoints, vertical: bool) -> usize {
         let scan = |q: &EdgePoint| {
             let (u, v) = if vertical { (q.y, q.x) } else { (q.x, q.y) };
@@ -571,6 +594,7 @@ impl LineScratch {
 /// [`LineScratch::file`] of input out of scan order: a counting sort by
 /// scan line (`rows`: each input point's, `u32::MAX` for none), then a sort
 /// of any scan line out of order along the scan.
+#[inline(never)]
 fn counting_sort(
     e: &EdgePoints,
     scan: &impl Fn(&EdgePoint) -> (ScanPoint, Option<usize>),
@@ -638,7 +662,8 @@ fn track(
     let sw = p.search_width;
     let mut slope = TEMPLATE_SLOPE[template];
     let mut fit = LineFit::new();
-    fit.add(Point::new(sp.u as f64, sp.v as f64));
+    // (Every filed point is finite.)
+    fit.add_finite(Point::new(sp.u as f64, sp.v as f64));
     // The mean, kept from one added point to the next (the prediction
     // and the stray test of every scan line tried use it).
     let mut mean = fit.mean();
@@ -685,10 +710,7 @@ fn track(
                 }
                 continue;
             }
-            let near = from_u(s, r as i64, nrows, pred - sw)
-                .take_while(|&k| s.points[k].u as f64 - pred <= sw)
-                .filter(|&k| !s.used[k]);
-            if let Some(idx) = nearest(&s.points, near, pred, sw, sp.response) {
+            if let Some(idx) = walk_nearest(s, r, nrows, pred, sw, sp.response) {
                 found = Some((idx, r));
                 break;
             }
@@ -714,7 +736,7 @@ fn track(
             grid.mark_used(r, &s.points[idx]);
         }
         let q = s.points[idx];
-        fit.add(Point::new(q.u as f64, q.v as f64));
+        fit.add_finite(Point::new(q.u as f64, q.v as f64));
         mean = fit.mean();
         resp_sum += q.response as f64;
         last = q;
