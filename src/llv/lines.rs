@@ -649,10 +649,9 @@ fn counting_sort(
 /// their fit, the sum of their responses and the last point.
 #[allow(clippy::too_many_arguments)]
 #[inline]
-fn track(
+fn track<const GRID: bool>(
     s: &mut LineScratch,
     grid: &mut Grid,
-    use_grid: bool,
     p: &LineParams,
     sp: &ScanPoint,
     start_row: usize,
@@ -692,7 +691,7 @@ fn track(
             // Every candidate's column is within sw + ½ of `pred`.
             // Otherwise the unused points near it are the window's bits,
             // in order along the scan line.
-            if use_grid && pred.abs() < 1e9 {
+            if GRID && pred.abs() < 1e9 {
                 // The columns within ⌊sw⌋ + 2 of the one nearest `pred`.
                 let centre = round_f64(pred);
                 let unused = &grid.unused[polarity(sp.response)];
@@ -732,7 +731,7 @@ fn track(
             }
         }
         s.used[idx] = true;
-        if use_grid {
+        if GRID {
             grid.mark_used(r, &s.points[idx]);
         }
         let q = s.points[idx];
@@ -753,32 +752,18 @@ fn track(
     (fit, resp_sum, last)
 }
 
-/// [`extract`] into reusable buffers; appends nothing else to `out` (it is
-/// cleared first).
-pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &mut LineScratch) {
-    out.clear();
-    let vertical = e.dir == Some(ScanDir::Vertical);
-    let nrows = s.file(e, vertical);
-    let total = s.points.len();
-    s.used.clear();
-    s.used.resize(total, false);
-    let mut grid = std::mem::take(&mut s.grid);
-    let sw = p.search_width;
-    let window_fits = sw.is_finite() && sw >= 0.0 && p.max_gap as f64 + sw <= 28.0;
-    #[cfg(test)]
-    let window_fits = window_fits && !s.walk_only;
-    // Every rounded `u` in `0..2²⁰` (so in the grid's columns); the largest.
-    let columns = s.points.iter().try_fold(0, |max, q| {
-        (0..1 << 20).contains(&q.iu).then(|| max.max(q.iu))
-    });
-    let use_grid = window_fits
-        && columns.is_some_and(|max_iu| grid.build(&s.points, &s.row_start, nrows, max_iu));
-    s.reach.clear();
-    if use_grid {
-        s.reach.extend((1..=p.max_gap).map(|i| Reach::new(i, sw)));
-        grid.search = Reach::new(0, sw).near;
-    }
-
+/// Follows the lines from every start point in turn (the main loop of
+/// [`extract_into`]), with the [`Grid`] or by walking the scan lines: one
+/// copy of the loop each, without the other's branches.
+#[inline(never)]
+fn follow<const GRID: bool>(
+    s: &mut LineScratch,
+    grid: &mut Grid,
+    p: &LineParams,
+    nrows: usize,
+    vertical: bool,
+    out: &mut Vec<Segment>,
+) {
     let min_angle = p.min_scan_angle_deg.to_radians();
     for start_row in 0..nrows {
         for start in s.row_start[start_row] as usize..s.row_start[start_row + 1] as usize {
@@ -787,7 +772,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
             }
             s.used[start] = true;
             let sp = s.points[start];
-            let template = if use_grid {
+            let template = if GRID {
                 grid.mark_used(start_row, &sp);
                 if !grid.has_successor(&s.points, &s.reach, &sp, start_row, nrows) {
                     continue;
@@ -802,8 +787,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
                 }
                 template_of(s, &sp, start_row, nrows)
             };
-            let (fit, resp_sum, last) =
-                track(s, &mut grid, use_grid, p, &sp, start_row, nrows, template);
+            let (fit, resp_sum, last) = track::<GRID>(s, grid, p, &sp, start_row, nrows, template);
             let response = resp_sum / fit.len() as f64;
             if response.abs() < p.min_response {
                 continue;
@@ -836,6 +820,39 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
                 shadow: false,
             });
         }
+    }
+}
+
+/// [`extract`] into reusable buffers; appends nothing else to `out` (it is
+/// cleared first).
+pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &mut LineScratch) {
+    out.clear();
+    let vertical = e.dir == Some(ScanDir::Vertical);
+    let nrows = s.file(e, vertical);
+    let total = s.points.len();
+    s.used.clear();
+    s.used.resize(total, false);
+    let mut grid = std::mem::take(&mut s.grid);
+    let sw = p.search_width;
+    let window_fits = sw.is_finite() && sw >= 0.0 && p.max_gap as f64 + sw <= 28.0;
+    #[cfg(test)]
+    let window_fits = window_fits && !s.walk_only;
+    // Every rounded `u` in `0..2²⁰` (so in the grid's columns); the largest.
+    let columns = s.points.iter().try_fold(0, |max, q| {
+        (0..1 << 20).contains(&q.iu).then(|| max.max(q.iu))
+    });
+    let use_grid = window_fits
+        && columns.is_some_and(|max_iu| grid.build(&s.points, &s.row_start, nrows, max_iu));
+    s.reach.clear();
+    if use_grid {
+        s.reach.extend((1..=p.max_gap).map(|i| Reach::new(i, sw)));
+        grid.search = Reach::new(0, sw).near;
+    }
+
+    if use_grid {
+        follow::<true>(s, &mut grid, p, nrows, vertical, out);
+    } else {
+        follow::<false>(s, &mut grid, p, nrows, vertical, out);
     }
     s.grid = grid;
 }
