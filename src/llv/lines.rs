@@ -239,6 +239,15 @@ pub fn extract(e: &EdgePoints, p: &LineParams) -> Vec<Segment> {
     out
 }
 
+/// The [`Grid`] bitmap of every point.
+const OCCUPIED: usize = 0;
+
+/// The [`Grid`] bitmap of the unused points with the polarity of `response`.
+#[inline]
+fn unused(response: f32) -> usize {
+    1 + polarity(response)
+}
+
 /// Bitmaps of the points by scan line and rounded `u` (one bit a pixel
 /// column): every point, and the points not yet used. The template scores
 /// and the successor test then read a few bits instead of walking the
@@ -249,11 +258,12 @@ pub fn extract(e: &EdgePoints, p: &LineParams) -> Vec<Segment> {
 #[derive(Clone, Debug, Default)]
 struct Grid {
     words: usize,
-    occupied: Vec<u64>,
-    /// The unused points, by polarity ([`polarity`]): a track only takes
-    /// points of its start's polarity, so only those can continue it.
-    unused: [Vec<u64>; 2],
-    /// Per word of `occupied` that has a bit set: the index of its first
+    /// Per word, three bitmaps: every point ([`OCCUPIED`]), and the unused
+    /// points by polarity ([`unused`]; a track only takes points of its
+    /// start's polarity, so only those can continue it). Side by side,
+    /// so that filing a point or reading a window checks one index.
+    cells: Vec<[u64; 3]>,
+    /// Per word of the occupied bitmap that has a bit set: the index of its first
     /// point, so a column's point is found without a search (other words:
     /// anything).
     first: Vec<u32>,
@@ -279,12 +289,8 @@ impl Grid {
         // The columns, and an empty word on either side.
         self.words = max_iu as usize / 64 + 3;
         let len = nrows * self.words;
-        self.occupied.clear();
-        self.occupied.resize(len, 0);
-        for u in &mut self.unused {
-            u.clear();
-            u.resize(len, 0);
-        }
+        self.cells.clear();
+        self.cells.resize(len, [0; 3]);
         if self.first.len() < len {
             self.first.resize(len, 0);
         }
@@ -293,16 +299,17 @@ impl Grid {
             for (k, q) in (ends[0]..ends[1]).zip(&points[ends[0] as usize..ends[1] as usize]) {
                 let c = q.iu as usize + 64;
                 let (w, bit) = (base + c / 64, 1u64 << (c % 64));
-                let occupied = self.occupied[w];
+                let cell = &mut self.cells[w];
+                let occupied = cell[OCCUPIED];
                 if occupied & bit != 0 {
                     self.words = 0;
                     return false;
                 }
+                cell[OCCUPIED] = occupied | bit;
+                cell[unused(q.response)] |= bit;
                 if occupied == 0 {
                     self.first[w] = k;
                 }
-                self.occupied[w] = occupied | bit;
-                self.unused[polarity(q.response)][w] |= bit;
             }
         }
         true
@@ -313,14 +320,14 @@ impl Grid {
     fn point_at(&self, r: usize, c: i64) -> usize {
         let c = (c + 64) as usize;
         let k = r * self.words + c / 64;
-        let below = self.occupied[k] & ((1u64 << (c % 64)) - 1);
+        let below = self.cells[k][OCCUPIED] & ((1u64 << (c % 64)) - 1);
         self.first[k] as usize + below.count_ones() as usize
     }
 
     #[inline]
     fn mark_used(&mut self, r: usize, q: &ScanPoint) {
         let c = q.iu as usize + 64;
-        self.unused[polarity(q.response)][r * self.words + c / 64] &= !(1u64 << (c % 64));
+        self.cells[r * self.words + c / 64][unused(q.response)] &= !(1u64 << (c % 64));
     }
 
     /// The template of §3.1 for a point at column `iu` of scan line `row`:
@@ -330,7 +337,7 @@ impl Grid {
         for (j, scores) in ROW_SCORES.iter().enumerate() {
             let r = (row + j).wrapping_sub(2);
             if r < nrows {
-                packed += scores[(self.around(&self.occupied, r, iu) >> 30 & 31) as usize];
+                packed += scores[(self.around(OCCUPIED, r, iu) >> 30 & 31) as usize];
             }
         }
         best_template(&packed.to_le_bytes().map(u32::from))
@@ -340,19 +347,19 @@ impl Grid {
     /// column `centre - 32 + k`. `centre` must be a point's column (or in
     /// `-32..=max_centre`).
     #[inline]
-    fn around(&self, bits: &[u64], r: usize, centre: i64) -> u64 {
+    fn around(&self, plane: usize, r: usize, centre: i64) -> u64 {
         let start = (centre + 32) as usize;
         let (w, b) = (r * self.words + start / 64, start % 64);
-        let pair = &bits[w..w + 2];
-        (pair[0] >> b) | ((pair[1] << 1) << (63 - b))
+        let pair = &self.cells[w..w + 2];
+        (pair[0][plane] >> b) | ((pair[1][plane] << 1) << (63 - b))
     }
 
     /// [`Grid::around`] any column: no bits far off the grid's columns.
     #[inline]
-    fn around_any(&self, bits: &[u64], r: usize, centre: i64) -> u64 {
+    fn around_any(&self, plane: usize, r: usize, centre: i64) -> u64 {
         let max_centre = (self.words as i64 - 1) * 64 - 33;
         if (-32..=max_centre).contains(&centre) {
-            self.around(bits, r, centre)
+            self.around(plane, r, centre)
         } else {
             0
         }
@@ -375,7 +382,7 @@ impl Grid {
         row: usize,
         nrows: usize,
     ) -> bool {
-        let unused = &self.unused[polarity(sp.response)];
+        let unused = unused(sp.response);
         let (mut near, mut inner) = (0, 0);
         for (r, rc) in (row + 1..nrows).zip(reach) {
             let bits = self.around(unused, r, sp.iu);
@@ -694,8 +701,7 @@ fn track<const GRID: bool>(
             if GRID && pred.abs() < 1e9 {
                 // The columns within ⌊sw⌋ + 2 of the one nearest `pred`.
                 let centre = round_f64(pred);
-                let unused = &grid.unused[polarity(sp.response)];
-                let mut bits = grid.around_any(unused, r, centre) & grid.search;
+                let mut bits = grid.around_any(unused(sp.response), r, centre) & grid.search;
                 let near = std::iter::from_fn(|| {
                     (bits != 0).then(|| {
                         let c = centre - 32 + bits.trailing_zeros() as i64;
