@@ -1055,7 +1055,7 @@ mod tests {
                     if rng.uniform() < 0.1 {
                         continue;
                     }
-                    let x = x0 + slope * (y - y0) as f64 + rng.range(-jitter, jitter);
+                    let x = x0 + slope * (y as f64 - y0 as f64) + rng.range(-jitter, jitter);
                     pts.push(EdgePoint {
                         x: x as f32,
                         y: y as f32,
