@@ -573,7 +573,7 @@ impl LineScratch {
                 u,
                 v,
                 response: q.response,
-                iu: 0,
+                iu: round_u(u),
             };
             (point, row_of(u, v))
         };
@@ -585,7 +585,7 @@ impl LineScratch {
         let (mut last_row, mut last_u) = (0, f32::NEG_INFINITY);
         let mut in_order = true;
         for q in &e.points {
-            let (mut point, Some(r)) = scan(q) else {
+            let (point, Some(r)) = scan(q) else {
                 continue;
             };
             if r < last_row || (r == last_row && point.u < last_u) {
@@ -596,7 +596,6 @@ impl LineScratch {
             if r >= row_start.len() {
                 row_start.resize(r + 1, points.len() as u32);
             }
-            point.iu = round_u(point.u);
             points.push(point);
         }
         let nrows = if in_order {
@@ -649,8 +648,7 @@ fn counting_sort(
     points.resize(total, ScanPoint::default());
     for (q, &r) in e.points.iter().zip(rows.iter()) {
         if r != u32::MAX {
-            let mut point = scan(q).0;
-            point.iu = round_u(point.u);
+            let point = scan(q).0;
             let slot = &mut row_start[r as usize + 1];
             points[*slot as usize] = point;
             *slot += 1;
@@ -715,7 +713,7 @@ fn track<const GRID: bool>(
             // Every candidate's column is within sw + ½ of `pred`.
             // Otherwise the unused points near it are the window's bits,
             // in order along the scan line.
-            if GRID && pred.abs() < 1e9 {
+            let next = if GRID && pred.abs() < 1e9 {
                 // The columns within ⌊sw⌋ + 2 of the one nearest `pred`.
                 let centre = round_f64(pred);
                 let mut bits = grid.around_any(unused(sp.response), r, centre) & grid.search;
@@ -726,13 +724,11 @@ fn track<const GRID: bool>(
                         grid.point_at(r, c)
                     })
                 });
-                if let Some(idx) = nearest(&s.points, near, pred, sw, sp.response) {
-                    found = Some((idx, r));
-                    break;
-                }
-                continue;
-            }
-            if let Some(idx) = walk_nearest(s, r, nrows, pred, sw, sp.response) {
+                nearest(&s.points, near, pred, sw, sp.response)
+            } else {
+                walk_nearest(s, r, nrows, pred, sw, sp.response)
+            };
+            if let Some(idx) = next {
                 found = Some((idx, r));
                 break;
             }
@@ -870,9 +866,6 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
     if use_grid {
         s.reach.extend((1..=p.max_gap).map(|i| Reach::new(i, sw)));
         grid.search = Reach::new(0, sw).near;
-    }
-
-    if use_grid {
         follow::<true>(s, &mut grid, p, nrows, vertical, out);
     } else {
         follow::<false>(s, &mut grid, p, nrows, vertical, out);
