@@ -7,13 +7,17 @@
 //! lanes, `edges/row.rs`) and the response is rounded once, when it is scaled by
 //! `1/A³`.
 //!
-//! Speed: the peak finder makes two vectorised passes instead of listing
-//! every candidate (about one pixel in thirteen on a noisy image): the first
-//! histograms candidate sizes per region, the second keeps the candidates at
-//! or above the region's limit. Both walk their flags 64 pixels per bit mask,
-//! since mispredicted branches, not arithmetic, bounded the older code. The
-//! straightforward former implementation is kept in `edges/reference.rs`
-//! (tests only); the tests compare both bit for bit.
+//! Speed: the peak finder makes two passes instead of listing every
+//! candidate (about one pixel in thirteen on a noisy image): the first
+//! tests four pixels at a time and puts the compare's sign bits straight
+//! into one bit mask per 64 pixels (through `wide`, `movmskps` on x86-64),
+//! then histograms the candidates' sizes per region; the second keeps the
+//! candidates at or above the region's limit, one bit at a time without a
+//! branch on the answer, and emits the kept ones. The region's limit is
+//! found walking up from size 2, where it usually is, not down from the
+//! largest peak. Mispredicted branches, not arithmetic, bounded the older
+//! code. The straightforward former implementation is kept in
+//! `edges/reference.rs` (tests only); the tests compare both bit for bit.
 //!
 //! Layout: a [`Response`] is always stored in image order, `data[y·w + x]`,
 //! for both scan directions. The vertical convolution and the vertical peak
@@ -23,6 +27,7 @@
 use super::image::GreyImage;
 use super::params::EdgeParams;
 use super::{EdgePoint, EdgePoints, LlvError, ScanDir};
+use wide::{CmpGe, CmpGt, f32x4};
 
 #[cfg(test)]
 mod reference;
@@ -259,13 +264,13 @@ fn mask_invalid(
 #[derive(Clone, Debug, Default)]
 pub struct PeakScratch {
     hist: Vec<u32>,
-    /// Candidate flags of the rows of one region (horizontal scan) or of
-    /// the whole response (vertical scan), `1` for a candidate.
-    flags_h: Vec<u8>,
-    flags_v: Vec<u8>,
-    /// Vertical scan: per column, the largest candidate `|E|`, then the
-    /// lower limit on `|E|` of a kept peak; the column's histogram offset.
-    colmax: Vec<f32>,
+    /// Candidate bits (then kept bits) of the rows of one region
+    /// (horizontal scan) or of the whole response (vertical scan), 64
+    /// pixels per word, see [`candidates`].
+    bits_h: Vec<u64>,
+    bits_v: Vec<u64>,
+    /// Vertical scan: per column, the lower limit on `|E|` of a kept peak
+    /// and the column's histogram offset.
     lim: Vec<f32>,
     offset: Vec<u32>,
 }
@@ -279,113 +284,90 @@ fn first_pass_floor(t: f32) -> f32 {
     if t >= 2.0 { t } else { below_two }
 }
 
-/// Candidates of the first pass: `flags[i] = 1` where `|mid[i]|` is a peak
-/// between `|lo[i]|` and `|hi[i]|` (§2.3) above `t1` (see
-/// [`first_pass_floor`]); returns the largest such `|E|` (0 if none).
-/// Branch-free on eight lanes so it vectorises; NaN compares false.
-#[inline]
-fn candidates_row(lo: &[f32], mid: &[f32], hi: &[f32], t1: f32, flags: &mut [u8]) -> f32 {
-    let n = flags.len().min(lo.len()).min(mid.len()).min(hi.len());
-    let (flags, lo, mid, hi) = (&mut flags[..n], &lo[..n], &mid[..n], &hi[..n]);
-    let mut mx = [0f32; 8];
-    let mut fc = flags.chunks_exact_mut(8);
-    let (mut mc, mut lc, mut hc) = (mid.chunks_exact(8), lo.chunks_exact(8), hi.chunks_exact(8));
-    for (((f, m), l), h) in (&mut fc).zip(&mut mc).zip(&mut lc).zip(&mut hc) {
-        for k in 0..8 {
-            let e0 = m[k].abs();
-            let c = (e0 > l[k].abs()) & (e0 >= h[k].abs()) & (e0 > t1);
-            f[k] = u8::from(c);
-            let v = if c { e0 } else { 0.0 };
-            mx[k] = if v > mx[k] { v } else { mx[k] };
+/// Pixels per candidate word.
+const WORD: usize = 64;
+
+/// The peak test (§2.3) on the 64 pixels of one word: bit `i` is set where
+/// `|mid[i]|` is above `|lo[i]|`, at least `|hi[i]|` and above `t1` (see
+/// [`first_pass_floor`]); NaN compares false. Four lanes at a time, and the compare's sign bits go straight into the
+/// word (`movmskps` on x86-64): no flag bytes to pack afterwards.
+#[inline(always)]
+fn candidate_word(lo: &[f32; WORD], mid: &[f32; WORD], hi: &[f32; WORD], t1: f32x4) -> u64 {
+    let quad = |s: &[f32; WORD], i: usize| f32x4::from([s[i], s[i + 1], s[i + 2], s[i + 3]]);
+    let mut bits = 0u64;
+    for i in (0..WORD).step_by(4) {
+        let e0 = quad(mid, i).abs();
+        let c = e0.cmp_gt(quad(lo, i).abs()) & e0.cmp_ge(quad(hi, i).abs()) & e0.cmp_gt(t1);
+        bits |= u64::from(c.move_mask() as u32 & 0xF) << i;
+    }
+    bits
+}
+
+/// [`candidate_word`] over a whole scan line of `n = mid.len()` pixels
+/// (`lo`, `hi` as long): bit `i % 64` of `words[i / 64]` for pixel `i`,
+/// `n.div_ceil(64)` words. A last partial word is computed on the 64 pixels
+/// that end the line and shifted into place; a line shorter than a word
+/// goes through a copy padded with NaN.
+#[inline(always)]
+fn candidates(lo: &[f32], mid: &[f32], hi: &[f32], t1: f32, words: &mut [u64]) {
+    let n = mid.len().min(lo.len()).min(hi.len());
+    let t1 = f32x4::splat(t1);
+    if n < WORD {
+        let mut pad = [[f32::NAN; WORD]; 3];
+        for (p, s) in pad.iter_mut().zip([lo, mid, hi]) {
+            p[..n].copy_from_slice(&s[..n]);
+        }
+        if let Some(w) = words.first_mut() {
+            *w = candidate_word(&pad[0], &pad[1], &pad[2], t1);
+        }
+        return;
+    }
+    let full = n / WORD;
+    for (k, w) in words.iter_mut().enumerate().take(full) {
+        let at = k * WORD;
+        *w = candidate_word(block(lo, at), block(mid, at), block(hi, at), t1);
+    }
+    if n % WORD != 0 {
+        let at = n - WORD;
+        let bits = candidate_word(block(lo, at), block(mid, at), block(hi, at), t1);
+        if let Some(w) = words.get_mut(full) {
+            *w = bits >> (full * WORD - at);
         }
     }
-    let mut best = mx.iter().fold(0f32, |a, &b| if b > a { b } else { a });
-    let rest = fc.into_remainder().iter_mut();
-    for (((f, &m), &l), &h) in rest
-        .zip(mc.remainder())
-        .zip(lc.remainder())
-        .zip(hc.remainder())
-    {
-        let e0 = m.abs();
-        let c = (e0 > l.abs()) & (e0 >= h.abs()) & (e0 > t1);
-        *f = u8::from(c);
-        if c && e0 > best {
-            best = e0;
-        }
-    }
-    best
 }
 
-/// [`candidates_row`] for the vertical scan: the largest candidate `|E|` is
-/// kept per column in `colmax`.
-#[inline]
-fn candidates_cols(
-    lo: &[f32],
-    mid: &[f32],
-    hi: &[f32],
-    t1: f32,
-    flags: &mut [u8],
-    colmax: &mut [f32],
-) {
-    for ((((f, &m), &l), &h), cm) in flags
-        .iter_mut()
-        .zip(mid)
-        .zip(lo)
-        .zip(hi)
-        .zip(colmax.iter_mut())
-    {
-        let e0 = m.abs();
-        let c = (e0 > l.abs()) & (e0 >= h.abs()) & (e0 > t1);
-        *f = u8::from(c);
-        let v = if c { e0 } else { 0.0 };
-        *cm = if v > *cm { v } else { *cm };
-    }
+/// The `WORD` values of `s` from `at` (the caller checked the length).
+#[inline(always)]
+fn block(s: &[f32], at: usize) -> &[f32; WORD] {
+    s[at..at + WORD].try_into().expect("a whole word")
 }
 
-/// The second pass: keeps the first pass's candidates (`flags`) above the
-/// region's limit (`|E| ≥ lim`, see [`limit`]); every kept peak was a
-/// candidate, since `lim ≥ 2` and the floor test is the same.
-#[inline]
-fn kept_row(mid: &[f32], lim: f32, flags: &mut [u8]) {
-    for (f, &m) in flags.iter_mut().zip(mid) {
-        *f &= u8::from(m.abs() >= lim);
-    }
-}
-
-/// [`kept_row`] with one limit per column (vertical scan).
-#[inline]
-fn kept_cols(mid: &[f32], lim: &[f32], flags: &mut [u8]) {
-    for ((f, &m), &g) in flags.iter_mut().zip(mid).zip(lim) {
-        *f &= u8::from(m.abs() >= g);
-    }
-}
-
-/// Calls `f(i)` for every `i` with `flags[i] == 1` (flags are 0 or 1), in
-/// order. Sixty-four flags are packed into one bit mask first (eight bytes
-/// of 0/1 become eight bits with one multiplication), so the loop over set
-/// bits ends — a mispredicted branch — once per 64 pixels, not once per 8.
-#[inline]
-fn for_each_flag(flags: &[u8], mut f: impl FnMut(usize)) {
-    /// Byte `i` (0 or 1) of a little-endian word lands on bit `56 + i`.
-    const GATHER: u64 = 0x0102_0408_1020_4080;
-    let word = |w: &[u8]| u64::from_le_bytes([w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7]]);
-    let mut chunks = flags.chunks_exact(64);
-    let mut base = 0;
-    for ch in &mut chunks {
-        let mut bits = 0u64;
-        for (k, w) in ch.chunks_exact(8).enumerate() {
-            bits |= (word(w).wrapping_mul(GATHER) >> 56) << (8 * k);
-        }
+/// Calls `f(i)` for every set bit `i` of `words` (bit `i % 64` of word
+/// `i / 64`), in order.
+#[inline(always)]
+fn for_each_bit(words: &[u64], mut f: impl FnMut(usize)) {
+    for (k, &w) in words.iter().enumerate() {
+        let mut bits = w;
         while bits != 0 {
-            f(base + bits.trailing_zeros() as usize);
+            f(k * WORD + bits.trailing_zeros() as usize);
             bits &= bits - 1;
         }
-        base += 64;
     }
-    for (k, &v) in chunks.remainder().iter().enumerate() {
-        if v != 0 {
-            f(base + k);
+}
+
+/// The second pass: keeps the candidate bits `i` with `keep(i)`, without a
+/// branch on the answer (about half the candidates are kept, at random).
+#[inline(always)]
+fn retain_bits(words: &mut [u64], mut keep: impl FnMut(usize) -> bool) {
+    for (k, w) in words.iter_mut().enumerate() {
+        let mut bits = *w;
+        let mut kept = 0u64;
+        while bits != 0 {
+            let b = bits.trailing_zeros();
+            kept |= u64::from(keep(k * WORD + b as usize)) << b;
+            bits &= bits - 1;
         }
+        *w = kept;
     }
 }
 
@@ -396,44 +378,59 @@ fn bin(e0: f32) -> usize {
     e0.min((BINS - 1) as f32) as u32 as usize
 }
 
+/// The bin of a region's histogram that counts its candidates: sizes 0
+/// and 1 are never candidates (the first pass's test excludes them), so
+/// bin 0 is free.
+const TOTAL: usize = 0;
+
+/// Counts a candidate of size `bin` in a region's histogram.
+#[inline(always)]
+fn count(hist: &mut [u32], bin: usize) {
+    hist[TOTAL] += 1;
+    hist[bin] += 1;
+}
+
 /// A region's lower limit on `|E|` for a kept peak, from the histogram of
-/// its candidate sizes ≥ 2 and its largest candidate `|E|` (`mx`, 0 if
-/// none), per llv.md §2.5; clears the bins used.
+/// its candidate sizes (≥ 2, with their number in bin [`TOTAL`]), per
+/// llv.md §2.5; clears the histogram.
 ///
-/// The threshold loop only ever reads bins `tmax..=2`, so sizes 0 and 1 are
-/// not counted; if no candidate reaches size 2, `tmax ≤ 1` is the final
-/// threshold and nothing is above it (limit +∞). A peak is kept when its
-/// size `⌊|E|⌋ > th`, i.e. `|E| ≥ th + 1` (`th` is a whole number), which is
-/// what the emit pass compares, without rounding.
-fn limit(hist: &mut [u32], mx: f32, m: u32) -> f32 {
-    if mx.is_nan() || mx < 2.0 {
-        return f32::INFINITY;
-    }
-    let tmax = bin(mx);
-    let Some(hist) = hist.get_mut(..=tmax) else {
+/// The rule walks a threshold `th` down from the largest size `tmax`,
+/// adding each bin's count, until `M` candidates are above it or it reaches
+/// 1; a peak is kept when its size `⌊|E|⌋ > th`, i.e. `|E| ≥ th + 1` (`th`
+/// is a whole number), which is what the second pass compares, without
+/// rounding. So the limit is the largest size `v` (2 to `tmax`) with at
+/// least `M` candidates of size `≥ v`, or 2 if there is none. That is
+/// found here walking up from 2, subtracting the bins below `v` from the
+/// total: the limit is near the noise level, far below `tmax`, so this is
+/// the short way. With `M = 0` the rule keeps nothing below `tmax + 1`
+/// (sizes are clamped at 255, so a huge `|E|` may still pass); with no
+/// candidate the limit is +∞.
+fn limit(hist: &mut [u32], m: u32) -> f32 {
+    let Some(hist) = hist.first_chunk_mut::<BINS>() else {
         return f32::INFINITY;
     };
-    let mut th = tmax;
-    let mut sum = 0u32;
-    // Eight bins at a time while the one-by-one walk would not stop inside
-    // them: `sum` stays below `m` and `th` above 1 for all eight steps.
-    while th >= 9 {
-        let s8 = hist[th - 7..=th]
-            .iter()
-            .fold(0u32, |a, &b| a.saturating_add(b));
-        let next = sum.saturating_add(s8);
-        if next >= m {
-            break;
+    let n = hist[TOTAL];
+    if n == 0 {
+        return f32::INFINITY;
+    }
+    hist[TOTAL] = 0;
+    let lim = if m == 0 {
+        hist.iter()
+            .rposition(|&c| c != 0)
+            .map_or(2, |tmax| tmax + 1)
+    } else if n < m {
+        2
+    } else {
+        let mut v = 2;
+        let mut below = 0;
+        while v < BINS - 1 && n - (below + hist[v]) >= m {
+            below += hist[v];
+            v += 1;
         }
-        sum = next;
-        th -= 8;
-    }
-    while sum < m && th > 1 {
-        sum = sum.saturating_add(hist[th]);
-        th -= 1;
-    }
-    hist.fill(0);
-    (th + 1) as f32
+        v
+    };
+    *hist = [0; BINS];
+    lim as f32
 }
 
 /// Parabolic subpixel offset through `|E|` at a peak and its two neighbours,
@@ -466,11 +463,11 @@ pub fn peaks(resp: &Response, p: &EdgeParams) -> EdgePoints {
 
 /// [`peaks`] into reusable buffers.
 ///
-/// Two passes instead of a list of every candidate: the first histograms
-/// the candidate sizes per region (for a horizontal scan, region by region
-/// while its rows are in the first-level cache), the second recomputes the
-/// peak test with the region's limit folded in and emits only the kept
-/// points, in lexical order.
+/// Two passes instead of a list of every candidate: the first marks the
+/// candidates in bit masks and histograms their sizes per region (for a
+/// horizontal scan, region by region while its rows are in the first-level
+/// cache), the second keeps the marked candidates at or above the region's
+/// limit and emits them, in lexical order.
 pub fn peaks_into(resp: &Response, p: &EdgeParams, out: &mut EdgePoints, s: &mut PeakScratch) {
     let (w, h) = (resp.width, resp.height);
     out.dir = Some(resp.dir);
@@ -501,32 +498,33 @@ fn peaks_h(resp: &Response, t1: f32, r: usize, m: u32, out: &mut EdgePoints, s: 
         s.hist.resize(BINS, 0);
     }
     let hist = &mut s.hist[..BINS];
-    // Flags of a region's rows: entries 0 and w-1 of each row are never
-    // written, so they stay 0 as long as the width does not change.
+    // Bit i of a row's words is the pixel x = i + 1 (the test needs both
+    // neighbours).
+    let nw = (w - 2).div_ceil(WORD);
     let rows = r.min(resp.height);
-    if s.flags_h.len() != rows * w {
-        s.flags_h.clear();
-        s.flags_h.resize(rows * w, 0);
+    if s.bits_h.len() != rows * nw {
+        s.bits_h.clear();
+        s.bits_h.resize(rows * nw, 0);
     }
     for (g, region) in resp.data.chunks(w * r).enumerate() {
-        let mut mx = 0f32;
-        for (row, flags) in region.chunks_exact(w).zip(s.flags_h.chunks_exact_mut(w)) {
-            let (lo, mid, hi) = (&row[..w - 2], &row[1..w - 1], &row[2..]);
-            mx = mx.max(candidates_row(lo, mid, hi, t1, &mut flags[1..w - 1]));
-            for_each_flag(flags, |x| hist[bin(row[x].abs())] += 1);
+        for (row, words) in region.chunks_exact(w).zip(s.bits_h.chunks_exact_mut(nw)) {
+            let mid = &row[1..w - 1];
+            candidates(&row[..w - 2], mid, &row[2..], t1, words);
+            for_each_bit(words, |i| count(hist, bin(mid[i].abs())));
         }
-        let lim = limit(hist, mx, m);
+        let lim = limit(hist, m);
         if lim == f32::INFINITY {
             continue;
         }
-        for (k, (row, flags)) in region
+        for (k, (row, words)) in region
             .chunks_exact(w)
-            .zip(s.flags_h.chunks_exact_mut(w))
+            .zip(s.bits_h.chunks_exact_mut(nw))
             .enumerate()
         {
             let y = (g * r + k) as f32;
-            kept_row(row, lim, flags);
-            for_each_flag(flags, |x| {
+            retain_bits(words, |i| row[i + 1].abs() >= lim);
+            for_each_bit(words, |i| {
+                let x = i + 1;
                 let (em, e0, ep) = (row[x - 1].abs(), row[x].abs(), row[x + 1].abs());
                 out.points.push(EdgePoint {
                     x: x as f32 + subpixel(em, e0, ep),
@@ -546,43 +544,44 @@ fn peaks_v(resp: &Response, t1: f32, r: usize, m: u32, out: &mut EdgePoints, s: 
         s.hist.resize(nreg * BINS, 0);
     }
     debug_assert!(s.hist.iter().all(|&n| n == 0), "histograms left dirty");
-    s.colmax.clear();
-    s.colmax.resize(w, 0.0);
+    let nw = w.div_ceil(WORD);
     s.offset.clear();
     s.offset.extend((0..w).map(|x| ((x / r) * BINS) as u32));
-    // One row of flags per response row (the first and last are unused);
-    // the first pass writes every flag it reads later.
-    if s.flags_v.len() != w * h {
-        s.flags_v.clear();
-        s.flags_v.resize(w * h, 0);
+    // One row of words per response row (the first and last are unused);
+    // the first pass writes every word it reads later.
+    if s.bits_v.len() != nw * h {
+        s.bits_v.clear();
+        s.bits_v.resize(nw * h, 0);
     }
-    let (hist, colmax, offset) = (&mut s.hist, &mut s.colmax, &s.offset);
+    let (hist, offset) = (&mut s.hist, &s.offset);
     let data = &resp.data;
-    let mut flag_rows = s.flags_v.chunks_exact_mut(w);
-    flag_rows.next();
-    for (y, flags) in (1..h - 1).zip(&mut flag_rows) {
+    let mut word_rows = s.bits_v.chunks_exact_mut(nw);
+    word_rows.next();
+    for (y, words) in (1..h - 1).zip(&mut word_rows) {
         let up = &data[(y - 1) * w..y * w];
         let row = &data[y * w..(y + 1) * w];
         let dn = &data[(y + 1) * w..(y + 2) * w];
-        candidates_cols(up, row, dn, t1, flags, colmax);
-        for_each_flag(flags, |x| hist[offset[x] as usize + bin(row[x].abs())] += 1);
+        candidates(up, row, dn, t1, words);
+        for_each_bit(words, |x| {
+            let o = offset[x] as usize;
+            count(&mut hist[o..o + BINS], bin(row[x].abs()));
+        });
     }
     s.lim.clear();
-    for (g, cols) in colmax.chunks(r).enumerate() {
-        let mx = cols.iter().fold(0f32, |a, &b| a.max(b));
-        let l = limit(&mut hist[g * BINS..(g + 1) * BINS], mx, m);
-        s.lim.extend(std::iter::repeat_n(l, cols.len()));
+    for (g, hist) in hist.chunks_exact_mut(BINS).enumerate() {
+        let l = limit(hist, m);
+        s.lim.extend(std::iter::repeat_n(l, r.min(w - g * r)));
     }
     let lim = &s.lim;
-    let mut flag_rows = s.flags_v.chunks_exact_mut(w);
-    flag_rows.next();
-    for (y, flags) in (1..h - 1).zip(&mut flag_rows) {
+    let mut word_rows = s.bits_v.chunks_exact_mut(nw);
+    word_rows.next();
+    for (y, words) in (1..h - 1).zip(&mut word_rows) {
         let up = &data[(y - 1) * w..y * w];
         let row = &data[y * w..(y + 1) * w];
         let dn = &data[(y + 1) * w..(y + 2) * w];
-        kept_cols(row, lim, flags);
+        retain_bits(words, |x| row[x].abs() >= lim[x]);
         let yf = y as f32;
-        for_each_flag(flags, |x| {
+        for_each_bit(words, |x| {
             let (em, e0, ep) = (up[x].abs(), row[x].abs(), dn[x].abs());
             out.points.push(EdgePoint {
                 x: x as f32,
@@ -717,7 +716,17 @@ mod tests {
         let (mut fast, mut slow) = (EdgePoints::default(), EdgePoints::default());
         let (mut fs, mut ss) = (PeakScratch::default(), reference::PeakScratch::default());
         let mut kept = 0;
-        for (w, h) in [(16, 16), (37, 53), (130, 17), (17, 130), (96, 80)] {
+        // Scan lines shorter than a word, of whole words, and with a
+        // partial last word, in both directions.
+        for (w, h) in [
+            (16, 16),
+            (37, 53),
+            (130, 17),
+            (17, 130),
+            (96, 80),
+            (66, 70),
+            (200, 23),
+        ] {
             for masked in [false, true] {
                 let img = random_image(&mut rng, w, h, masked);
                 for a in 3..=7 {
@@ -731,6 +740,7 @@ mod tests {
                             (1.0, 50, 7),
                             (2.0, 4096, 1),
                             (0.5, 2, 4096),
+                            (2.0, 0, 1),
                         ] {
                             let p = EdgeParams {
                                 half_width: a as u32,
