@@ -294,11 +294,16 @@ const WORD: usize = 64;
 #[inline(always)]
 fn candidate_word(lo: &[f32; WORD], mid: &[f32; WORD], hi: &[f32; WORD], t1: f32x4) -> u64 {
     let quad = |s: &[f32; WORD], i: usize| f32x4::from([s[i], s[i + 1], s[i + 2], s[i + 3]]);
-    let mut bits = 0u64;
-    for i in (0..WORD).step_by(4) {
+    let test = |i: usize| {
         let e0 = quad(mid, i).abs();
         let c = e0.cmp_gt(quad(lo, i).abs()) & e0.cmp_ge(quad(hi, i).abs()) & e0.cmp_gt(t1);
-        bits |= u64::from(c.move_mask() as u32 & 0xF) << i;
+        c.move_mask() as u32 & 0xF
+    };
+    // Eight pixels a step: half the loop's overhead, constant shifts
+    // (sixteen a step measured no better).
+    let mut bits = 0u64;
+    for i in (0..WORD).step_by(8) {
+        bits |= u64::from(test(i) | test(i + 4) << 4) << i;
     }
     bits
 }
@@ -374,8 +379,9 @@ fn retain_bits(words: &mut [u64], mut keep: impl FnMut(usize) -> bool) {
 /// The histogram bin of a peak: its size, `|E|` rounded down, at most 255.
 #[inline]
 fn bin(e0: f32) -> usize {
-    // Clamped first, so the conversion needs no saturation (NaN gives 0).
-    e0.min((BINS - 1) as f32) as u32 as usize
+    // (A conversion to `u8` saturates itself, more cheaply than one to a
+    // wider type; `min` also takes NaN to 255.)
+    e0.min((BINS - 1) as f32) as u8 as usize
 }
 
 /// The bin of a region's histogram that counts its candidates: sizes 0
