@@ -1,0 +1,77 @@
+//! Runs one LLV stage N times on the bench scene (512², noise σ 2, seed 42),
+//! for instruction counts that do not depend on the machine's other load:
+//!
+//! ```text
+//! cargo build --release --example llv_count
+//! for n in 5 15; do valgrind --tool=callgrind --callgrind-out-file=/tmp/cg.$n \
+//!     target/release/examples/llv_count pipeline $n; done
+//! ```
+//!
+//! Instructions per run = (total at N = 15 − total at N = 5) / 10, which
+//! takes out the scene's rendering and the warm-up. Stages: `pipeline`
+//! (edges, lines, CONNECT; no lens), `edges` (response and peaks, both
+//! directions), `response`, `peaks`, `lines`.
+
+use vss::llv::edges::{PeakScratch, Response, ResponseScratch, peaks_into, response_into};
+use vss::llv::lines::{LineScratch, extract_into};
+use vss::llv::pipeline::{Input, Workspace};
+use vss::llv::{EdgePoints, Params, ScanDir};
+
+#[path = "../tests/support/llv_scene.rs"]
+mod llv_scene;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let (Some(stage), Some(Ok(n))) = (args.get(1), args.get(2).map(|s| s.parse::<usize>())) else {
+        eprintln!("usage: llv_count pipeline|edges|response|peaks|lines N");
+        std::process::exit(2);
+    };
+    let img = llv_scene::scene(512, 512, 2.0, 42);
+    let p = Params::default();
+    let a = p.edges.half_width as usize;
+    let mut ws = Workspace::new();
+    ws.run(&Input::single(&img), &p).expect("the scene runs");
+    let warm = ws.outputs().clone();
+    let (mut rh, mut rv) = (Response::default(), Response::default());
+    let (mut eh, mut ev) = (EdgePoints::default(), EdgePoints::default());
+    let mut rs = ResponseScratch::default();
+    let mut ps = PeakScratch::default();
+    let mut ls = LineScratch::default();
+    let (mut lh, mut lv) = (Vec::new(), Vec::new());
+    let mut response = |rh: &mut Response, rv: &mut Response| {
+        response_into(&img, ScanDir::Horizontal, a, rh, &mut rs).expect("size");
+        response_into(&img, ScanDir::Vertical, a, rv, &mut rs).expect("size");
+    };
+    if stage == "peaks" {
+        response(&mut rh, &mut rv);
+    }
+    let mut check = 0usize;
+    for _ in 0..n {
+        match stage.as_str() {
+            "pipeline" => {
+                ws.run(&Input::single(&img), &p).expect("the scene runs");
+                check += ws.outputs().lines.len();
+            }
+            "edges" | "response" | "peaks" => {
+                if stage != "peaks" {
+                    response(&mut rh, &mut rv);
+                }
+                if stage != "response" {
+                    peaks_into(&rh, &p.edges, &mut eh, &mut ps);
+                    peaks_into(&rv, &p.edges, &mut ev, &mut ps);
+                }
+                check += eh.points.len() + ev.points.len();
+            }
+            "lines" => {
+                extract_into(&warm.edges_h, &p.lines, &mut lh, &mut ls);
+                extract_into(&warm.edges_v, &p.lines, &mut lv, &mut ls);
+                check += lh.len() + lv.len();
+            }
+            other => {
+                eprintln!("unknown stage {other}");
+                std::process::exit(2);
+            }
+        }
+    }
+    println!("{stage} x{n}: {check}");
+}
