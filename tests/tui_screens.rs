@@ -102,9 +102,14 @@ fn view() -> SessionView {
 
 /// Runs the survey for image 1 through messages; returns the app in Review.
 fn reviewed() -> App {
+    reviewed_in(view())
+}
+
+/// [`reviewed`] in the session `v`.
+fn reviewed_in(v: SessionView) -> App {
     let mut app = App::new(&profile(), colour());
     app.start();
-    app.update(Msg::Store(StoreEvent::Opened(view())));
+    app.update(Msg::Store(StoreEvent::Opened(v)));
     let mut cmds = code(&mut app, KeyCode::Enter);
     for (i, letter) in ['a', 'b', 'c'].into_iter().enumerate() {
         assert!(
@@ -196,6 +201,40 @@ fn survey_review_shows_the_line_count_and_accept_moves_on() {
     );
     let (s, _) = draw(&app, 100, 30);
     assert!(s.contains("Image 2: camera"), "{s}");
+}
+
+#[test]
+fn accept_moves_on_to_the_camera_and_location_the_survey_planned() {
+    // The session has image 2 on record for camera 3 at location 2 (a new
+    // survey plans one image per camera); image 1 is taken with camera 1.
+    let plan = |k, camera, location| ImageState {
+        k,
+        camera,
+        location,
+        captured: Vec::new(),
+        outputs: false,
+        stale: false,
+        edits: 0,
+    };
+    let mut v = view();
+    v.images = vec![plan(1, 1, 1), plan(2, 3, 2)];
+    let mut app = reviewed_in(v);
+    key(&mut app, 'a');
+    let (s, _) = draw(&app, 100, 30);
+    assert!(s.contains("Image 2: camera 3 (c), location 2 (p)"), "{s}");
+    // Enter captures image 2 with that camera.
+    let cmds = code(&mut app, KeyCode::Enter);
+    assert!(
+        cmds.iter().any(|c| matches!(
+            c,
+            Cmd::Device(DeviceCmd::Capture {
+                purpose: FramePurpose::Survey { k: 2, .. },
+                camera: 3,
+                ..
+            })
+        )),
+        "capture with camera 3 asked: {cmds:?}"
+    );
 }
 
 #[test]

@@ -84,6 +84,7 @@ impl App {
                     .push(Level::Info, format!("image {} accepted", self.work.k));
                 self.work.k += 1;
                 self.work.phase = Phase::Setup;
+                self.follow_plan();
                 cmds
             }
             Action::Redo => {
@@ -220,6 +221,22 @@ impl App {
         Vec::new()
     }
 
+    /// Sets the camera and location of the image about to be captured to
+    /// the ones the session has on record for it (the survey's plan, or the
+    /// image being redone), as the checklist shows them; an image with no
+    /// record keeps the current ones.
+    fn follow_plan(&mut self) {
+        let k = self.work.k;
+        if let Some(i) = self
+            .session
+            .as_ref()
+            .and_then(|s| s.images.iter().find(|i| i.k == k))
+        {
+            self.work.camera = i.camera.max(1);
+            self.work.location = i.location.max(1);
+        }
+    }
+
     pub(super) fn session_opened(&mut self, v: SessionView) -> Vec<Cmd> {
         self.log.push(
             Level::Info,
@@ -278,6 +295,7 @@ impl App {
         }
         self.work.k = k;
         self.work.phase = Phase::Setup;
+        self.follow_plan();
         self.log.push(
             Level::Info,
             format!("image {k} will be captured again: Enter starts"),
