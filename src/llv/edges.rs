@@ -289,8 +289,9 @@ const WORD: usize = 64;
 
 /// The peak test (§2.3) on the 64 pixels of one word: bit `i` is set where
 /// `|mid[i]|` is above `|lo[i]|`, at least `|hi[i]|` and above `t1` (see
-/// [`first_pass_floor`]); NaN compares false. Four lanes at a time, and the compare's sign bits go straight into the
-/// word (`movmskps` on x86-64): no flag bytes to pack afterwards.
+/// [`first_pass_floor`]); NaN compares false. Four lanes at a time, and
+/// the compare's sign bits go straight into the word (`movmskps` on
+/// x86-64): no flag bytes to pack afterwards.
 #[inline(always)]
 fn candidate_word(lo: &[f32; WORD], mid: &[f32; WORD], hi: &[f32; WORD], t1: f32x4) -> u64 {
     let quad = |s: &[f32; WORD], i: usize| f32x4::from([s[i], s[i + 1], s[i + 2], s[i + 3]]);
@@ -347,15 +348,25 @@ fn block(s: &[f32], at: usize) -> &[f32; WORD] {
     s[at..at + WORD].try_into().expect("a whole word")
 }
 
+/// The positions of the set bits of one word, lowest first.
+#[inline(always)]
+fn set_bits(mut bits: u64) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (bits != 0).then(|| {
+            let b = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            b
+        })
+    })
+}
+
 /// Calls `f(i)` for every set bit `i` of `words` (bit `i % 64` of word
 /// `i / 64`), in order.
 #[inline(always)]
 fn for_each_bit(words: &[u64], mut f: impl FnMut(usize)) {
     for (k, &w) in words.iter().enumerate() {
-        let mut bits = w;
-        while bits != 0 {
-            f(k * WORD + bits.trailing_zeros() as usize);
-            bits &= bits - 1;
+        for b in set_bits(w) {
+            f(k * WORD + b);
         }
     }
 }
@@ -365,12 +376,9 @@ fn for_each_bit(words: &[u64], mut f: impl FnMut(usize)) {
 #[inline(always)]
 fn retain_bits(words: &mut [u64], mut keep: impl FnMut(usize) -> bool) {
     for (k, w) in words.iter_mut().enumerate() {
-        let mut bits = *w;
         let mut kept = 0u64;
-        while bits != 0 {
-            let b = bits.trailing_zeros();
-            kept |= u64::from(keep(k * WORD + b as usize)) << b;
-            bits &= bits - 1;
+        for b in set_bits(*w) {
+            kept |= u64::from(keep(k * WORD + b)) << b;
         }
         *w = kept;
     }
