@@ -249,17 +249,17 @@ impl App {
             ),
             None => (v.images.iter().map(|i| i.k).max().unwrap_or(0) + 1, false),
         };
-        let img = v.images.iter().find(|i| i.k == k);
         self.work = Work {
             k,
-            camera: img.map_or(self.work.camera.max(1), |i| i.camera.max(1)),
-            location: img.map_or(self.work.location.max(1), |i| i.location.max(1)),
+            camera: self.work.camera.max(1),
+            location: self.work.location.max(1),
             phase: Phase::Setup,
         };
         if resume {
             self.log.push(Level::Info, format!("resuming at image {k}"));
         }
         self.session = Some(v);
+        self.follow_plan();
         self.current = None;
         if resume {
             vec![Cmd::Store(StoreCmd::Load(k))]
