@@ -37,9 +37,10 @@
 //!
 //! Speed: most edge points are noise (the adaptive threshold keeps at
 //! least `M` a scan line), so the cost is in rejecting starts cheaply.
-//! Input already in the scan frame's lexical order (EdgeH; EdgeV once
-//! the edges come column by column) is filed in one pass, other input by
-//! a counting sort. Each point's rounded `u` is kept, and a `Grid` of
+//! Input already in the scan frame's lexical order (EdgeH, row by row) is
+//! filed in one pass, other input (EdgeV, which the edge stage emits row
+//! by row, and files in any order) by a counting sort; emitting EdgeV
+//! column by column instead cost the edge stage more than it saved here. Each point's rounded `u` is kept, and a `Grid` of
 //! bitmaps (every point; the unused ones by polarity; side by side per
 //! word) answers "is there an unused point near here?" and the template
 //! scores with a few word operations; points are found from a column by
@@ -280,9 +281,9 @@ struct Grid {
     /// start's polarity, so only those can continue it). Side by side,
     /// so that filing a point or reading a window checks one index.
     cells: Vec<[u64; 3]>,
-    /// Per word of the occupied bitmap that has a bit set: the index of its first
-    /// point, so a column's point is found without a search (other words:
-    /// anything).
+    /// Per word of the occupied bitmap that has a bit set: the index of its
+    /// first point, so a column's point is found without a search (other
+    /// words: anything).
     first: Vec<u32>,
     /// The columns a track searches for its next point, `±(⌊sw⌋ + 2)`
     /// around the one nearest the prediction, as [`Grid::around`] bits:
