@@ -5,7 +5,7 @@
 
 use divan::{Bencher, black_box};
 use vss::llv::connect::{ConnectScratch, connect_into};
-use vss::llv::edges::{PeakScratch, Response, ResponseScratch, peaks_into, response_into};
+use vss::llv::edges::{PeakScratch, Response, ResponseScratch, exact_response_into, peaks_into};
 use vss::llv::lens::{CameraModel, LensMap, correct_into};
 use vss::llv::lines::{LineScratch, extract_into};
 use vss::llv::pipeline::{Input, StageOutputs, Workspace};
@@ -66,8 +66,8 @@ fn edges_both_directions(b: Bencher, n: usize) {
     let mut ps = PeakScratch::default();
     b.bench_local(|| {
         let img = black_box(&img);
-        response_into(img, ScanDir::Horizontal, 4, &mut rh, &mut counts).expect("size");
-        response_into(img, ScanDir::Vertical, 4, &mut rv, &mut counts).expect("size");
+        exact_response_into(img, ScanDir::Horizontal, 4, &mut rh, &mut counts).expect("size");
+        exact_response_into(img, ScanDir::Vertical, 4, &mut rv, &mut counts).expect("size");
         peaks_into(&rh, &p.edges, &mut eh, &mut ps);
         peaks_into(&rv, &p.edges, &mut ev, &mut ps);
     });

@@ -12,7 +12,7 @@
 //! (edges, lines, CONNECT; no lens), `edges` (response and peaks, both
 //! directions), `response`, `peaks`, `lines`.
 
-use vss::llv::edges::{PeakScratch, Response, ResponseScratch, peaks_into, response_into};
+use vss::llv::edges::{PeakScratch, Response, ResponseScratch, exact_response_into, peaks_into};
 use vss::llv::lines::{LineScratch, extract_into};
 use vss::llv::pipeline::{Input, Workspace};
 use vss::llv::{EdgePoints, Params, ScanDir};
@@ -22,11 +22,23 @@ mod llv_scene;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let (Some(stage), Some(Ok(n))) = (args.get(1), args.get(2).map(|s| s.parse::<usize>())) else {
-        eprintln!("usage: llv_count pipeline|edges|response|peaks|lines N");
+    let (Some(stage), Some(n)) = (args.get(1), args.get(2)) else {
+        eprintln!("usage: llv_count pipeline|edges|response|peaks|lines N | scene FILE.pgm");
         std::process::exit(2);
     };
     let img = llv_scene::scene(512, 512, 2.0, 42);
+    if stage == "scene" {
+        // Writes the bench scene as a binary PGM to `N` (a path here).
+        let (w, h) = img.size();
+        let mut f = format!("P5\n{w} {h}\n255\n").into_bytes();
+        f.extend_from_slice(img.data());
+        std::fs::write(n, f).expect("write the scene");
+        return;
+    }
+    let Ok(n) = n.parse::<usize>() else {
+        eprintln!("N must be a whole number, not {n:?}");
+        std::process::exit(2);
+    };
     let p = Params::default();
     let a = p.edges.half_width as usize;
     let mut ws = Workspace::new();
@@ -39,8 +51,8 @@ fn main() {
     let mut ls = LineScratch::default();
     let (mut lh, mut lv) = (Vec::new(), Vec::new());
     let mut response = |rh: &mut Response, rv: &mut Response| {
-        response_into(&img, ScanDir::Horizontal, a, rh, &mut rs).expect("size");
-        response_into(&img, ScanDir::Vertical, a, rv, &mut rs).expect("size");
+        exact_response_into(&img, ScanDir::Horizontal, a, rh, &mut rs).expect("size");
+        exact_response_into(&img, ScanDir::Vertical, a, rv, &mut rs).expect("size");
     };
     if stage == "peaks" {
         response(&mut rh, &mut rv);

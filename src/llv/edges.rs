@@ -7,31 +7,28 @@
 //! lanes, `edges/row.rs`) and the response is rounded once, when it is scaled by
 //! `1/A³`.
 //!
-//! Speed: the peak finder makes two passes instead of listing every
-//! candidate (about one pixel in thirteen on a noisy image): the first
-//! tests four pixels at a time and puts the compare's sign bits straight
-//! into one bit mask per 64 pixels (through `wide`, `movmskps` on x86-64),
-//! then histograms the candidates' sizes per region; the second keeps the
-//! candidates at or above the region's limit, one bit at a time without a
-//! branch on the answer, and emits the kept ones. The region's limit is
-//! found walking up from size 2, where it usually is, not down from the
-//! largest peak. Mispredicted branches, not arithmetic, bounded the older
-//! code. The straightforward former implementation is kept in
-//! `edges/reference.rs` (tests only); the tests compare both bit for bit.
+//! Exact form: a single image's response with `A ≤ 5` keeps those sums
+//! (`i16`, with their magnitudes) instead of `f32` values; the peak finder
+//! (`edges/peaks.rs`, which also says how it is fast) then tests sixteen
+//! pixels at a time instead of four and converts only its candidates, with
+//! the same points bit for bit. The several-lightings response is not such
+//! a sum and stays `f32`.
 //!
-//! Layout: a [`Response`] is always stored in image order, `data[y·w + x]`,
+//! Layout: a [`Response`] is always stored in image order, `[y·w + x]`,
 //! for both scan directions. The vertical convolution and the vertical peak
 //! test then run over whole rows (contiguous, vectorisable) instead of
 //! striding down columns, so no transposed copy is needed.
 
 use super::image::GreyImage;
 use super::params::EdgeParams;
-use super::{EdgePoint, EdgePoints, LlvError, ScanDir};
-use wide::{CmpGe, CmpGt, f32x4};
+use super::{EdgePoints, LlvError, ScanDir};
 
+mod peaks;
 #[cfg(test)]
 mod reference;
 pub(crate) mod row;
+
+pub use peaks::{PeakScratch, peaks, peaks_into};
 
 /// The largest bin of the peak-size histogram (responses are below 255).
 const BINS: usize = 256;
@@ -63,13 +60,35 @@ fn integer_kernel(a: usize) -> Vec<i32> {
 /// A signed edge response along one scan direction, in grey levels, stored
 /// in image order (`data[y * width + x]`). NaN marks "no response": within
 /// `A` pixels of the border along the scan or of an invalid pixel.
+///
+/// A response of one image with `A ≤ 5` ([`exact_response_into`], what the
+/// pipeline uses) is held as the kernel's exact integer sums instead, and
+/// `data` is then empty: read values with [`Response::get`] or
+/// [`Response::value`], which give the same `f32` either way. (Two
+/// responses of equal values in different forms compare unequal.)
 #[derive(Clone, Debug, PartialEq)]
 pub struct Response {
     pub width: usize,
     pub height: usize,
     pub dir: ScanDir,
     pub data: Vec<f32>,
+    exact: Exact,
 }
+
+/// The exact form of a [`Response`]: per pixel the kernel's sum `S`
+/// (`E = S · scale`, `scale = 1/A³`) and its magnitude `|S|`, or
+/// [`NONE`] there for "no response". In use when `scale > 0`.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Exact {
+    scale: f32,
+    sums: Vec<i16>,
+    keys: Vec<i16>,
+}
+
+/// The magnitude that marks "no response" in [`Exact::keys`]: above every
+/// sum's (at most 30 600), so that as a neighbour it stops a peak, and
+/// never a candidate itself (the peak test excludes it).
+const NONE: i16 = i16::MAX;
 
 impl Default for Response {
     /// An empty horizontal response (a buffer to fill with [`response_into`]).
@@ -79,6 +98,7 @@ impl Default for Response {
             height: 0,
             dir: ScanDir::Horizontal,
             data: Vec::new(),
+            exact: Exact::default(),
         }
     }
 }
@@ -91,9 +111,56 @@ impl Response {
         self.width = w;
         self.height = h;
         self.dir = dir;
+        self.exact.scale = 0.0;
         if self.data.len() != w * h {
             self.data.clear();
             self.data.resize(w * h, f32::NAN);
+        }
+    }
+
+    /// [`Response::reshape`] for the exact form with half-width `a`; the
+    /// `f32` values are emptied (their buffer is kept for reuse).
+    fn reshape_exact(&mut self, w: usize, h: usize, dir: ScanDir, a: usize) {
+        self.width = w;
+        self.height = h;
+        self.dir = dir;
+        self.data.clear();
+        let e = &mut self.exact;
+        e.scale = row::scale(a);
+        if e.sums.len() != w * h {
+            e.sums.clear();
+            e.sums.resize(w * h, 0);
+            e.keys.clear();
+            e.keys.resize(w * h, NONE);
+        }
+    }
+
+    /// Whether the response is held as exact sums (`data` is then empty).
+    pub fn is_exact(&self) -> bool {
+        self.exact.scale > 0.0
+    }
+
+    /// Whether the response has a value (or "none") for every pixel of a
+    /// `w × h` image.
+    pub fn covers(&self, w: usize, h: usize) -> bool {
+        let n = if self.is_exact() {
+            self.exact.keys.len()
+        } else {
+            self.data.len()
+        };
+        (self.width, self.height) == (w, h) && n == w * h
+    }
+
+    /// The value at index `i = y · width + x`, NaN for "no response" (and
+    /// outside the image).
+    pub fn value(&self, i: usize) -> f32 {
+        if self.is_exact() {
+            match self.exact.keys.get(i) {
+                Some(&k) if k != NONE => f32::from(self.exact.sums[i]) * self.exact.scale,
+                _ => f32::NAN,
+            }
+        } else {
+            self.data.get(i).copied().unwrap_or(f32::NAN)
         }
     }
 
@@ -102,10 +169,7 @@ impl Response {
         if x >= self.width || y >= self.height {
             return None;
         }
-        self.data
-            .get(y * self.width + x)
-            .copied()
-            .filter(|v| !v.is_nan())
+        Some(self.value(y * self.width + x)).filter(|v| !v.is_nan())
     }
 }
 
@@ -185,19 +249,91 @@ pub fn response_into(
         }
     }
     if let Some(mask) = img.valid_mask() {
-        mask_invalid(mask, w, h, dir, a, &mut out.data, &mut scratch.counts);
+        mask_invalid(
+            mask,
+            w,
+            h,
+            dir,
+            a,
+            &mut out.data,
+            f32::NAN,
+            &mut scratch.counts,
+        );
     }
     Ok(())
 }
 
-/// Sets NaN wherever the kernel window touches an invalid pixel.
-fn mask_invalid(
+/// [`response_into`] in the exact form (see [`Response`]) for `a ≤ 5`,
+/// where the kernel's sums fit `i16`; the `f32` form for `a` = 6, 7. The
+/// peaks found in either form are the same, bit for bit: the peak finder
+/// compares magnitudes `|S|` (ordered as `|E|`) and converts to `f32`,
+/// exactly as [`response_into`] does, only at candidates.
+pub fn exact_response_into(
+    img: &GreyImage,
+    dir: ScanDir,
+    a: usize,
+    out: &mut Response,
+    scratch: &mut ResponseScratch,
+) -> Result<(), LlvError> {
+    if a > 5 {
+        return response_into(img, dir, a, out, scratch);
+    }
+    check_half_width(a)?;
+    img.check_stage_size()?;
+    let (w, h) = img.size();
+    let px = img.data();
+    if px.len() != w * h {
+        return Err(LlvError::BufferSize {
+            width: w,
+            height: h,
+            expected: w * h,
+            actual: px.len(),
+        });
+    }
+    out.reshape_exact(w, h, dir, a);
+    let Exact { sums, keys, .. } = &mut out.exact;
+    let rows = sums.chunks_exact_mut(w).zip(keys.chunks_exact_mut(w));
+    match dir {
+        ScanDir::Horizontal => {
+            for ((srow, krow), row) in rows.zip(px.chunks_exact(w)) {
+                let taps = row::Taps::horizontal(row, a);
+                if !(w > 2 * a
+                    && row::lee_row_exact(&taps, a, &mut srow[a..w - a], &mut krow[a..w - a]))
+                {
+                    krow.fill(NONE);
+                    continue;
+                }
+                krow[..a].fill(NONE);
+                krow[w - a..].fill(NONE);
+            }
+        }
+        ScanDir::Vertical => {
+            for (y, (srow, krow)) in rows.enumerate() {
+                if !(y >= a
+                    && y + a < h
+                    && row::lee_row_exact(&row::Taps::vertical(px, w, y, a), a, srow, krow))
+                {
+                    krow.fill(NONE);
+                }
+            }
+        }
+    }
+    if let Some(mask) = img.valid_mask() {
+        mask_invalid(mask, w, h, dir, a, keys, NONE, &mut scratch.counts);
+    }
+    Ok(())
+}
+
+/// Sets `none` wherever the kernel window touches an invalid pixel.
+#[allow(clippy::too_many_arguments)]
+fn mask_invalid<T: Copy>(
     mask: &[bool],
     w: usize,
     h: usize,
     dir: ScanDir,
     a: usize,
-    data: &mut [f32],
+    data: &mut [T],
+    none: T,
     counts: &mut Vec<u32>,
 ) {
     match dir {
@@ -216,7 +352,7 @@ fn mask_invalid(
                     let lo = x.saturating_sub(a);
                     let hi = (x + a + 1).min(w);
                     if counts[hi] != counts[lo] {
-                        *d = f32::NAN;
+                        *d = none;
                     }
                 }
             }
@@ -249,360 +385,10 @@ fn mask_invalid(
                     add(counts, y - a - 1, false);
                 }
                 for (d, &c) in data[y * w..(y + 1) * w].iter_mut().zip(counts.iter()) {
-                    *d = if c != 0 { f32::NAN } else { *d };
+                    *d = if c != 0 { none } else { *d };
                 }
             }
         }
-    }
-}
-
-/// Reusable buffers of the peak finder.
-///
-/// `hist` holds one 256-bin histogram of peak sizes per region of the
-/// vertical scan (one per row region of the horizontal scan is enough); it
-/// is all zeros between calls: each use clears the bins it filled.
-#[derive(Clone, Debug, Default)]
-pub struct PeakScratch {
-    hist: Vec<u32>,
-    /// Candidate bits (then kept bits) of the rows of one region
-    /// (horizontal scan) or of the whole response (vertical scan), 64
-    /// pixels per word, see [`candidates`].
-    bits_h: Vec<u64>,
-    bits_v: Vec<u64>,
-    /// Vertical scan: per column, the lower limit on `|E|` of a kept peak
-    /// and the column's histogram offset.
-    lim: Vec<f32>,
-    offset: Vec<u32>,
-}
-
-/// The first pass's test folds "above the floor `T`" and "size ≥ 2"
-/// (smaller sizes never count for the threshold, see [`limit`]) into one
-/// comparison `|E| > t1`: `t1 = T` if `T ≥ 2`, else the largest `f32`
-/// below 2 (so `|E| > t1 ⇔ |E| ≥ 2`). `T` is not NaN here.
-fn first_pass_floor(t: f32) -> f32 {
-    let below_two = f32::from_bits(2f32.to_bits() - 1);
-    if t >= 2.0 { t } else { below_two }
-}
-
-/// Pixels per candidate word.
-const WORD: usize = 64;
-
-/// The peak test (§2.3) on the 64 pixels of one word: bit `i` is set where
-/// `|mid[i]|` is above `|lo[i]|`, at least `|hi[i]|` and above `t1` (see
-/// [`first_pass_floor`]); NaN compares false. Four lanes at a time, and
-/// the compare's sign bits go straight into the word (`movmskps` on
-/// x86-64): no flag bytes to pack afterwards.
-#[inline(always)]
-fn candidate_word(lo: &[f32; WORD], mid: &[f32; WORD], hi: &[f32; WORD], t1: f32x4) -> u64 {
-    let quad = |s: &[f32; WORD], i: usize| f32x4::from([s[i], s[i + 1], s[i + 2], s[i + 3]]);
-    let test = |i: usize| {
-        let e0 = quad(mid, i).abs();
-        let c = e0.cmp_gt(quad(lo, i).abs()) & e0.cmp_ge(quad(hi, i).abs()) & e0.cmp_gt(t1);
-        c.move_mask() as u32 & 0xF
-    };
-    // Eight pixels a step: half the loop's overhead, constant shifts
-    // (sixteen a step measured no better).
-    let mut bits = 0u64;
-    for i in (0..WORD).step_by(8) {
-        bits |= u64::from(test(i) | test(i + 4) << 4) << i;
-    }
-    bits
-}
-
-/// [`candidate_word`] over a whole scan line of `n = mid.len()` pixels
-/// (`lo`, `hi` as long): bit `i % 64` of `words[i / 64]` for pixel `i`,
-/// `n.div_ceil(64)` words. A last partial word is computed on the 64 pixels
-/// that end the line and shifted into place; a line shorter than a word
-/// goes through a copy padded with NaN.
-#[inline(always)]
-fn candidates(lo: &[f32], mid: &[f32], hi: &[f32], t1: f32, words: &mut [u64]) {
-    let n = mid.len().min(lo.len()).min(hi.len());
-    let t1 = f32x4::splat(t1);
-    if n < WORD {
-        let mut pad = [[f32::NAN; WORD]; 3];
-        for (p, s) in pad.iter_mut().zip([lo, mid, hi]) {
-            p[..n].copy_from_slice(&s[..n]);
-        }
-        if let Some(w) = words.first_mut() {
-            *w = candidate_word(&pad[0], &pad[1], &pad[2], t1);
-        }
-        return;
-    }
-    let full = n / WORD;
-    for (k, w) in words.iter_mut().enumerate().take(full) {
-        let at = k * WORD;
-        *w = candidate_word(block(lo, at), block(mid, at), block(hi, at), t1);
-    }
-    if n % WORD != 0 {
-        let at = n - WORD;
-        let bits = candidate_word(block(lo, at), block(mid, at), block(hi, at), t1);
-        if let Some(w) = words.get_mut(full) {
-            *w = bits >> (full * WORD - at);
-        }
-    }
-}
-
-/// The `WORD` values of `s` from `at` (the caller checked the length).
-#[inline(always)]
-fn block(s: &[f32], at: usize) -> &[f32; WORD] {
-    s[at..at + WORD].try_into().expect("a whole word")
-}
-
-/// The positions of the set bits of one word, lowest first.
-#[inline(always)]
-fn set_bits(mut bits: u64) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (bits != 0).then(|| {
-            let b = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            b
-        })
-    })
-}
-
-/// Calls `f(i)` for every set bit `i` of `words` (bit `i % 64` of word
-/// `i / 64`), in order.
-#[inline(always)]
-fn for_each_bit(words: &[u64], mut f: impl FnMut(usize)) {
-    for (k, &w) in words.iter().enumerate() {
-        for b in set_bits(w) {
-            f(k * WORD + b);
-        }
-    }
-}
-
-/// The second pass: keeps the candidate bits `i` with `keep(i)`, without a
-/// branch on the answer (about half the candidates are kept, at random).
-#[inline(always)]
-fn retain_bits(words: &mut [u64], mut keep: impl FnMut(usize) -> bool) {
-    for (k, w) in words.iter_mut().enumerate() {
-        let mut kept = 0u64;
-        for b in set_bits(*w) {
-            kept |= u64::from(keep(k * WORD + b)) << b;
-        }
-        *w = kept;
-    }
-}
-
-/// The histogram bin of a peak: its size, `|E|` rounded down, at most 255.
-#[inline]
-fn bin(e0: f32) -> usize {
-    // (A conversion to `u8` saturates itself, more cheaply than one to a
-    // wider type; `min` also takes NaN to 255.)
-    e0.min((BINS - 1) as f32) as u8 as usize
-}
-
-/// The bin of a region's histogram that counts its candidates: sizes 0
-/// and 1 are never candidates (the first pass's test excludes them), so
-/// bin 0 is free.
-const TOTAL: usize = 0;
-
-/// Counts a candidate of size `bin` in a region's histogram.
-#[inline(always)]
-fn count(hist: &mut [u32], bin: usize) {
-    hist[TOTAL] += 1;
-    hist[bin] += 1;
-}
-
-/// A region's lower limit on `|E|` for a kept peak, from the histogram of
-/// its candidate sizes (≥ 2, with their number in bin [`TOTAL`]), per
-/// llv.md §2.5; clears the histogram.
-///
-/// The rule walks a threshold `th` down from the largest size `tmax`,
-/// adding each bin's count, until `M` candidates are above it or it reaches
-/// 1; a peak is kept when its size `⌊|E|⌋ > th`, i.e. `|E| ≥ th + 1` (`th`
-/// is a whole number), which is what the second pass compares, without
-/// rounding. So the limit is the largest size `v` (2 to `tmax`) with at
-/// least `M` candidates of size `≥ v`, or 2 if there is none. That is
-/// found here walking up from 2, subtracting the bins below `v` from the
-/// total: the limit is near the noise level, far below `tmax`, so this is
-/// the short way. With `M = 0` the rule keeps nothing below `tmax + 1`
-/// (sizes are clamped at 255, so a huge `|E|` may still pass); with no
-/// candidate the limit is +∞.
-fn limit(hist: &mut [u32], m: u32) -> f32 {
-    let Some(hist) = hist.first_chunk_mut::<BINS>() else {
-        return f32::INFINITY;
-    };
-    let n = hist[TOTAL];
-    if n == 0 {
-        return f32::INFINITY;
-    }
-    hist[TOTAL] = 0;
-    let lim = if m == 0 {
-        hist.iter()
-            .rposition(|&c| c != 0)
-            .map_or(2, |tmax| tmax + 1)
-    } else if n < m {
-        2
-    } else {
-        let mut v = 2;
-        let mut below = 0;
-        while v < BINS - 1 && n - (below + hist[v]) >= m {
-            below += hist[v];
-            v += 1;
-        }
-        v
-    };
-    *hist = [0; BINS];
-    lim as f32
-}
-
-/// Parabolic subpixel offset through `|E|` at a peak and its two neighbours,
-/// clamped to ±0.5 (llv.md §2.4).
-#[inline]
-fn subpixel(em: f32, e0: f32, ep: f32) -> f32 {
-    let den = 2.0 * (em - 2.0 * e0 + ep);
-    if den < 0.0 {
-        ((em - ep) / den).clamp(-0.5, 0.5)
-    } else {
-        0.0
-    }
-}
-
-/// Peaks of a response with subpixel positions and the per-region adaptive
-/// threshold (llv.md §2.3–2.5), in lexical order.
-///
-/// Settled details:
-/// - a peak needs both neighbours along the scan to have a response, so no
-///   edge is reported at the border of the valid area;
-/// - a region is `region_lines` consecutive scan lines (rows for
-///   `Horizontal`, columns for `Vertical`);
-/// - "size" is `|E|` rounded down to whole grey levels; a candidate is kept
-///   when its size is above the region's threshold and `|E| > T`.
-pub fn peaks(resp: &Response, p: &EdgeParams) -> EdgePoints {
-    let mut out = EdgePoints::default();
-    peaks_into(resp, p, &mut out, &mut PeakScratch::default());
-    out
-}
-
-/// [`peaks`] into reusable buffers.
-///
-/// Two passes instead of a list of every candidate: the first marks the
-/// candidates in bit masks and histograms their sizes per region (for a
-/// horizontal scan, region by region while its rows are in the first-level
-/// cache), the second keeps the marked candidates at or above the region's
-/// limit and emits them, in lexical order.
-pub fn peaks_into(resp: &Response, p: &EdgeParams, out: &mut EdgePoints, s: &mut PeakScratch) {
-    let (w, h) = (resp.width, resp.height);
-    out.dir = Some(resp.dir);
-    out.width = w;
-    out.height = h;
-    out.points.clear();
-    if w < 3 || h < 3 || resp.data.len() != w.saturating_mul(h) {
-        return;
-    }
-    let t = p.floor as f32;
-    if t.is_nan() {
-        // No `|E| > T` holds: no peak at all.
-        return;
-    }
-    let t1 = first_pass_floor(t);
-    let r = p.region_lines.max(1) as usize;
-    let m = p.per_region;
-    match resp.dir {
-        ScanDir::Horizontal => peaks_h(resp, t1, r, m, out, s),
-        ScanDir::Vertical => peaks_v(resp, t1, r, m, out, s),
-    }
-}
-
-fn peaks_h(resp: &Response, t1: f32, r: usize, m: u32, out: &mut EdgePoints, s: &mut PeakScratch) {
-    let w = resp.width;
-    if s.hist.len() < BINS {
-        s.hist.clear();
-        s.hist.resize(BINS, 0);
-    }
-    let hist = &mut s.hist[..BINS];
-    // Bit i of a row's words is the pixel x = i + 1 (the test needs both
-    // neighbours).
-    let nw = (w - 2).div_ceil(WORD);
-    let rows = r.min(resp.height);
-    if s.bits_h.len() != rows * nw {
-        s.bits_h.clear();
-        s.bits_h.resize(rows * nw, 0);
-    }
-    for (g, region) in resp.data.chunks(w * r).enumerate() {
-        for (row, words) in region.chunks_exact(w).zip(s.bits_h.chunks_exact_mut(nw)) {
-            let mid = &row[1..w - 1];
-            candidates(&row[..w - 2], mid, &row[2..], t1, words);
-            for_each_bit(words, |i| count(hist, bin(mid[i].abs())));
-        }
-        let lim = limit(hist, m);
-        if lim == f32::INFINITY {
-            continue;
-        }
-        for (k, (row, words)) in region
-            .chunks_exact(w)
-            .zip(s.bits_h.chunks_exact_mut(nw))
-            .enumerate()
-        {
-            let y = (g * r + k) as f32;
-            retain_bits(words, |i| row[i + 1].abs() >= lim);
-            for_each_bit(words, |i| {
-                let x = i + 1;
-                let (em, e0, ep) = (row[x - 1].abs(), row[x].abs(), row[x + 1].abs());
-                out.points.push(EdgePoint {
-                    x: x as f32 + subpixel(em, e0, ep),
-                    y,
-                    response: row[x],
-                });
-            });
-        }
-    }
-}
-
-fn peaks_v(resp: &Response, t1: f32, r: usize, m: u32, out: &mut EdgePoints, s: &mut PeakScratch) {
-    let (w, h) = (resp.width, resp.height);
-    let nreg = w.div_ceil(r);
-    if s.hist.len() != nreg * BINS {
-        s.hist.clear();
-        s.hist.resize(nreg * BINS, 0);
-    }
-    debug_assert!(s.hist.iter().all(|&n| n == 0), "histograms left dirty");
-    let nw = w.div_ceil(WORD);
-    s.offset.clear();
-    s.offset.extend((0..w).map(|x| ((x / r) * BINS) as u32));
-    // One row of words per response row (the first and last are unused);
-    // the first pass writes every word it reads later.
-    if s.bits_v.len() != nw * h {
-        s.bits_v.clear();
-        s.bits_v.resize(nw * h, 0);
-    }
-    let (hist, offset) = (&mut s.hist, &s.offset);
-    let data = &resp.data;
-    let mut word_rows = s.bits_v.chunks_exact_mut(nw);
-    word_rows.next();
-    for (y, words) in (1..h - 1).zip(&mut word_rows) {
-        let up = &data[(y - 1) * w..y * w];
-        let row = &data[y * w..(y + 1) * w];
-        let dn = &data[(y + 1) * w..(y + 2) * w];
-        candidates(up, row, dn, t1, words);
-        for_each_bit(words, |x| {
-            let o = offset[x] as usize;
-            count(&mut hist[o..o + BINS], bin(row[x].abs()));
-        });
-    }
-    s.lim.clear();
-    for (g, hist) in hist.chunks_exact_mut(BINS).enumerate() {
-        let l = limit(hist, m);
-        s.lim.extend(std::iter::repeat_n(l, r.min(w - g * r)));
-    }
-    let lim = &s.lim;
-    let mut word_rows = s.bits_v.chunks_exact_mut(nw);
-    word_rows.next();
-    for (y, words) in (1..h - 1).zip(&mut word_rows) {
-        let up = &data[(y - 1) * w..y * w];
-        let row = &data[y * w..(y + 1) * w];
-        let dn = &data[(y + 1) * w..(y + 2) * w];
-        retain_bits(words, |x| row[x].abs() >= lim[x]);
-        let yf = y as f32;
-        for_each_bit(words, |x| {
-            let (em, e0, ep) = (up[x].abs(), row[x].abs(), dn[x].abs());
-            out.points.push(EdgePoint {
-                x: x as f32,
-                y: yf + subpixel(em, e0, ep),
-                response: row[x],
-            });
-        });
     }
 }
 
@@ -616,6 +402,7 @@ pub fn detect(img: &GreyImage, dir: ScanDir, p: &EdgeParams) -> Result<EdgePoint
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::llv::EdgePoint;
     use crate::llv::synth::rng::SplitMix64;
 
     fn img_from(w: usize, h: usize, f: impl Fn(usize, usize) -> u8) -> GreyImage {
@@ -716,6 +503,16 @@ mod tests {
                             same_bits(&fast.data, &slow.data),
                             "{w}x{h} masked={masked} a={a} {dir:?}"
                         );
+                        // The exact form (reusing the same buffer, as the
+                        // pipeline does) reads the same values.
+                        exact_response_into(&img, dir, a, &mut fast, &mut fs).unwrap();
+                        assert_eq!(fast.is_exact(), a <= 5);
+                        assert!(fast.covers(w, h));
+                        let values: Vec<f32> = (0..w * h).map(|i| fast.value(i)).collect();
+                        assert!(
+                            same_bits(&values, &slow.data),
+                            "exact: {w}x{h} masked={masked} a={a} {dir:?}"
+                        );
                     }
                 }
             }
@@ -725,7 +522,7 @@ mod tests {
     #[test]
     fn fast_peaks_equal_the_reference_point_for_point() {
         let mut rng = SplitMix64::new(0xDEAD_BEEF_0BAD_F00D);
-        let mut resp = Response::default();
+        let (mut resp, mut exact) = (Response::default(), Response::default());
         let mut rs = ResponseScratch::default();
         let (mut fast, mut slow) = (EdgePoints::default(), EdgePoints::default());
         let (mut fs, mut ss) = (PeakScratch::default(), reference::PeakScratch::default());
@@ -746,6 +543,7 @@ mod tests {
                 for a in 3..=7 {
                     for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
                         response_into(&img, dir, a, &mut resp, &mut rs).unwrap();
+                        exact_response_into(&img, dir, a, &mut exact, &mut rs).unwrap();
                         for (floor, m, r) in [
                             (2.0, 8, 1),
                             (0.0, 1, 1),
@@ -755,6 +553,11 @@ mod tests {
                             (2.0, 4096, 1),
                             (0.5, 2, 4096),
                             (2.0, 0, 1),
+                            // Floors between two sums' values, on one, and
+                            // above every response.
+                            (3.3, 8, 1),
+                            (4.0, 5, 1),
+                            (1e9, 8, 1),
                         ] {
                             let p = EdgeParams {
                                 half_width: a as u32,
@@ -770,6 +573,11 @@ mod tests {
                             assert!(
                                 same_points(&fast, &slow),
                                 "{w}x{h} masked={masked} a={a} {dir:?} T={floor} M={m} r={r}"
+                            );
+                            peaks_into(&exact, &p, &mut fast, &mut fs);
+                            assert!(
+                                same_points(&fast, &slow),
+                                "exact: {w}x{h} masked={masked} a={a} {dir:?} T={floor} M={m} r={r}"
                             );
                             kept += fast.points.len();
                         }
@@ -813,6 +621,7 @@ mod tests {
                     height: h,
                     dir,
                     data,
+                    ..Response::default()
                 };
                 for (floor, m, r) in [(0.0, 1, 1), (2.0, 3, 2), (0.0, 0, 1)] {
                     let p = EdgeParams {

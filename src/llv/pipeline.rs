@@ -14,7 +14,7 @@ use serde::Serialize;
 
 use super::connect::{ConnectScratch, connect_into};
 use super::corners::{CornerScratch, close_corners_with};
-use super::edges::{PeakScratch, Response, ResponseScratch, peaks_into, response_into};
+use super::edges::{PeakScratch, Response, ResponseScratch, exact_response_into, peaks_into};
 use super::image::GreyImage;
 use super::lens::{LensMap, correct_into};
 use super::lines::{LineScratch, extract_into};
@@ -147,7 +147,7 @@ impl Workspace {
         let prev_fits = self.valid
             && self.out.edges_h.width == size.0
             && self.out.edges_h.height == size.1
-            && self.out.response_h.data.len() == size.0 * size.1;
+            && self.out.response_h.covers(size.0, size.1);
         let from = if prev_fits { from } else { Stage::Lens };
         let prev_params = std::mem::replace(&mut self.out.params, p.clone());
         self.valid = false;
@@ -245,14 +245,14 @@ impl Workspace {
         };
         if images.len() == 1 && ambient.is_none() {
             let img = &images[0];
-            response_into(
+            exact_response_into(
                 img,
                 ScanDir::Horizontal,
                 a,
                 &mut self.out.response_h,
                 &mut self.response,
             )?;
-            response_into(
+            exact_response_into(
                 img,
                 ScanDir::Vertical,
                 a,

@@ -14,6 +14,10 @@
 //!
 //! `(sum as f32) · (1/A³)` is then one rounding, the same as the former
 //! `f32` accumulation of whole numbers followed by the same scaling.
+//!
+//! For `A ≤ 5` the single-image path keeps the sums themselves
+//! ([`lee_row_exact`]): the `i16` sum and its magnitude, without the
+//! conversion to `f32`, which the peak finder then does only at candidates.
 
 /// Outputs per block: eight SSE2 registers of `i16` accumulators; fewer
 /// outputs per block spend as much on slicing the taps as on arithmetic.
@@ -81,6 +85,23 @@ pub(crate) fn lee_row(taps: &Taps, a: usize, out: &mut [f32]) {
     }
 }
 
+/// Writes the exact Lee sums `S` (the response is `S · 1/A³`) of every
+/// output of `sums` and their magnitudes `|S|` into `keys` (as long), for a
+/// half-width `a` of 3–5, whose sums fit `i16`; false (nothing written) for
+/// any other, or if the taps are too short.
+pub(crate) fn lee_row_exact(taps: &Taps, a: usize, sums: &mut [i16], keys: &mut [i16]) -> bool {
+    if sums.len() != keys.len() || !taps.covers(a, sums.len()) {
+        return false;
+    }
+    match a {
+        3 => row_exact::<3>(taps, sums, keys),
+        4 => row_exact::<4>(taps, sums, keys),
+        5 => row_exact::<5>(taps, sums, keys),
+        _ => return false,
+    }
+    true
+}
+
 /// `c_s = 6 s (A − s)` for `s = 0..8` (only `1..A` is used).
 const fn coef(a: usize, s: usize) -> i32 {
     if s == 0 || s >= a {
@@ -90,7 +111,7 @@ const fn coef(a: usize, s: usize) -> i32 {
     }
 }
 
-fn scale(a: usize) -> f32 {
+pub(crate) fn scale(a: usize) -> f32 {
     1.0 / (a * a * a) as f32
 }
 
@@ -123,6 +144,45 @@ fn by_blocks(taps: &Taps, a: usize, out: &mut [f32], mut block: impl FnMut(usize
     }
     if i < n {
         block(n - BLK, out);
+    }
+}
+
+fn row_exact<const A: usize>(taps: &Taps, sums: &mut [i16], keys: &mut [i16]) {
+    let n = sums.len();
+    if n < BLK {
+        for (j, (s, k)) in sums.iter_mut().zip(keys.iter_mut()).enumerate() {
+            let mut acc = 0i32;
+            for t in 1..A {
+                acc += coef(A, t) * (i32::from(taps.hi[t][j]) - i32::from(taps.lo[t][j]));
+            }
+            // |acc| ≤ 30 600 for A ≤ 5.
+            *s = acc as i16;
+            *k = acc.unsigned_abs() as i16;
+        }
+        return;
+    }
+    let block = |i: usize, sums: &mut [i16], keys: &mut [i16]| {
+        let mut acc = [0i16; BLK];
+        for s in 1..A {
+            let c = coef(A, s) as i16;
+            let h = &taps.hi[s][i..i + BLK];
+            let l = &taps.lo[s][i..i + BLK];
+            for ((o, &h), &l) in acc.iter_mut().zip(h).zip(l) {
+                *o = o.wrapping_add(c.wrapping_mul(h as i16 - l as i16));
+            }
+        }
+        sums[i..i + BLK].copy_from_slice(&acc);
+        for (k, &v) in keys[i..i + BLK].iter_mut().zip(&acc) {
+            *k = v.wrapping_abs();
+        }
+    };
+    let mut i = 0;
+    while i + BLK <= n {
+        block(i, sums, keys);
+        i += BLK;
+    }
+    if i < n {
+        block(n - BLK, sums, keys);
     }
 }
 
@@ -165,6 +225,38 @@ fn row_i32<const A: usize>(taps: &Taps, out: &mut [f32]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn exact_rows_scale_to_the_float_rows_bit_for_bit() {
+        let mut rng = crate::llv::synth::rng::SplitMix64::new(11);
+        // Extremes too: 0/255 steps give the largest sums.
+        let src: Vec<u8> = (0..300)
+            .map(|i| match i % 50 {
+                0..10 => 0,
+                10..20 => 255,
+                _ => rng.next_u64() as u8,
+            })
+            .collect();
+        for a in 3..=7 {
+            for len in 2 * a + 1..=300 {
+                let row = &src[..len];
+                let n = len - 2 * a;
+                let mut want = vec![f32::NAN; n];
+                lee_row(&Taps::horizontal(row, a), a, &mut want);
+                let (mut sums, mut keys) = (vec![0i16; n], vec![0i16; n]);
+                let done = lee_row_exact(&Taps::horizontal(row, a), a, &mut sums, &mut keys);
+                assert_eq!(done, a <= 5, "a={a}");
+                if !done {
+                    continue;
+                }
+                for j in 0..n {
+                    let e = sums[j] as f32 * scale(a);
+                    assert_eq!(e.to_bits(), want[j].to_bits(), "a={a} len={len} j={j}");
+                    assert_eq!(i32::from(keys[j]), i32::from(sums[j]).abs());
+                }
+            }
+        }
+    }
 
     #[test]
     fn rows_equal_the_tap_by_tap_float_sum_for_every_length() {

@@ -244,7 +244,7 @@ fn cursor_line(app: &App, cur: &Loaded, area: Rect, buf: &mut Buffer) {
     let (x, y) = app.pipeline.nav.cursor_or_centre(grey.size());
     let g = grey.get(x, y).map_or("-".into(), |v| v.to_string());
     let resp = |r: Option<&crate::llv::edges::Response>| -> String {
-        r.and_then(|r| r.data.get(y * r.width + x).copied())
+        r.and_then(|r| r.get(x, y))
             .filter(|v| v.is_finite())
             .map_or("-".into(), |v| format!("{v:+.1}"))
     };
