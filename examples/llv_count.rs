@@ -10,7 +10,8 @@
 //! Instructions per run = (total at N = 15 − total at N = 5) / 10, which
 //! takes out the scene's rendering and the warm-up. Stages: `pipeline`
 //! (edges, lines, CONNECT; no lens), `edges` (response and peaks, both
-//! directions), `response`, `peaks`, `lines`.
+//! directions), `response`, `peaks` (`peaks_h`, `peaks_v`: one direction),
+//! `lines`; `scene FILE.pgm` writes the scene.
 
 use vss::llv::edges::{PeakScratch, Response, ResponseScratch, exact_response_into, peaks_into};
 use vss::llv::lines::{LineScratch, extract_into};
@@ -23,7 +24,9 @@ mod llv_scene;
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let (Some(stage), Some(n)) = (args.get(1), args.get(2)) else {
-        eprintln!("usage: llv_count pipeline|edges|response|peaks|lines N | scene FILE.pgm");
+        eprintln!(
+            "usage: llv_count pipeline|edges|response|peaks|peaks_h|peaks_v|lines N | scene FILE.pgm"
+        );
         std::process::exit(2);
     };
     let img = llv_scene::scene(512, 512, 2.0, 42);
@@ -54,7 +57,7 @@ fn main() {
         exact_response_into(&img, ScanDir::Horizontal, a, rh, &mut rs).expect("size");
         exact_response_into(&img, ScanDir::Vertical, a, rv, &mut rs).expect("size");
     };
-    if stage == "peaks" {
+    if stage.starts_with("peaks") {
         response(&mut rh, &mut rv);
     }
     let mut check = 0usize;
@@ -64,12 +67,14 @@ fn main() {
                 ws.run(&Input::single(&img), &p).expect("the scene runs");
                 check += ws.outputs().lines.len();
             }
-            "edges" | "response" | "peaks" => {
-                if stage != "peaks" {
+            "edges" | "response" | "peaks" | "peaks_h" | "peaks_v" => {
+                if !stage.starts_with("peaks") {
                     response(&mut rh, &mut rv);
                 }
-                if stage != "response" {
+                if stage != "response" && stage != "peaks_v" {
                     peaks_into(&rh, &p.edges, &mut eh, &mut ps);
+                }
+                if stage != "response" && stage != "peaks_h" {
                     peaks_into(&rv, &p.edges, &mut ev, &mut ps);
                 }
                 check += eh.points.len() + ev.points.len();

@@ -6,9 +6,11 @@
 //! Two passes instead of a list of every candidate (about one pixel in
 //! thirteen on a noisy image): the first tests a word of 64 pixels at a
 //! time and puts the compare's sign bits straight into one bit mask per
-//! word, then histograms the candidates' sizes per region; the second
-//! keeps the candidates at or above the region's limit, one bit at a time
-//! without a branch on the answer, and emits the kept ones. The region's
+//! word (and a second mask of the candidates of size 3 and up, [`BIG`]),
+//! then histograms those big candidates' sizes per region, counting the
+//! rest in bulk; the second keeps the candidates at or above the region's
+//! limit — all of them, or all big ones, or the big ones that pass a test
+//! one bit at a time without a branch on the answer — and emits them. The region's
 //! limit is found walking up from size 2, where it usually is, not down
 //! from the largest peak. Mispredicted branches, not arithmetic, bounded
 //! the older code. The straightforward former implementation is kept in
@@ -39,13 +41,15 @@ pub struct PeakScratch {
     /// Candidate bits (then kept bits) of the rows of one region
     /// (horizontal scan) or of the whole response (vertical scan), 64
     /// pixels per word, see [`candidates`].
-    bits_h: Vec<u64>,
-    bits_v: Vec<u64>,
+    bits_h: Vec<Bits>,
+    bits_v: Vec<Bits>,
     /// Vertical scan: per column, the lower limit of a kept peak (on `|E|`,
     /// or on `|S|` in the exact form) and the column's histogram offset.
     lim: Vec<f32>,
     lim_keys: Vec<i32>,
     offset: Vec<u32>,
+    /// Vertical scan: per word of columns, those of each [`Keep`] rule.
+    rules: Vec<[u64; 3]>,
 }
 
 /// The first pass's test folds "above the floor `T`" and "size ≥ 2"
@@ -60,12 +64,26 @@ fn first_pass_floor(t: f32) -> f32 {
 /// Pixels per candidate word.
 const WORD: usize = 64;
 
+/// The candidate bits of one word: `[CAND]` every candidate, `[BIG_CAND]`
+/// those of size [`BIG`] and up.
+type Bits = [u64; 2];
+const CAND: usize = 0;
+const BIG_CAND: usize = 1;
+
+/// Candidates of size 2, the smallest (most of them, on noise: about 60 %
+/// on the bench scene), are counted in a region's total only, by popcount
+/// where the region is whole words; only those of this size and up go
+/// into the histogram one by one. The keep pass then needs no test at all
+/// where the limit is 2 or 3 (all candidates, or all big ones: 97 % of
+/// the bench scene's regions), and tests big candidates only above.
+const BIG: f32 = 3.0;
+
 /// What the peak finder reads of a response, in one of its forms: per
 /// pixel a value whose magnitude orders as `|E|`.
 trait Source {
     /// A pixel's value: the signed `f32` response, or the exact `|S|`.
     type T: Copy;
-    /// The first pass's floor, prepared once a call.
+    /// The first pass's floor and the size [`BIG`], prepared once a call.
     type Floor: Copy;
     /// A region's limit, prepared once a region.
     type Lim: Copy;
@@ -74,16 +92,18 @@ trait Source {
     const PAD: Self::T;
     fn values(&self) -> &[Self::T];
     fn floor(&self, t1: f32) -> Self::Floor;
-    /// The peak test (§2.3) on the 64 pixels of one word: bit `i` is set
-    /// where the magnitude of `mid[i]` is above that of `lo[i]`, at least
-    /// that of `hi[i]` and above the floor (see [`first_pass_floor`]); a
-    /// pixel without a response (or a neighbour without one) never is.
+    /// The peak test (§2.3) on the 64 pixels of one word: bit `i` of
+    /// `[CAND]` is set where the magnitude of `mid[i]` is above that of
+    /// `lo[i]`, at least that of `hi[i]` and above the floor (see
+    /// [`first_pass_floor`]), and bit `i` of `[BIG_CAND]` where, besides,
+    /// `|E| ≥ BIG`; a pixel without a response (or a neighbour without
+    /// one) is never a candidate.
     fn word(
         lo: &[Self::T; WORD],
         mid: &[Self::T; WORD],
         hi: &[Self::T; WORD],
         t1: Self::Floor,
-    ) -> u64;
+    ) -> Bits;
     /// `|E|` of a value.
     fn mag(&self, v: Self::T) -> f32;
     /// The signed response `E` at index `i`.
@@ -99,7 +119,7 @@ struct Float<'a>(&'a [f32]);
 
 impl Source for Float<'_> {
     type T = f32;
-    type Floor = f32x4;
+    type Floor = (f32x4, f32x4);
     type Lim = f32;
     const PAD: f32 = f32::NAN;
 
@@ -107,25 +127,29 @@ impl Source for Float<'_> {
         self.0
     }
 
-    fn floor(&self, t1: f32) -> f32x4 {
-        f32x4::splat(t1)
+    fn floor(&self, t1: f32) -> (f32x4, f32x4) {
+        (f32x4::splat(t1), f32x4::splat(BIG))
     }
 
     /// Four lanes at a time, and the compare's sign bits go straight into
     /// the word (`movmskps` on x86-64): no flag bytes to pack afterwards.
     #[inline(always)]
-    fn word(lo: &[f32; WORD], mid: &[f32; WORD], hi: &[f32; WORD], t1: f32x4) -> u64 {
+    fn word(lo: &[f32; WORD], mid: &[f32; WORD], hi: &[f32; WORD], t: (f32x4, f32x4)) -> Bits {
         let quad = |s: &[f32; WORD], i: usize| f32x4::from([s[i], s[i + 1], s[i + 2], s[i + 3]]);
         let test = |i: usize| {
             let e0 = quad(mid, i).abs();
-            let c = e0.cmp_gt(quad(lo, i).abs()) & e0.cmp_ge(quad(hi, i).abs()) & e0.cmp_gt(t1);
-            c.move_mask() as u32 & 0xF
+            let c = e0.cmp_gt(quad(lo, i).abs()) & e0.cmp_ge(quad(hi, i).abs()) & e0.cmp_gt(t.0);
+            let big = c & e0.cmp_ge(t.1);
+            [c.move_mask() as u32 & 0xF, big.move_mask() as u32 & 0xF]
         };
         // Eight pixels a step: half the loop's overhead, constant shifts
         // (sixteen a step measured no better).
-        let mut bits = 0u64;
+        let mut bits = [0u64; 2];
         for i in (0..WORD).step_by(8) {
-            bits |= u64::from(test(i) | test(i + 4) << 4) << i;
+            let (a, b) = (test(i), test(i + 4));
+            for (w, (a, b)) in bits.iter_mut().zip(a.into_iter().zip(b)) {
+                *w |= u64::from(a | b << 4) << i;
+            }
         }
         bits
     }
@@ -157,7 +181,8 @@ impl Source for Float<'_> {
 impl Source for &Exact {
     type T = i16;
     /// The largest `|S|` at or below the floor.
-    type Floor = i16x16;
+    /// The largest `|S|` at or below the floor, and below [`BIG`].
+    type Floor = (i16x16, i16x16);
     /// The smallest `|S|` that reaches the limit (32 768: none does).
     type Lim = i32;
     const PAD: i16 = NONE;
@@ -166,15 +191,18 @@ impl Source for &Exact {
         &self.keys
     }
 
-    fn floor(&self, t1: f32) -> i16x16 {
-        let above = self.first_key(t1, |e| e > t1);
-        i16x16::splat((above - 1).min(i32::from(i16::MAX)) as i16)
+    fn floor(&self, t1: f32) -> (i16x16, i16x16) {
+        let below = |first: i32| i16x16::splat((first - 1).min(i32::from(i16::MAX)) as i16);
+        (
+            below(self.first_key(t1, |e| e > t1)),
+            below(self.first_key(BIG, |e| e >= BIG)),
+        )
     }
 
     /// Sixteen lanes at a time: the compares' masks packed to bytes and
     /// their sign bits taken at once (`packsswb`, `pmovmskb` on x86-64).
     #[inline(always)]
-    fn word(lo: &[i16; WORD], mid: &[i16; WORD], hi: &[i16; WORD], t1: i16x16) -> u64 {
+    fn word(lo: &[i16; WORD], mid: &[i16; WORD], hi: &[i16; WORD], t: (i16x16, i16x16)) -> Bits {
         let load = |s: &[i16; WORD], i: usize| {
             i16x16::new(*s[i..].first_chunk::<16>().expect("within the word"))
         };
@@ -183,12 +211,15 @@ impl Source for &Exact {
             let k0 = load(mid, i);
             // `k0 ≥ hi` as "not hi > k0"; `NONE` neighbours are above any
             // `k0` but `NONE` itself, which is left out.
-            let c = k0.cmp_gt(load(lo, i)) & k0.cmp_gt(t1);
-            c & !(load(hi, i).cmp_gt(k0) | k0.cmp_eq(none))
+            let c = k0.cmp_gt(load(lo, i)) & k0.cmp_gt(t.0);
+            let c = c & !(load(hi, i).cmp_gt(k0) | k0.cmp_eq(none));
+            [c, c & k0.cmp_gt(t.1)]
         };
-        let mut bits = 0u64;
+        let mut bits = [0u64; 2];
         for i in (0..WORD).step_by(16) {
-            bits |= u64::from(test(i).move_mask() as u32 & 0xFFFF) << i;
+            for (w, c) in bits.iter_mut().zip(test(i)) {
+                *w |= u64::from(c.move_mask() as u32 & 0xFFFF) << i;
+            }
         }
         bits
     }
@@ -243,7 +274,7 @@ impl Exact {
 /// pixels that end the line and shifted into place; a line shorter than a
 /// word goes through a padded copy.
 #[inline(always)]
-fn candidates<S: Source>(lo: &[S::T], mid: &[S::T], hi: &[S::T], t1: S::Floor, words: &mut [u64]) {
+fn candidates<S: Source>(lo: &[S::T], mid: &[S::T], hi: &[S::T], t1: S::Floor, words: &mut [Bits]) {
     let n = mid.len().min(lo.len()).min(hi.len());
     if n < WORD {
         let mut pad = [[S::PAD; WORD]; 3];
@@ -264,7 +295,7 @@ fn candidates<S: Source>(lo: &[S::T], mid: &[S::T], hi: &[S::T], t1: S::Floor, w
         let at = n - WORD;
         let bits = S::word(block(lo, at), block(mid, at), block(hi, at), t1);
         if let Some(w) = words.get_mut(full) {
-            *w = bits >> (full * WORD - at);
+            *w = bits.map(|b| b >> (full * WORD - at));
         }
     }
 }
@@ -287,28 +318,56 @@ fn set_bits(mut bits: u64) -> impl Iterator<Item = usize> {
     })
 }
 
-/// Calls `f(i)` for every set bit `i` of `words` (bit `i % 64` of word
-/// `i / 64`), in order.
+/// Calls `f(i)` for every set bit `i` of plane `plane` of `words` (bit
+/// `i % 64` of word `i / 64`), in order.
 #[inline(always)]
-fn for_each_bit(words: &[u64], mut f: impl FnMut(usize)) {
-    for (k, &w) in words.iter().enumerate() {
-        for b in set_bits(w) {
+fn for_each_bit(words: &[Bits], plane: usize, mut f: impl FnMut(usize)) {
+    for (k, w) in words.iter().enumerate() {
+        for b in set_bits(w[plane]) {
             f(k * WORD + b);
         }
     }
 }
 
-/// The second pass: keeps the candidate bits `i` with `keep(i)`, without a
-/// branch on the answer (about half the candidates are kept, at random).
+/// The bits `i` of `bits` (word `k`) with `keep(i)`, without a branch on
+/// the answer (about half the candidates tested are kept, at random).
 #[inline(always)]
-fn retain_bits(words: &mut [u64], mut keep: impl FnMut(usize) -> bool) {
-    for (k, w) in words.iter_mut().enumerate() {
-        let mut kept = 0u64;
-        for b in set_bits(*w) {
-            kept |= u64::from(keep(k * WORD + b)) << b;
-        }
-        *w = kept;
+fn retain(bits: u64, k: usize, mut keep: impl FnMut(usize) -> bool) -> u64 {
+    let mut kept = 0u64;
+    for b in set_bits(bits) {
+        kept |= u64::from(keep(k * WORD + b)) << b;
     }
+    kept
+}
+
+/// How the keep pass treats a region with limit `lim`: keep every
+/// candidate (`lim ≤ 2`: every candidate's `|E|` is at least 2, see
+/// [`first_pass_floor`]), every big one (`lim` = 3 = [`BIG`]; limits are
+/// whole numbers or +∞), or test the big ones.
+#[derive(Clone, Copy, PartialEq)]
+enum Keep {
+    All,
+    Big,
+    Test,
+}
+
+fn keep_rule(lim: f32) -> Keep {
+    if lim <= 2.0 {
+        Keep::All
+    } else if lim <= BIG {
+        Keep::Big
+    } else {
+        Keep::Test
+    }
+}
+
+/// Completes a region's histogram before [`limit`]: bin [`TOTAL`] holds
+/// the number of candidates `n`, bin 1 (free, like bin 0) the number of
+/// big ones, so bin 2 gets the rest.
+#[inline]
+fn settle(hist: &mut [u32]) {
+    hist[2] += hist[TOTAL] - hist[1];
+    hist[1] = 0;
 }
 
 /// The histogram bin of a peak: its size, `|E|` rounded down, at most 255.
@@ -324,10 +383,11 @@ fn bin(e0: f32) -> usize {
 /// bin 0 is free.
 const TOTAL: usize = 0;
 
-/// Counts a candidate of size `bin` in a region's histogram.
+/// Counts a big candidate of size `bin` in a region's histogram (see
+/// [`settle`]).
 #[inline(always)]
-fn count(hist: &mut [u32], bin: usize) {
-    hist[TOTAL] += 1;
+fn count_big(hist: &mut [u32], bin: usize) {
+    hist[1] += 1;
     hist[bin] += 1;
 }
 
@@ -454,18 +514,24 @@ fn peaks_h<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
     let rows = r.min(h);
     if s.bits_h.len() != rows * nw {
         s.bits_h.clear();
-        s.bits_h.resize(rows * nw, 0);
+        s.bits_h.resize(rows * nw, [0; 2]);
     }
     for (g, region) in src.values().chunks(w * r).enumerate() {
         for (row, words) in region.chunks_exact(w).zip(s.bits_h.chunks_exact_mut(nw)) {
             let mid = &row[1..w - 1];
             candidates::<S>(&row[..w - 2], mid, &row[2..], t1, words);
-            for_each_bit(words, |i| count(hist, bin(src.mag(mid[i]))));
+            for wd in words.iter() {
+                hist[TOTAL] += wd[CAND].count_ones();
+                hist[1] += wd[BIG_CAND].count_ones();
+            }
+            for_each_bit(words, BIG_CAND, |i| hist[bin(src.mag(mid[i]))] += 1);
         }
+        settle(hist);
         let lim = limit(hist, m);
         if lim == f32::INFINITY {
             continue;
         }
+        let rule = keep_rule(lim);
         let lim = src.lim(lim);
         for (k, (row, words)) in region
             .chunks_exact(w)
@@ -473,8 +539,14 @@ fn peaks_h<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
             .enumerate()
         {
             let y = g * r + k;
-            retain_bits(words, |i| S::at_least(row[i + 1], lim));
-            for_each_bit(words, |i| {
+            for (j, wd) in words.iter_mut().enumerate() {
+                wd[CAND] = match rule {
+                    Keep::All => wd[CAND],
+                    Keep::Big => wd[BIG_CAND],
+                    Keep::Test => retain(wd[BIG_CAND], j, |i| S::at_least(row[i + 1], lim)),
+                };
+            }
+            for_each_bit(words, CAND, |i| {
                 let x = i + 1;
                 let (em, e0, ep) = (src.mag(row[x - 1]), src.mag(row[x]), src.mag(row[x + 1]));
                 out.points.push(EdgePoint {
@@ -503,7 +575,7 @@ fn peaks_v<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
     // the first pass writes every word it reads later.
     if s.bits_v.len() != nw * h {
         s.bits_v.clear();
-        s.bits_v.resize(nw * h, 0);
+        s.bits_v.resize(nw * h, [0; 2]);
     }
     let data = src.values();
     let mut word_rows = s.bits_v.chunks_exact_mut(nw);
@@ -514,16 +586,27 @@ fn peaks_v<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
         let dn = &data[(y + 1) * w..(y + 2) * w];
         candidates::<S>(up, row, dn, t1, words);
         let (hist, offset) = (&mut s.hist, &s.offset);
-        for_each_bit(words, |x| {
+        for_each_bit(words, CAND, |x| hist[offset[x] as usize + TOTAL] += 1);
+        for_each_bit(words, BIG_CAND, |x| {
             let o = offset[x] as usize;
-            count(&mut hist[o..o + BINS], bin(src.mag(row[x])));
+            count_big(&mut hist[o..o + BINS], bin(src.mag(row[x])));
         });
     }
+    // Per column, its region's limit (as `S` compares it) and, per word,
+    // the columns of each keep rule.
     let mut lims = std::mem::take(S::lims(s));
     lims.clear();
+    s.rules.clear();
+    s.rules.resize(nw, [0; 3]);
     for (g, hist) in s.hist.chunks_exact_mut(BINS).enumerate() {
-        let l = src.lim(limit(hist, m));
-        lims.extend(std::iter::repeat_n(l, r.min(w - g * r)));
+        settle(hist);
+        let l = limit(hist, m);
+        let rule = keep_rule(l) as usize;
+        let l = src.lim(l);
+        for x in g * r..(g * r + r).min(w) {
+            lims.push(l);
+            s.rules[x / WORD][rule] |= 1 << (x % WORD);
+        }
     }
     let mut word_rows = s.bits_v.chunks_exact_mut(nw);
     word_rows.next();
@@ -531,9 +614,14 @@ fn peaks_v<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
         let up = &data[(y - 1) * w..y * w];
         let row = &data[y * w..(y + 1) * w];
         let dn = &data[(y + 1) * w..(y + 2) * w];
-        retain_bits(words, |x| S::at_least(row[x], lims[x]));
+        for (k, (wd, rule)) in words.iter_mut().zip(&s.rules).enumerate() {
+            let test = wd[BIG_CAND] & rule[Keep::Test as usize];
+            wd[CAND] = (wd[CAND] & rule[Keep::All as usize])
+                | (wd[BIG_CAND] & rule[Keep::Big as usize])
+                | retain(test, k, |x| S::at_least(row[x], lims[x]));
+        }
         let yf = y as f32;
-        for_each_bit(words, |x| {
+        for_each_bit(words, CAND, |x| {
             let (em, e0, ep) = (src.mag(up[x]), src.mag(row[x]), src.mag(dn[x]));
             out.points.push(EdgePoint {
                 x: x as f32,
