@@ -589,6 +589,38 @@ mod tests {
     }
 
     #[test]
+    fn a_fresh_scratch_serves_any_order_of_directions_and_regions() {
+        // The vertical scan's per-region buffers after a horizontal scan
+        // (one region's histogram) and for a single region of columns.
+        let mut rng = SplitMix64::new(99);
+        let img = random_image(&mut rng, 90, 70, false);
+        let mut rs = ResponseScratch::default();
+        let (mut rh, mut rv) = (Response::default(), Response::default());
+        exact_response_into(&img, ScanDir::Horizontal, 4, &mut rh, &mut rs).unwrap();
+        exact_response_into(&img, ScanDir::Vertical, 4, &mut rv, &mut rs).unwrap();
+        let fh = response(&img, ScanDir::Horizontal, 4).unwrap();
+        let fv = response(&img, ScanDir::Vertical, 4).unwrap();
+        for r in [1, 90, 5000, 3] {
+            let p = EdgeParams {
+                region_lines: r,
+                per_region: 3,
+                ..EdgeParams::default()
+            };
+            let mut fs = PeakScratch::default();
+            for (resp, float) in [(&rh, &fh), (&rv, &fv), (&rh, &fh), (&rv, &fv)] {
+                let fast = {
+                    let mut out = EdgePoints::default();
+                    peaks_into(resp, &p, &mut out, &mut fs);
+                    out
+                };
+                let slow = reference::peaks(float, &p);
+                assert!(!slow.points.is_empty());
+                assert!(same_points(&fast, &slow), "{:?} r={r}", resp.dir);
+            }
+        }
+    }
+
+    #[test]
     fn peaks_of_unusual_responses_equal_the_reference() {
         // Hand-made responses: sizes 0 and 1 only, huge values, infinities,
         // NaN holes, ties.
