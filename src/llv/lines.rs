@@ -237,9 +237,9 @@ pub struct LineScratch {
     /// `row_start[r]..row_start[r + 1]` are the points of scan line `r`.
     row_start: Vec<u32>,
     used: Vec<bool>,
-    /// The scan line of each input point (`u32::MAX`: not finite), when
-    /// the input is not in scan order.
-    rows: Vec<u32>,
+    /// Input not in scan order: each filed point in input order, with its
+    /// scan line.
+    staged: Vec<(ScanPoint, u32)>,
     reach: Vec<Reach>,
     grid: Grid,
     /// Tests: never use the [`Grid`] (to compare both ways).
@@ -604,9 +604,9 @@ impl LineScratch {
             row_start.push(points.len() as u32);
             nrows
         } else {
-            let mut rows = std::mem::take(&mut self.rows);
-            let nrows = counting_sort(e, &scan, &mut points, &mut row_start, &mut rows);
-            self.rows = rows;
+            let mut staged = std::mem::take(&mut self.staged);
+            let nrows = counting_sort(e, &scan, &mut points, &mut row_start, &mut staged);
+            self.staged = staged;
             nrows
         };
         self.points = points;
@@ -616,44 +616,40 @@ impl LineScratch {
 }
 
 /// [`LineScratch::file`] of input out of scan order: a counting sort by
-/// scan line (`rows`: each input point's, `u32::MAX` for none), then a sort
-/// of any scan line out of order along the scan.
+/// scan line (each point converted once, into `staged` with its scan
+/// line; points without one are left out), then a sort of any scan line
+/// out of order along the scan.
 #[inline(never)]
 fn counting_sort(
     e: &EdgePoints,
     scan: &impl Fn(&EdgePoint) -> (ScanPoint, Option<usize>),
     points: &mut Vec<ScanPoint>,
     row_start: &mut Vec<u32>,
-    rows: &mut Vec<u32>,
+    staged: &mut Vec<(ScanPoint, u32)>,
 ) -> usize {
     // `row_start[r + 2]` counts scan line `r` first.
     row_start.clear();
-    rows.clear();
-    rows.extend(e.points.iter().map(|q| match scan(q).1 {
-        Some(r) => {
+    staged.clear();
+    for q in &e.points {
+        if let (point, Some(r)) = scan(q) {
             if r + 2 >= row_start.len() {
                 row_start.resize(r + 3, 0);
             }
             row_start[r + 2] += 1;
-            r as u32
+            staged.push((point, r as u32));
         }
-        None => u32::MAX,
-    }));
+    }
     let nrows = row_start.len().saturating_sub(2);
     row_start.resize(nrows + 2, 0);
     for r in 2..nrows + 2 {
         row_start[r] += row_start[r - 1];
     }
-    let total = row_start[nrows + 1] as usize;
     points.clear();
-    points.resize(total, ScanPoint::default());
-    for (q, &r) in e.points.iter().zip(rows.iter()) {
-        if r != u32::MAX {
-            let point = scan(q).0;
-            let slot = &mut row_start[r as usize + 1];
-            points[*slot as usize] = point;
-            *slot += 1;
-        }
+    points.resize(staged.len(), ScanPoint::default());
+    for &(point, r) in staged.iter() {
+        let slot = &mut row_start[r as usize + 1];
+        points[*slot as usize] = point;
+        *slot += 1;
     }
     row_start.truncate(nrows + 1);
     // Within a scan line, order by u (the input may come from a file).
