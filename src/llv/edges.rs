@@ -213,18 +213,7 @@ pub fn response_into(
     out: &mut Response,
     scratch: &mut ResponseScratch,
 ) -> Result<(), LlvError> {
-    check_half_width(a)?;
-    img.check_stage_size()?;
-    let (w, h) = img.size();
-    let px = img.data();
-    if px.len() != w * h {
-        return Err(LlvError::BufferSize {
-            width: w,
-            height: h,
-            expected: w * h,
-            actual: px.len(),
-        });
-    }
+    let (w, h, px) = checked_input(img, a)?;
     out.reshape(w, h, dir);
     match dir {
         ScanDir::Horizontal => {
@@ -278,18 +267,7 @@ pub fn exact_response_into(
     if a > 5 {
         return response_into(img, dir, a, out, scratch);
     }
-    check_half_width(a)?;
-    img.check_stage_size()?;
-    let (w, h) = img.size();
-    let px = img.data();
-    if px.len() != w * h {
-        return Err(LlvError::BufferSize {
-            width: w,
-            height: h,
-            expected: w * h,
-            actual: px.len(),
-        });
-    }
+    let (w, h, px) = checked_input(img, a)?;
     out.reshape_exact(w, h, dir, a);
     let Exact { sums, keys, .. } = &mut out.exact;
     let rows = sums.chunks_exact_mut(w).zip(keys.chunks_exact_mut(w));
@@ -322,6 +300,24 @@ pub fn exact_response_into(
         mask_invalid(mask, w, h, dir, a, keys, NONE, &mut scratch.counts);
     }
     Ok(())
+}
+
+/// The size and pixels of an image the kernel with half-width `a` can run
+/// on (a valid half-width, a stage-sized image, a whole buffer).
+fn checked_input(img: &GreyImage, a: usize) -> Result<(usize, usize, &[u8]), LlvError> {
+    check_half_width(a)?;
+    img.check_stage_size()?;
+    let (w, h) = img.size();
+    let px = img.data();
+    if px.len() != w * h {
+        return Err(LlvError::BufferSize {
+            width: w,
+            height: h,
+            expected: w * h,
+            actual: px.len(),
+        });
+    }
+    Ok((w, h, px))
 }
 
 /// Sets `none` wherever the kernel window touches an invalid pixel.

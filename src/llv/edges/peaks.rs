@@ -559,6 +559,12 @@ fn peaks_h<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
     }
 }
 
+/// Rows `y - 1`, `y`, `y + 1` of a `w`-wide image (`1 ≤ y`, `y + 1` a row).
+#[inline(always)]
+fn around<T>(data: &[T], w: usize, y: usize) -> [&[T]; 3] {
+    [y - 1, y, y + 1].map(|r| &data[r * w..(r + 1) * w])
+}
+
 fn peaks_v<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut PeakScratch) {
     let Region { w, h, r, m } = p;
     let nreg = w.div_ceil(r);
@@ -581,9 +587,7 @@ fn peaks_v<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
     let mut word_rows = s.bits_v.chunks_exact_mut(nw);
     word_rows.next();
     for (y, words) in (1..h - 1).zip(&mut word_rows) {
-        let up = &data[(y - 1) * w..y * w];
-        let row = &data[y * w..(y + 1) * w];
-        let dn = &data[(y + 1) * w..(y + 2) * w];
+        let [up, row, dn] = around(data, w, y);
         candidates::<S>(up, row, dn, t1, words);
         let (hist, offset) = (&mut s.hist, &s.offset);
         for_each_bit(words, CAND, |x| hist[offset[x] as usize + TOTAL] += 1);
@@ -611,9 +615,7 @@ fn peaks_v<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
     let mut word_rows = s.bits_v.chunks_exact_mut(nw);
     word_rows.next();
     for (y, words) in (1..h - 1).zip(&mut word_rows) {
-        let up = &data[(y - 1) * w..y * w];
-        let row = &data[y * w..(y + 1) * w];
-        let dn = &data[(y + 1) * w..(y + 2) * w];
+        let [up, row, dn] = around(data, w, y);
         for (k, (wd, rule)) in words.iter_mut().zip(&s.rules).enumerate() {
             let test = wd[BIG_CAND] & rule[Keep::Test as usize];
             wd[CAND] = (wd[CAND] & rule[Keep::All as usize])

@@ -118,11 +118,15 @@ pub(crate) fn scale(a: usize) -> f32 {
 /// One output, exactly: the fallback for rows shorter than a block.
 #[inline]
 fn one(taps: &Taps, a: usize, j: usize) -> f32 {
-    let mut acc = 0i32;
-    for s in 1..a {
-        acc += coef(a, s) * (i32::from(taps.hi[s][j]) - i32::from(taps.lo[s][j]));
-    }
-    acc as f32 * scale(a)
+    one_sum(taps, a, j) as f32 * scale(a)
+}
+
+/// The exact sum of output `j`.
+#[inline]
+fn one_sum(taps: &Taps, a: usize, j: usize) -> i32 {
+    (1..a)
+        .map(|s| coef(a, s) * (i32::from(taps.hi[s][j]) - i32::from(taps.lo[s][j])))
+        .sum()
 }
 
 /// Runs `block(i, out)` on blocks of [`BLK`] outputs starting at `i` that
@@ -137,13 +141,8 @@ fn by_blocks(taps: &Taps, a: usize, out: &mut [f32], mut block: impl FnMut(usize
         }
         return;
     }
-    let mut i = 0;
-    while i + BLK <= n {
+    for i in block_starts(n) {
         block(i, out);
-        i += BLK;
-    }
-    if i < n {
-        block(n - BLK, out);
     }
 }
 
@@ -151,53 +150,49 @@ fn row_exact<const A: usize>(taps: &Taps, sums: &mut [i16], keys: &mut [i16]) {
     let n = sums.len();
     if n < BLK {
         for (j, (s, k)) in sums.iter_mut().zip(keys.iter_mut()).enumerate() {
-            let mut acc = 0i32;
-            for t in 1..A {
-                acc += coef(A, t) * (i32::from(taps.hi[t][j]) - i32::from(taps.lo[t][j]));
-            }
             // |acc| ≤ 30 600 for A ≤ 5.
+            let acc = one_sum(taps, A, j);
             *s = acc as i16;
             *k = acc.unsigned_abs() as i16;
         }
         return;
     }
-    let block = |i: usize, sums: &mut [i16], keys: &mut [i16]| {
-        let mut acc = [0i16; BLK];
-        for s in 1..A {
-            let c = coef(A, s) as i16;
-            let h = &taps.hi[s][i..i + BLK];
-            let l = &taps.lo[s][i..i + BLK];
-            for ((o, &h), &l) in acc.iter_mut().zip(h).zip(l) {
-                *o = o.wrapping_add(c.wrapping_mul(h as i16 - l as i16));
-            }
-        }
+    for i in block_starts(n) {
+        let acc = sums_i16::<A>(taps, i);
         sums[i..i + BLK].copy_from_slice(&acc);
         for (k, &v) in keys[i..i + BLK].iter_mut().zip(&acc) {
             *k = v.wrapping_abs();
         }
-    };
-    let mut i = 0;
-    while i + BLK <= n {
-        block(i, sums, keys);
-        i += BLK;
     }
-    if i < n {
-        block(n - BLK, sums, keys);
+}
+
+/// The exact sums of the [`BLK`] outputs from `i`, in `i16` lanes (`A ≤
+/// 5`; the taps cover them).
+#[inline(always)]
+fn sums_i16<const A: usize>(taps: &Taps, i: usize) -> [i16; BLK] {
+    let mut acc = [0i16; BLK];
+    for s in 1..A {
+        let c = coef(A, s) as i16;
+        let h = &taps.hi[s][i..i + BLK];
+        let l = &taps.lo[s][i..i + BLK];
+        for ((o, &h), &l) in acc.iter_mut().zip(h).zip(l) {
+            *o = o.wrapping_add(c.wrapping_mul(h as i16 - l as i16));
+        }
     }
+    acc
+}
+
+/// The starts of the blocks of [`BLK`] outputs that cover a row of `n ≥
+/// BLK`, the last one overlapping its predecessor.
+fn block_starts(n: usize) -> impl Iterator<Item = usize> {
+    let last = n.saturating_sub(BLK);
+    (0..last).step_by(BLK).chain(std::iter::once(last))
 }
 
 fn row_i16<const A: usize>(taps: &Taps, out: &mut [f32]) {
     let sc = scale(A);
     by_blocks(taps, A, out, |i, out| {
-        let mut acc = [0i16; BLK];
-        for s in 1..A {
-            let c = coef(A, s) as i16;
-            let h = &taps.hi[s][i..i + BLK];
-            let l = &taps.lo[s][i..i + BLK];
-            for ((o, &h), &l) in acc.iter_mut().zip(h).zip(l) {
-                *o = o.wrapping_add(c.wrapping_mul(h as i16 - l as i16));
-            }
-        }
+        let acc = sums_i16::<A>(taps, i);
         for (o, &v) in out[i..i + BLK].iter_mut().zip(&acc) {
             *o = v as f32 * sc;
         }
