@@ -38,9 +38,10 @@
 //! Speed: most edge points are noise (the adaptive threshold keeps at
 //! least `M` a scan line), so the cost is in rejecting starts cheaply.
 //! Input already in the scan frame's lexical order (EdgeH, row by row) is
-//! filed in one pass, other input (EdgeV, which the edge stage emits row
-//! by row, and files in any order) by a counting sort; emitting EdgeV
-//! column by column instead cost the edge stage more than it saved here. Each point's rounded `u` is kept, and a `Grid` of
+//! filed in one pass; other input (EdgeV, which the edge stage emits row
+//! by row, and points read from files in any order) by a counting sort.
+//! Emitting EdgeV column by column instead cost the edge stage more than
+//! it saved here. Each point's rounded `u` is kept, and a `Grid` of
 //! bitmaps (every point; the unused ones by polarity; side by side per
 //! word) answers "is there an unused point near here?" and the template
 //! scores with a few word operations; points are found from a column by

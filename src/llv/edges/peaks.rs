@@ -180,7 +180,6 @@ impl Source for Float<'_> {
 
 impl Source for &Exact {
     type T = i16;
-    /// The largest `|S|` at or below the floor.
     /// The largest `|S|` at or below the floor, and below [`BIG`].
     type Floor = (i16x16, i16x16);
     /// The smallest `|S|` that reaches the limit (32 768: none does).
@@ -344,11 +343,22 @@ fn retain(bits: u64, k: usize, mut keep: impl FnMut(usize) -> bool) -> u64 {
 /// candidate (`lim ≤ 2`: every candidate's `|E|` is at least 2, see
 /// [`first_pass_floor`]), every big one (`lim` = 3 = [`BIG`]; limits are
 /// whole numbers or +∞), or test the big ones.
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy)]
 enum Keep {
     All,
     Big,
     Test,
+}
+
+/// The keep pass on one word `k` of candidate bits: the candidates of
+/// the columns of rule [`Keep::All`] in `rules`, the big ones of those of
+/// [`Keep::Big`], and the big ones of those of [`Keep::Test`] that pass
+/// `test` (a horizontal region has one rule for every column).
+#[inline(always)]
+fn kept(wd: Bits, rules: &[u64; 3], k: usize, test: impl FnMut(usize) -> bool) -> u64 {
+    (wd[CAND] & rules[Keep::All as usize])
+        | (wd[BIG_CAND] & rules[Keep::Big as usize])
+        | retain(wd[BIG_CAND] & rules[Keep::Test as usize], k, test)
 }
 
 fn keep_rule(lim: f32) -> Keep {
@@ -359,15 +369,6 @@ fn keep_rule(lim: f32) -> Keep {
     } else {
         Keep::Test
     }
-}
-
-/// Completes a region's histogram before [`limit`]: bin [`TOTAL`] holds
-/// the number of candidates `n`, bin 1 (free, like bin 0) the number of
-/// big ones, so bin 2 gets the rest.
-#[inline]
-fn settle(hist: &mut [u32]) {
-    hist[2] += hist[TOTAL] - hist[1];
-    hist[1] = 0;
 }
 
 /// The histogram bin of a peak: its size, `|E|` rounded down, at most 255.
@@ -384,16 +385,17 @@ fn bin(e0: f32) -> usize {
 const TOTAL: usize = 0;
 
 /// Counts a big candidate of size `bin` in a region's histogram (see
-/// [`settle`]).
+/// [`limit`]).
 #[inline(always)]
 fn count_big(hist: &mut [u32], bin: usize) {
     hist[1] += 1;
     hist[bin] += 1;
 }
 
-/// A region's lower limit on `|E|` for a kept peak, from the histogram of
-/// its candidate sizes (≥ 2, with their number in bin [`TOTAL`]), per
-/// llv.md §2.5; clears the histogram.
+/// A region's lower limit on `|E|` for a kept peak, per llv.md §2.5, from
+/// its histogram: the number of candidates in bin [`TOTAL`], the number
+/// of big ones in bin 1 (free, like bin 0) and the count of each big size
+/// in its bin (size 2 gets the rest); clears the histogram.
 ///
 /// The rule walks a threshold `th` down from the largest size `tmax`,
 /// adding each bin's count, until `M` candidates are above it or it reaches
@@ -414,7 +416,9 @@ fn limit(hist: &mut [u32], m: u32) -> f32 {
     if n == 0 {
         return f32::INFINITY;
     }
+    hist[2] += n - hist[1];
     hist[TOTAL] = 0;
+    hist[1] = 0;
     let lim = if m == 0 {
         hist.iter()
             .rposition(|&c| c != 0)
@@ -526,12 +530,12 @@ fn peaks_h<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
             }
             for_each_bit(words, BIG_CAND, |i| hist[bin(src.mag(mid[i]))] += 1);
         }
-        settle(hist);
         let lim = limit(hist, m);
         if lim == f32::INFINITY {
             continue;
         }
-        let rule = keep_rule(lim);
+        let mut rules = [0; 3];
+        rules[keep_rule(lim) as usize] = !0;
         let lim = src.lim(lim);
         for (k, (row, words)) in region
             .chunks_exact(w)
@@ -540,11 +544,7 @@ fn peaks_h<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
         {
             let y = g * r + k;
             for (j, wd) in words.iter_mut().enumerate() {
-                wd[CAND] = match rule {
-                    Keep::All => wd[CAND],
-                    Keep::Big => wd[BIG_CAND],
-                    Keep::Test => retain(wd[BIG_CAND], j, |i| S::at_least(row[i + 1], lim)),
-                };
+                wd[CAND] = kept(*wd, &rules, j, |i| S::at_least(row[i + 1], lim));
             }
             for_each_bit(words, CAND, |i| {
                 let x = i + 1;
@@ -603,7 +603,6 @@ fn peaks_v<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
     s.rules.clear();
     s.rules.resize(nw, [0; 3]);
     for (g, hist) in s.hist.chunks_exact_mut(BINS).enumerate() {
-        settle(hist);
         let l = limit(hist, m);
         let rule = keep_rule(l) as usize;
         let l = src.lim(l);
@@ -616,11 +615,8 @@ fn peaks_v<S: Source>(src: &S, t1: f32, p: Region, out: &mut EdgePoints, s: &mut
     word_rows.next();
     for (y, words) in (1..h - 1).zip(&mut word_rows) {
         let [up, row, dn] = around(data, w, y);
-        for (k, (wd, rule)) in words.iter_mut().zip(&s.rules).enumerate() {
-            let test = wd[BIG_CAND] & rule[Keep::Test as usize];
-            wd[CAND] = (wd[CAND] & rule[Keep::All as usize])
-                | (wd[BIG_CAND] & rule[Keep::Big as usize])
-                | retain(test, k, |x| S::at_least(row[x], lims[x]));
+        for (k, (wd, rules)) in words.iter_mut().zip(&s.rules).enumerate() {
+            wd[CAND] = kept(*wd, rules, k, |x| S::at_least(row[x], lims[x]));
         }
         let yf = y as f32;
         for_each_bit(words, CAND, |x| {
