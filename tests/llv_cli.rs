@@ -115,3 +115,47 @@ fn a_missing_image_fails_but_the_others_run() {
     assert!(!r.status.success());
     assert!(String::from_utf8_lossy(&r.stderr).contains("edges.half_width"));
 }
+
+/// A hand-made edge file with a stray point far outside its image (ten
+/// million scan lines down) runs like any other: the line stages once
+/// tried to size their bitmaps by it and aborted on a 3.7 TB allocation.
+#[test]
+fn a_stray_edge_point_far_outside_the_image_is_no_crash() {
+    use vss::formats::edgefile::write_edges;
+    use vss::llv::{EdgePoint, EdgePoints, ScanDir};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let point = |x: f32, y: f32| EdgePoint {
+        x,
+        y,
+        response: 25.0,
+    };
+    let mut h: Vec<EdgePoint> = (0..40)
+        .map(|y| point(30.0 + 0.25 * y as f32, y as f32))
+        .collect();
+    h.push(point(1_000_000.0, 9_999_990.0));
+    let v: Vec<EdgePoint> = (0..40)
+        .map(|x| point(x as f32, 20.0 + 0.5 * x as f32))
+        .collect();
+    let edges = |dir, points| EdgePoints {
+        dir: Some(dir),
+        width: 64,
+        height: 48,
+        points,
+    };
+    write_edges(&d.join("stray.hpo"), &edges(ScanDir::Horizontal, h)).unwrap();
+    write_edges(&d.join("stray.vpo"), &edges(ScanDir::Vertical, v)).unwrap();
+    let r = vss()
+        .args(["llv", "--json", "--out"])
+        .arg(d)
+        .arg("--from-edges")
+        .arg(d.join("stray.hpo"))
+        .arg(d.join("stray.vpo"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    let o: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert_eq!(o["lines"], 2, "the steep line and the shallow one: {o}");
+    assert!(d.join("stray.ldr").is_file());
+}
