@@ -58,9 +58,10 @@
 //! compares the result with that of the extractor before, kept in
 //! `lines/reference.rs`, bit for bit). The bitmaps are exact only when
 //! no two points of a scan line share a column (true of edge points, one
-//! pixel thick); otherwise — a hand-made file — the extractor walks the
-//! scan lines with binary searches, with the same result (a test compares
-//! both).
+//! pixel thick), and are only built when they take at most 64 words a
+//! point (so a stray point far outside the image does not size them);
+//! otherwise — a hand-made file — the extractor walks the scan lines with
+//! binary searches, with the same result (a test compares both).
 
 use super::fit::LineFit;
 use super::params::LineParams;
