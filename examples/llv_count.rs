@@ -11,8 +11,12 @@
 //! takes out the scene's rendering and the warm-up. Stages: `pipeline`
 //! (edges, lines, CONNECT; no lens), `edges` (response and peaks, both
 //! directions), `response`, `peaks` (`peaks_h`, `peaks_v`: one direction),
-//! `lines`; `scene FILE.pgm` writes the scene.
+//! `lines`, `split` (the pipeline's stages with each scan direction on a
+//! thread of its own, then CONNECT without corners: what two cores would
+//! give; time it, its instruction
+//! count means nothing); `scene FILE.pgm` writes the scene.
 
+use vss::llv::connect::{ConnectScratch, connect_into};
 use vss::llv::edges::{PeakScratch, Response, ResponseScratch, exact_response_into, peaks_into};
 use vss::llv::lines::{LineScratch, extract_into};
 use vss::llv::pipeline::{Input, Workspace};
@@ -25,7 +29,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let (Some(stage), Some(n)) = (args.get(1), args.get(2)) else {
         eprintln!(
-            "usage: llv_count pipeline|edges|response|peaks|peaks_h|peaks_v|lines N | scene FILE.pgm"
+            "usage: llv_count pipeline|edges|response|peaks|peaks_h|peaks_v|lines|split N | scene FILE.pgm"
         );
         std::process::exit(2);
     };
@@ -60,6 +64,8 @@ fn main() {
     if stage.starts_with("peaks") {
         response(&mut rh, &mut rv);
     }
+    let (mut split_h, mut split_v) = Default::default();
+    let (mut joined, mut cs) = (Vec::new(), ConnectScratch::default());
     let mut check = 0usize;
     for _ in 0..n {
         match stage.as_str() {
@@ -83,6 +89,29 @@ fn main() {
                 extract_into(&warm.edges_h, &p.lines, &mut lh, &mut ls);
                 extract_into(&warm.edges_v, &p.lines, &mut lv, &mut ls);
                 check += lh.len() + lv.len();
+            }
+            "split" => {
+                // What two cores would give: each scan direction's response,
+                // peaks and lines on a thread of its own (a scoped thread a
+                // run, as a plain implementation would), then CONNECT.
+                let img = &img;
+                let one =
+                    |dir,
+                     r: &mut Response,
+                     e: &mut EdgePoints,
+                     l: &mut Vec<_>,
+                     sc: &mut (ResponseScratch, PeakScratch, LineScratch)| {
+                        exact_response_into(img, dir, a, r, &mut sc.0).expect("size");
+                        peaks_into(r, &p.edges, e, &mut sc.1);
+                        extract_into(e, &p.lines, l, &mut sc.2);
+                    };
+                std::thread::scope(|s| {
+                    s.spawn(|| one(ScanDir::Vertical, &mut rv, &mut ev, &mut lv, &mut split_v));
+                    one(ScanDir::Horizontal, &mut rh, &mut eh, &mut lh, &mut split_h);
+                });
+                lh.extend_from_slice(&lv);
+                connect_into(&lh, &p.connect, &mut joined, &mut cs);
+                check += joined.len();
             }
             other => {
                 eprintln!("unknown stage {other}");
