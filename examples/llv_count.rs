@@ -13,8 +13,8 @@
 //! directions), `response`, `peaks` (`peaks_h`, `peaks_v`: one direction),
 //! `lines`, `split` (the pipeline's stages with each scan direction on a
 //! thread of its own, then CONNECT without corners: what two cores would
-//! give; time it, its instruction
-//! count means nothing); `scene FILE.pgm` writes the scene.
+//! give; time it, its instruction count means nothing); `scene FILE.pgm`
+//! writes the scene.
 
 use vss::llv::connect::{ConnectScratch, connect_into};
 use vss::llv::edges::{PeakScratch, Response, ResponseScratch, exact_response_into, peaks_into};
