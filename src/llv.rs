@@ -46,6 +46,15 @@ pub enum LlvError {
         height: usize,
         min: usize,
     },
+    /// Beyond the largest size the stages support.
+    #[error(
+        "image of {width} × {height} pixels is too large: the stages take at most {max} pixels (8192 × 8192)"
+    )]
+    TooLarge {
+        width: usize,
+        height: usize,
+        max: usize,
+    },
     /// Images that must share a size (lightings of one view, a lens map) do not.
     #[error("image sizes differ: {a:?} and {b:?}")]
     SizeMismatch {

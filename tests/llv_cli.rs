@@ -159,3 +159,41 @@ fn a_stray_edge_point_far_outside_the_image_is_no_crash() {
     assert_eq!(o["lines"], 2, "the steep line and the shallow one: {o}");
     assert!(d.join("stray.ldr").is_file());
 }
+
+/// A small file that decodes to an image beyond what the stages take (a PNG
+/// of zeros, 8200 × 8200 pixels in under a megabyte) is refused with its
+/// size and the limit, before a lens map or the stages take memory for it.
+#[test]
+fn an_image_beyond_the_stages_limit_is_refused_up_front() {
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge1.png");
+    let (w, h) = (8200u32, 8200u32);
+    let file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+    let mut enc = png::Encoder::new(file, w, h);
+    enc.set_color(png::ColorType::Grayscale);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc.write_header().unwrap();
+    let mut stream = writer.stream_writer().unwrap();
+    let row = vec![0u8; w as usize];
+    for _ in 0..h {
+        stream.write_all(&row).unwrap();
+    }
+    stream.finish().unwrap();
+    writer.finish().unwrap();
+    assert!(std::fs::metadata(&path).unwrap().len() < 1 << 20);
+    let cdf = Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/sim/cam1.cdf");
+    let r = vss()
+        .args(["llv", "--cdf"])
+        .arg(&cdf)
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert_eq!(r.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("huge1.png") && err.contains("8200 × 8200") && err.contains("too large"),
+        "{err}"
+    );
+    assert!(!dir.path().join("huge1.ldr").exists());
+}

@@ -188,6 +188,12 @@ fn run_group(
         .iter()
         .map(|f| imageio::read_any(f))
         .collect::<Result<_, _>>()?;
+    // Sizes first: a lens map is made for the size before the stages run.
+    for (path, f) in grp.files.iter().zip(&files) {
+        f.image
+            .check_stage_size()
+            .with_context(|| path.display().to_string())?;
+    }
     let images: Vec<GreyImage> = files.iter().map(|f| f.image.clone()).collect();
     let size = images.first().map(GreyImage::size).unwrap_or_default();
     let map = camera.map(|m| {

@@ -6,6 +6,14 @@ use super::LlvError;
 /// The smallest image the stages accept (llv.md §0).
 pub const MIN_SIZE: usize = 16;
 
+/// The most pixels the stages accept: 2²⁶, 8192 × 8192. The cell's cameras
+/// give 512 × 512; the stages' buffers take about 10 bytes a pixel for one
+/// image, more with a lens map or several lightings (`vss llv` on an 8192²
+/// image peaks at 0.7 GB, 1.3 GB with a `.cdf`). A small file that decodes
+/// to a huge image (a compressed PNG, a sparse `.img`) is refused up front
+/// rather than exhausting memory half-way.
+pub const MAX_PIXELS: usize = 1 << 26;
+
 /// An 8-bit grey image. `data[y * width + x]` is `Img(x, y)`.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct GreyImage {
@@ -15,6 +23,26 @@ pub struct GreyImage {
     /// `Some(mask)` where some pixels are invalid: `mask[i]` is true for a
     /// valid pixel. `None` means every pixel is valid.
     valid: Option<Vec<bool>>,
+}
+
+/// [`GreyImage::check_stage_size`] of an image of `width` × `height`
+/// pixels, before it is read or a lens map is made for it.
+pub fn check_stage_size(width: usize, height: usize) -> Result<(), LlvError> {
+    if width < MIN_SIZE || height < MIN_SIZE {
+        return Err(LlvError::TooSmall {
+            width,
+            height,
+            min: MIN_SIZE,
+        });
+    }
+    if width.saturating_mul(height) > MAX_PIXELS {
+        return Err(LlvError::TooLarge {
+            width,
+            height,
+            max: MAX_PIXELS,
+        });
+    }
+    Ok(())
 }
 
 impl GreyImage {
@@ -43,16 +71,10 @@ impl GreyImage {
         Self::new(width, height, vec![value; width.saturating_mul(height)])
     }
 
-    /// Checks the size the LLV stages need (≥ 16 × 16).
+    /// Checks the size the LLV stages need (≥ 16 × 16, at most
+    /// [`MAX_PIXELS`]).
     pub fn check_stage_size(&self) -> Result<(), LlvError> {
-        if self.width < MIN_SIZE || self.height < MIN_SIZE {
-            return Err(LlvError::TooSmall {
-                width: self.width,
-                height: self.height,
-                min: MIN_SIZE,
-            });
-        }
-        Ok(())
+        check_stage_size(self.width, self.height)
     }
 
     pub fn width(&self) -> usize {
@@ -131,5 +153,13 @@ mod tests {
         assert_eq!(img.get(3, 1), Some(7));
         assert_eq!(img.get(4, 1), None);
         assert!(img.check_stage_size().is_err());
+        // The largest size, one pixel more, and a product that overflows.
+        assert!(check_stage_size(8192, 8192).is_ok());
+        assert!(matches!(
+            check_stage_size(8193, 8192),
+            Err(LlvError::TooLarge { .. })
+        ));
+        assert!(check_stage_size(1 << 40, 1 << 40).is_err());
+        assert!(check_stage_size(usize::MAX, 16).is_err());
     }
 }

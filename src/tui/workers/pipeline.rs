@@ -98,6 +98,8 @@ impl Engine {
         req: &PipelineRequest,
     ) -> Result<Arc<StageOutputs>, crate::llv::LlvError> {
         let size = req.images.first().map(GreyImage::size).unwrap_or((0, 0));
+        // Before a lens map is made for the size.
+        crate::llv::image::check_stage_size(size.0, size.1)?;
         let lens = match req.camera {
             Some(m) if req.params.lens.enabled && !m.is_identity() => Some(self.lens_map(m, size)),
             _ => None,
