@@ -58,7 +58,7 @@
 //! compares the result with that of the extractor before, kept in
 //! `lines/reference.rs`, bit for bit). The bitmaps are exact only when
 //! no two points of a scan line share a column (true of edge points, one
-//! pixel thick), and are only built when they take at most 64 words a
+//! pixel thick), and are only built when they take at most 16 words a
 //! point (so a stray point far outside the image does not size them);
 //! otherwise — a hand-made file — the extractor walks the scan lines with
 //! binary searches, with the same result (a test compares both).
@@ -265,6 +265,12 @@ fn unused(response: f32) -> usize {
     1 + polarity(response)
 }
 
+/// The most words a [`Grid`] bitmap may take: 2²², 28 bytes each with the
+/// three bitmaps and the index (117 MB). Edge points of the largest image
+/// the stages take (8192², about 16 points a scan line) need a quarter of
+/// it; beyond it the extractor walks.
+const MAX_GRID_WORDS: usize = 1 << 22;
+
 /// Bitmaps of the points by scan line and rounded `u` (one bit a pixel
 /// column): every point, and the points not yet used. The template scores
 /// and the successor test then read a few bits instead of walking the
@@ -298,7 +304,7 @@ impl Grid {
     /// along each, whose rounded `u` are all in `0..=max_iu`, `max_iu <
     /// 2²⁰`; false (and no grid) when two points of a scan line share a
     /// column, or when the bitmaps would be large for their points (more
-    /// than 2¹⁶ words each, and more than 64 a point).
+    /// than 2¹⁶ words each and 16 a point, or more than [`MAX_GRID_WORDS`]).
     #[inline(never)]
     fn build(
         &mut self,
@@ -310,7 +316,7 @@ impl Grid {
         // The columns, and an empty word on either side.
         self.words = max_iu as usize / 64 + 3;
         let len = nrows.saturating_mul(self.words);
-        if len > (64 * points.len()).max(1 << 16) {
+        if len > (16 * points.len()).clamp(1 << 16, MAX_GRID_WORDS) {
             // Far larger than its points (a sparse hand-made file, say a
             // stray point ten million scan lines down): walking is cheaper
             // than clearing the bitmaps, and they might not fit in memory.
