@@ -5,6 +5,24 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+/// `println!` that hands a failed write back (`?`, as a [`StdoutError`])
+/// instead of panicking: a reader that goes away (`vss info FILE | head
+/// -2`) ends the command quietly (see [`main`]).
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout(), $($arg)*).map_err($crate::cli::StdoutError)?
+    }};
+}
+
+/// `print!` as [`outln`] does it.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout(), $($arg)*).map_err($crate::cli::StdoutError)?
+    }};
+}
+
 pub mod convert;
 pub mod grab;
 pub mod info;
@@ -85,11 +103,30 @@ pub fn main() -> ExitCode {
     };
     match result {
         Ok(code) => code,
+        // The reader of the output went away (`| head`): it has what it
+        // wanted, so stop quietly, as a pipeline expects.
+        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("vss: error: {e:#}");
             ExitCode::FAILURE
         }
     }
+}
+
+/// A failed write of a command's output to stdout: kept apart from other
+/// I/O errors, so that only a closed stdout ends a command quietly (a
+/// grabber link that breaks is an error).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write the output: {0}")]
+pub struct StdoutError(pub std::io::Error);
+
+/// Whether `e` comes from writing the output to a pipe whose reader has
+/// gone.
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<StdoutError>()
+            .is_some_and(|o| o.0.kind() == std::io::ErrorKind::BrokenPipe)
+    })
 }
 
 fn run(g: &Global, cmd: Command) -> anyhow::Result<ExitCode> {

@@ -60,6 +60,6 @@ pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     }
     write_any(&a.output, &f)?;
     let (w, h) = f.image.size();
-    println!("{} → {} ({w} × {h})", a.input.display(), a.output.display());
+    outln!("{} → {} ({w} × {h})", a.input.display(), a.output.display());
     Ok(ExitCode::SUCCESS)
 }

@@ -28,9 +28,9 @@ pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         match describe(f) {
             Ok(text) => {
                 if i > 0 {
-                    println!();
+                    outln!();
                 }
-                print!("{text}");
+                out!("{text}");
             }
             Err(e) => {
                 eprintln!("vss: error: {e}");

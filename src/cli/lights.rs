@@ -75,7 +75,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                 .map_or_else(|| format!("relay {b}"), |l| l.name.clone())
         })
         .collect();
-    println!(
+    outln!(
         "{}: relays {mask:04x}; on: {}",
         board.port_name(),
         if on.is_empty() {

@@ -154,6 +154,9 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             &mut maps,
             &mut ws,
         ) {
+            if super::is_broken_pipe(&e) {
+                return Err(e);
+            }
             eprintln!("vss: error: {}: {e:#}", grp.stem);
             failed += 1;
         }
@@ -232,7 +235,7 @@ fn run_group(
     written.extend(write_outputs(a, &grp.dir, &grp.stem, out, true)?);
     if let (Some(t), Some(r)) = (&a.auto, &proposal) {
         if !a.json {
-            print_auto(&grp.stem, t, r);
+            print_auto(&grp.stem, t, r)?;
         }
     }
     report(
@@ -243,7 +246,7 @@ fn run_group(
         out,
         &written,
         proposal.as_ref(),
-    );
+    )?;
     Ok(())
 }
 
@@ -290,24 +293,25 @@ fn from_edges(hpo: &Path, vpo: &Path, a: &Args, p: &Params) -> anyhow::Result<()
         &out,
         &written,
         None,
-    );
+    )?;
     Ok(())
 }
 
 /// What `--auto` changed, in text.
-fn print_auto(stem: &str, t: &Target, r: &AutoResult) {
-    println!(
+fn print_auto(stem: &str, t: &Target, r: &AutoResult) -> anyhow::Result<()> {
+    outln!(
         "{stem}: auto {t}: {} lines (was {}) after {} pipeline runs",
         r.lines.len(),
         r.base_lines,
         r.runs
     );
     if r.changes.is_empty() {
-        println!("  no change: the current parameters are the best found");
+        outln!("  no change: the current parameters are the best found");
     }
     for (key, old, new) in &r.changes {
-        println!("  --set {key}={new}   (was {old})");
+        outln!("  --set {key}={new}   (was {old})");
     }
+    Ok(())
 }
 
 /// What `--auto` changed, as JSON.
@@ -330,7 +334,7 @@ fn report(
     out: &StageOutputs,
     written: &[PathBuf],
     proposal: Option<&AutoResult>,
-) {
+) -> anyhow::Result<()> {
     let t = &out.timings;
     let shown = |p: &PathBuf| crate::formats::sanitize(&p.display().to_string());
     if a.json {
@@ -355,37 +359,38 @@ fn report(
         if let (Some(r), Some(obj)) = (proposal, v.as_object_mut()) {
             obj.insert("auto".to_string(), auto_json(r));
         }
-        println!("{v}");
-        return;
+        outln!("{v}");
+        return Ok(());
     }
     let ms = |us: u64| us as f64 / 1000.0;
-    println!(
+    outln!(
         "{stem} ({}): {} × {}",
         files.iter().map(shown).collect::<Vec<_>>().join(" "),
         size.0,
         size.1
     );
-    println!(
+    outln!(
         "  edge points  H {:>6}   V {:>6}",
         out.edges_h.points.len(),
         out.edges_v.points.len()
     );
-    println!(
+    outln!(
         "  lines        {:>6} extracted, {} after CONNECT",
         out.lines_raw.len(),
         out.lines.len()
     );
-    println!(
+    outln!(
         "  time (ms)    lens {:.2}  edges {:.2}  lines {:.2}  connect {:.2}",
         ms(t.lens_us),
         ms(t.edges_us),
         ms(t.lines_us),
         ms(t.connect_us)
     );
-    println!(
+    outln!(
         "  wrote        {}",
         written.iter().map(shown).collect::<Vec<_>>().join(" ")
     );
+    Ok(())
 }
 
 #[cfg(test)]

@@ -56,7 +56,7 @@ pub enum Cmd {
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     match a.cmd {
         Cmd::List => {
-            print!("{}", list_text());
+            out!("{}", list_text());
             Ok(ExitCode::SUCCESS)
         }
         Cmd::Export { profile, set, out } => {
@@ -73,7 +73,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                         f.name
                     );
                 }
-                None => print!("{}", format_par(&f)),
+                None => out!("{}", format_par(&f)),
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -116,7 +116,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                         file.display()
                     );
                 }
-                None => print!("{}", llv_toml(&params)),
+                None => out!("{}", llv_toml(&params)),
             }
             Ok(ExitCode::SUCCESS)
         }

@@ -58,7 +58,7 @@ pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
 fn write(path: &Path, text: &str) -> anyhow::Result<()> {
     write_atomic(path, text.as_bytes())
         .with_context(|| format!("cannot write {}", path.display()))?;
-    println!("wrote {}", path.display());
+    outln!("wrote {}", path.display());
     Ok(())
 }
 

@@ -52,9 +52,9 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     };
     let report = evaluate(&cfg, &profile.llv).context("running the pipeline on the scenes")?;
     if a.json {
-        println!("{}", serde_json::to_string(&report)?);
+        outln!("{}", serde_json::to_string(&report)?);
     } else {
-        print!(
+        out!(
             "{}",
             table(&report, g.profile.as_deref().unwrap_or("default"))
         );

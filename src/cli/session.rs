@@ -159,21 +159,24 @@ fn new(g: &Global, name: &str, dir: Option<PathBuf>) -> anyhow::Result<ExitCode>
     if let Some(w) = s.name().dos_warning(s.manifest().session.planned_images) {
         eprintln!("vss: note: {w}");
     }
-    println!("created session {}", s.dir().display());
-    print_checklist(&s);
+    outln!("created session {}", s.dir().display());
+    print_checklist(&s)?;
     Ok(ExitCode::SUCCESS)
 }
 
 fn show(dir: &Path) -> anyhow::Result<ExitCode> {
     let s = Session::inspect(dir)?;
     let m = s.manifest();
-    println!("session {} in {}", m.session.name, s.dir().display());
-    println!(
+    outln!("session {} in {}", m.session.name, s.dir().display());
+    outln!(
         "  created {}, modified {} by vss {}, profile {:?}",
-        m.session.created, m.session.modified, m.session.version, m.session.profile
+        m.session.created,
+        m.session.modified,
+        m.session.version,
+        m.session.profile
     );
     match s.lock_holder() {
-        Some(h) => println!(
+        Some(h) => outln!(
             "  in use by {h}{}",
             if h.is_stale() {
                 " (gone: stale lock)"
@@ -181,11 +184,11 @@ fn show(dir: &Path) -> anyhow::Result<ExitCode> {
                 ""
             }
         ),
-        None => println!("  not in use"),
+        None => outln!("  not in use"),
     }
-    println!("lightings:");
+    outln!("lightings:");
     for l in &m.lighting {
-        println!(
+        outln!(
             "  {}: {}{}",
             l.letter,
             if l.on.is_empty() {
@@ -200,30 +203,38 @@ fn show(dir: &Path) -> anyhow::Result<ExitCode> {
             }
         );
     }
-    print_checklist(&s);
+    print_checklist(&s)?;
     for r in &m.image {
         if let Some(o) = &r.outputs {
             let c = &o.counts;
-            println!(
+            outln!(
                 "  image {}: {} + {} edge points, {} lines extracted, {} lines; made {}",
-                r.number, c.edges_h, c.edges_v, c.lines_raw, c.lines, o.made
+                r.number,
+                c.edges_h,
+                c.edges_v,
+                c.lines_raw,
+                c.lines,
+                o.made
             );
         }
         for e in &r.edit {
-            println!(
+            outln!(
                 "  image {}: edit {} at {} -> {} lines",
-                r.number, e.op, e.at, e.lines
+                r.number,
+                e.op,
+                e.at,
+                e.lines
             );
         }
     }
     Ok(ExitCode::SUCCESS)
 }
 
-fn print_checklist(s: &Session) {
+fn print_checklist(s: &Session) -> anyhow::Result<()> {
     let p = s.progress();
     let (done, all) = p.done();
-    println!("checklist ({done} of {all} images done):");
-    println!("  image camera location captured  outputs");
+    outln!("checklist ({done} of {all} images done):");
+    outln!("  image camera location captured  outputs");
     for i in &p.images {
         let captured: String = p
             .letters
@@ -240,31 +251,34 @@ fn print_checklist(s: &Session) {
         } else {
             String::new()
         };
-        println!(
+        outln!(
             "  {:>5} {:>6} {:>8} {captured:<9} {out}{edits}",
-            i.number, i.camera, i.location
+            i.number,
+            i.camera,
+            i.location
         );
     }
     match p.next_step() {
-        Some(step) => println!("next: {step}"),
-        None => println!("next: nothing, the survey is complete"),
+        Some(step) => outln!("next: {step}"),
+        None => outln!("next: nothing, the survey is complete"),
     }
+    Ok(())
 }
 
 fn check(dir: &Path, strict: bool) -> anyhow::Result<ExitCode> {
     let s = Session::inspect(dir)?;
     let r = s.check();
     for p in &r.problems {
-        println!("problem: {p}");
+        outln!("problem: {p}");
     }
     for w in &r.warnings {
-        println!("warning: {w}");
+        outln!("warning: {w}");
     }
     for (k, why) in &r.stale {
-        println!("stale: image {k}: {why}");
+        outln!("stale: image {k}: {why}");
     }
     let bad = !r.problems.is_empty() || (strict && (!r.warnings.is_empty() || !r.stale.is_empty()));
-    println!(
+    outln!(
         "{}: {} files read, {} problems, {} warnings, {} stale",
         if bad { "FAILED" } else { "ok" },
         r.checked,
@@ -295,6 +309,6 @@ fn redo(g: &Global, dir: &Path, k: u32, from: &str, take_over: bool) -> anyhow::
     let summary = s
         .redo(k, stage, &profile.llv)
         .with_context(|| format!("redo image {k} of {}", dir.display()))?;
-    println!("{summary}");
+    outln!("{summary}");
     Ok(ExitCode::SUCCESS)
 }
