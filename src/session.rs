@@ -40,6 +40,25 @@ pub use redo::RedoSummary;
 
 use manifest::{EditRecord, FileRecord, GreyRecord, ImageRecord, LightingInfo, SessionInfo};
 
+/// The largest image number a session accepts, and the most images it may
+/// plan. The number goes into every file name of the image (`cube9999b.img`,
+/// spec/formats.md §1) and the checklist has a line for every number up to
+/// the largest, so an unbounded number (`vss grab --image 4294967295`, or a
+/// hand-edited `planned_images`) would size a checklist of four billion
+/// lines. A survey is a few cameras at a few locations, tens of images; four
+/// digits are far beyond that and keep the per-number work (the checklist,
+/// the `.cdf` copies of `vss session new`) to a few thousand steps.
+pub const MAX_IMAGE_NUMBER: u32 = 9999;
+
+/// Checks that `k` is an image number a session accepts: 1 to
+/// [`MAX_IMAGE_NUMBER`].
+pub fn check_image_number(k: u32) -> Result<(), SessionError> {
+    if k == 0 || k > MAX_IMAGE_NUMBER {
+        return Err(SessionError::BadImage(k));
+    }
+    Ok(())
+}
+
 /// What can go wrong with a session; every message names the file or folder
 /// and says what to do.
 #[derive(Debug, thiserror::Error)]
@@ -49,11 +68,13 @@ pub enum SessionError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{0}")]
+    // Transparent, not "{0}": with "{0}" the wrapped error was also the
+    // source, and `vss` printed its message twice.
+    #[error(transparent)]
     Name(#[from] NameError),
-    #[error("{0}")]
+    #[error(transparent)]
     Format(#[from] FormatError),
-    #[error("{0}")]
+    #[error(transparent)]
     Llv(#[from] LlvError),
     #[error(
         "session {} already exists; open it instead (`vss session show {}`)",
@@ -89,8 +110,12 @@ pub enum SessionError {
     ReadOnly { dir: PathBuf },
     #[error("lighting {letter:?} is not one of this session's lightings ({known})")]
     UnknownLighting { letter: char, known: String },
-    #[error("image number {0} is out of range: image numbers start at 1")]
+    #[error("image number {0} is out of range: image numbers run from 1 to {MAX_IMAGE_NUMBER}")]
     BadImage(u32),
+    #[error(
+        "{0} planned images are more than a session holds: image numbers run from 1 to {MAX_IMAGE_NUMBER}"
+    )]
+    TooManyImages(u32),
     #[error("image {image} of session {session}: {what}")]
     Missing {
         session: String,
@@ -209,12 +234,21 @@ impl Session {
         name: &str,
         profile: &Profile,
     ) -> Result<Session, SessionError> {
+        match Self::open_existing(parent, name)? {
+            Some(s) => Ok(s),
+            None => Self::create(parent, name, profile),
+        }
+    }
+
+    /// Opens `parent/name` for writing if it is a session; `None` when there
+    /// is none yet (and nothing is made).
+    pub fn open_existing(parent: &Path, name: &str) -> Result<Option<Session>, SessionError> {
         let n = SessionName::new(name)?;
         let dir = parent.join(n.as_str());
         if dir.join(format!("{n}.toml")).exists() {
-            Self::open(&dir)
+            Self::open(&dir).map(Some)
         } else {
-            Self::create(parent, name, profile)
+            Ok(None)
         }
     }
 
@@ -324,9 +358,12 @@ impl Session {
         .file_name()
     }
 
-    /// Sets how many images the survey plans.
+    /// Sets how many images the survey plans (at most [`MAX_IMAGE_NUMBER`]).
     pub fn set_planned_images(&mut self, n: u32) -> Result<(), SessionError> {
         self.writable()?;
+        if n > MAX_IMAGE_NUMBER {
+            return Err(SessionError::TooManyImages(n));
+        }
         self.manifest.session.planned_images = n.max(1);
         self.commit()
     }
@@ -342,6 +379,7 @@ impl Session {
         cdf: Option<&Path>,
     ) -> Result<(), SessionError> {
         self.writable()?;
+        check_image_number(k)?;
         let cdf_record = match cdf {
             Some(src) => {
                 let parsed = formats::cdf::read_cdf(src)?;
@@ -373,6 +411,7 @@ impl Session {
         img: &ImgFile,
     ) -> Result<PathBuf, SessionError> {
         self.writable()?;
+        check_image_number(k)?;
         if !self.letters().contains(&letter) {
             return Err(SessionError::UnknownLighting {
                 letter,
@@ -415,6 +454,7 @@ impl Session {
     /// as the new `NAMEk.ldr`, then appends `op` to the edit log.
     pub fn record_edit(&mut self, k: u32, op: &str, lines: &[Segment]) -> Result<(), SessionError> {
         self.writable()?;
+        check_image_number(k)?;
         let file = self.file_name(k, None, "ldr");
         let bytes = formats::lines::format_lines(lines).into_bytes();
         self.write_file(&file, &bytes)?;
@@ -468,9 +508,7 @@ impl Session {
     /// The record of image `k`, made with the default camera and location
     /// (images go round the cameras, then to the next location).
     fn record_mut(&mut self, k: u32) -> Result<&mut ImageRecord, SessionError> {
-        if k == 0 {
-            return Err(SessionError::BadImage(k));
-        }
+        check_image_number(k)?;
         let cams = self.manifest.session.cameras.max(1);
         let pos = match self.manifest.image.binary_search_by_key(&k, |r| r.number) {
             Ok(i) => i,

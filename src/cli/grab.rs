@@ -7,7 +7,9 @@
 //! The images go through the session (`crate::session`): `DIR/NAME` is
 //! opened, or created from the profile, and its lock taken, so a console
 //! surveying the same session is not written under, and every frame lands
-//! in the manifest with the camera and its `.cdf`.
+//! in the manifest with the camera and its `.cdf`. The image number, camera
+//! and lightings are checked before a new session is made, so a refused
+//! grab leaves nothing behind.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -55,6 +57,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("{}: the session path ends in no name", a.session.display()))?;
     let session = SessionName::new(name)
         .with_context(|| format!("{}: not a valid session name", a.session.display()))?;
+    crate::session::check_image_number(a.image).context("--image")?;
     let files: Vec<(char, PathBuf)> = a
         .lighting
         .iter()
@@ -85,7 +88,9 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let mut sess = Session::open_or_create(&parent, session.as_str(), &profile)
+    // An existing session is locked before the grabber is touched; a new
+    // one is made only once the camera and lightings are known good.
+    let existing = Session::open_existing(&parent, session.as_str())
         .with_context(|| format!("cannot open the session {}", a.session.display()))?;
     let faults = match &a.sim_faults {
         Some(s) => Faults::parse(s)?,
@@ -112,6 +117,20 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     }
     for (letter, _) in &files {
         cell.mask_for(*letter)?;
+    }
+    let mut sess = match existing {
+        Some(s) => s,
+        None => Session::create(&parent, session.as_str(), &profile)
+            .with_context(|| format!("cannot create the session {}", a.session.display()))?,
+    };
+    // A session made with another profile may letter its lightings otherwise.
+    let known = sess.letters();
+    if let Some(letter) = a.lighting.iter().find(|l| !known.contains(l)) {
+        bail!(
+            "lighting {letter} is not one of the lightings of session {} ({}); nothing was captured",
+            a.session.display(),
+            known.iter().collect::<String>()
+        );
     }
     let cdf = profile.cdf_path(a.camera).filter(|p| p.is_file());
     sess.set_image_info(a.image, a.camera, 1, cdf.as_deref())
@@ -161,7 +180,7 @@ fn capture_one(
     } else {
         cap.lights_on.join(", ")
     };
-    println!(
+    outln!(
         "{}: camera {camera}, lighting {letter} ({on}), crc {:08X}, {} ms",
         path.display(),
         cap.frame.crc,

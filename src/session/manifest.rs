@@ -7,7 +7,8 @@
 //!
 //! It is plain serde + TOML, readable and editable by a person. Loading is
 //! strict (unknown keys are errors) and then checked for sense (unique image
-//! numbers and letters, file names that stay inside the session folder), so
+//! numbers and letters, image numbers and `planned_images` within
+//! [`MAX_IMAGE_NUMBER`], file names that stay inside the session folder), so
 //! a manifest edited into nonsense is reported with its file and line and
 //! never silently rewritten.
 
@@ -15,7 +16,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::SessionError;
+use super::{MAX_IMAGE_NUMBER, SessionError};
 use crate::llv::{Params, Segment};
 
 /// Version of the manifest schema this console writes.
@@ -47,7 +48,8 @@ pub struct SessionInfo {
     /// Name of the profile the session was made with.
     #[serde(default)]
     pub profile: String,
-    /// Images the survey plans (the checklist's length).
+    /// Images the survey plans (the checklist's length), at most
+    /// [`MAX_IMAGE_NUMBER`].
     pub planned_images: u32,
     pub cameras: u32,
 }
@@ -287,6 +289,15 @@ impl Manifest {
         if self.session.cameras == 0 {
             return Err((Some("cameras".into()), "cameras must be at least 1".into()));
         }
+        if self.session.planned_images > MAX_IMAGE_NUMBER {
+            return Err((
+                Some("planned_images".into()),
+                format!(
+                    "planned_images {} is more than a session holds: image numbers run from 1 to {MAX_IMAGE_NUMBER}",
+                    self.session.planned_images
+                ),
+            ));
+        }
         let mut letters = Vec::new();
         for l in &self.lighting {
             if !l.letter.is_ascii_lowercase() {
@@ -303,16 +314,21 @@ impl Manifest {
             }
             letters.push(l.letter);
         }
-        let mut numbers = Vec::new();
+        let mut numbers = std::collections::BTreeSet::new();
         for r in &self.image {
             let at = Some(format!("number = {}", r.number));
-            if r.number == 0 || numbers.contains(&r.number) {
+            if r.number == 0 || r.number > MAX_IMAGE_NUMBER {
                 return Err((
                     at,
-                    format!("image number {} is 0 or appears twice", r.number),
+                    format!(
+                        "image number {} is out of range: image numbers run from 1 to {MAX_IMAGE_NUMBER}",
+                        r.number
+                    ),
                 ));
             }
-            numbers.push(r.number);
+            if !numbers.insert(r.number) {
+                return Err((at, format!("image number {} appears twice", r.number)));
+            }
             for g in &r.grey {
                 if !letters.contains(&g.letter) {
                     return Err((
@@ -474,6 +490,28 @@ mod tests {
         assert!(err.contains("appears twice"), "{err}");
         let line = text.lines().position(|l| l == "letter = \"a\"").unwrap() + 1;
         assert!(err.starts_with(&format!("cube.toml:{line}:")), "{err}");
+
+        let mut m = full();
+        m.image[0].number = MAX_IMAGE_NUMBER + 1;
+        let text = m.to_toml().unwrap();
+        let err = Manifest::parse(&text, Path::new("cube.toml"))
+            .unwrap_err()
+            .to_string();
+        let line = text
+            .lines()
+            .position(|l| l == format!("number = {}", MAX_IMAGE_NUMBER + 1))
+            .unwrap()
+            + 1;
+        assert!(err.starts_with(&format!("cube.toml:{line}:")), "{err}");
+        assert!(err.contains(&format!("1 to {MAX_IMAGE_NUMBER}")), "{err}");
+
+        let mut m = full();
+        m.session.planned_images = u32::MAX;
+        let err = Manifest::parse(&m.to_toml().unwrap(), Path::new("c.toml")).unwrap_err();
+        assert!(
+            err.to_string().contains("planned_images 4294967295"),
+            "{err}"
+        );
 
         let mut m = full();
         m.format = 9;

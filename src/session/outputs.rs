@@ -35,6 +35,7 @@ impl Session {
         params: &Params,
     ) -> Result<(), SessionError> {
         self.writable()?;
+        super::check_image_number(k)?;
         let letters: Vec<char> = self
             .manifest
             .image(k)

@@ -3,6 +3,7 @@
 //! whether its outputs are done, missing or stale, how many manual edits;
 //! and the resume point, the first thing left to do.
 
+use super::MAX_IMAGE_NUMBER;
 use super::manifest::{ImageRecord, Manifest};
 
 /// State of the stage outputs of one image.
@@ -92,6 +93,11 @@ impl Progress {
     }
 }
 
+/// The checklist of `m`: a line for every number from 1 to the planned
+/// images or the largest recorded number, whichever is more. A manifest that
+/// did not pass [`Manifest::parse`] may hold numbers beyond
+/// [`MAX_IMAGE_NUMBER`]: the lines without a record stop there and records
+/// beyond it are listed as they are, so no number sizes the list.
 pub fn progress(m: &Manifest) -> Progress {
     let letters: Vec<char> = m.lighting.iter().map(|l| l.letter).collect();
     let last = m
@@ -100,27 +106,21 @@ pub fn progress(m: &Manifest) -> Progress {
         .map(|r| r.number)
         .max()
         .unwrap_or(0)
-        .max(m.session.planned_images);
+        .max(m.session.planned_images)
+        .min(MAX_IMAGE_NUMBER);
     let cams = m.session.cameras.max(1);
-    let images = (1..=last)
-        .map(|k| match m.image(k) {
-            Some(r) => {
-                let captured: Vec<char> = r.grey.iter().map(|g| g.letter).collect();
-                ImageProgress {
-                    number: k,
-                    camera: r.camera,
-                    location: r.location,
-                    missing: letters
-                        .iter()
-                        .copied()
-                        .filter(|l| !captured.contains(l))
-                        .collect(),
-                    captured,
-                    outputs: output_state(r),
-                    edits: r.edit.len(),
-                }
-            }
-            None => ImageProgress {
+    // Walk the records in number order beside the numbers, rather than
+    // search the records for every number. A stable sort keeps the first of
+    // duplicate numbers first, the one `Manifest::image` finds.
+    let mut records: Vec<&ImageRecord> = m.image.iter().filter(|r| r.number > 0).collect();
+    records.sort_by_key(|r| r.number);
+    records.dedup_by_key(|r| r.number);
+    let mut recorded = records.into_iter().peekable();
+    let mut images = Vec::new();
+    for k in 1..=last {
+        match recorded.next_if(|r| r.number == k) {
+            Some(r) => images.push(from_record(r, &letters)),
+            None => images.push(ImageProgress {
                 number: k,
                 camera: (k - 1) % cams + 1,
                 location: (k - 1) / cams + 1,
@@ -128,10 +128,29 @@ pub fn progress(m: &Manifest) -> Progress {
                 missing: letters.clone(),
                 outputs: OutputState::Missing,
                 edits: 0,
-            },
-        })
-        .collect();
+            }),
+        }
+    }
+    images.extend(recorded.map(|r| from_record(r, &letters)));
     Progress { letters, images }
+}
+
+/// The checklist line of a recorded image.
+fn from_record(r: &ImageRecord, letters: &[char]) -> ImageProgress {
+    let captured: Vec<char> = r.grey.iter().map(|g| g.letter).collect();
+    ImageProgress {
+        number: r.number,
+        camera: r.camera,
+        location: r.location,
+        missing: letters
+            .iter()
+            .copied()
+            .filter(|l| !captured.contains(l))
+            .collect(),
+        captured,
+        outputs: output_state(r),
+        edits: r.edit.len(),
+    }
 }
 
 /// Whether the outputs of `r` were made from the inputs now recorded.
@@ -169,5 +188,69 @@ pub fn output_state(r: &ImageRecord) -> OutputState {
         OutputState::Done
     } else {
         OutputState::Stale(why.join("; "))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::session::manifest::{FORMAT, LightingInfo, SessionInfo};
+
+    fn manifest(planned: u32, numbers: &[u32]) -> Manifest {
+        Manifest {
+            format: FORMAT,
+            session: SessionInfo {
+                name: "cube".into(),
+                created: String::new(),
+                modified: String::new(),
+                version: String::new(),
+                profile: String::new(),
+                planned_images: planned,
+                cameras: 2,
+            },
+            lighting: vec![LightingInfo {
+                letter: 'a',
+                on: Vec::new(),
+                note: String::new(),
+            }],
+            image: numbers
+                .iter()
+                .map(|&number| ImageRecord {
+                    number,
+                    camera: 9,
+                    location: 9,
+                    cdf: None,
+                    grey: Vec::new(),
+                    outputs: None,
+                    edit: Vec::new(),
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn a_line_for_every_number_up_to_the_largest() {
+        let p = progress(&manifest(2, &[5, 3]));
+        let numbers: Vec<u32> = p.images.iter().map(|i| i.number).collect();
+        assert_eq!(numbers, [1, 2, 3, 4, 5]);
+        // Recorded images keep their camera; the others go round the cameras.
+        let cams: Vec<u32> = p.images.iter().map(|i| i.camera).collect();
+        assert_eq!(cams, [1, 2, 9, 2, 9]);
+        assert_eq!(
+            p.next_step(),
+            Some(Step::Capture {
+                image: 1,
+                letter: 'a'
+            })
+        );
+    }
+
+    #[test]
+    fn numbers_beyond_the_limit_do_not_size_the_checklist() {
+        // Not a manifest that loads (validate refuses it); one built in memory.
+        let p = progress(&manifest(u32::MAX, &[u32::MAX, 2]));
+        assert_eq!(p.images.len(), MAX_IMAGE_NUMBER as usize + 1);
+        assert_eq!(p.images.last().map(|i| i.number), Some(u32::MAX));
+        assert_eq!(p.images[1].camera, 9, "image 2 from its record");
     }
 }

@@ -135,6 +135,7 @@ impl Session {
         params: &Params,
     ) -> Result<RedoSummary, SessionError> {
         self.writable()?;
+        super::check_image_number(k)?;
         let name = self.name.to_string();
         let missing = |what: String| SessionError::Missing {
             session: name.clone(),
