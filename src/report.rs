@@ -5,10 +5,12 @@
 //! plain data ([`GreyImage`], [`Segment`], [`EdgePoints`]); saving goes
 //! through [`crate::fsutil::write_atomic`].
 
+pub mod clip;
 pub mod encode;
 pub mod ps;
 pub mod svg;
 
+use crate::formats::edgefile::MAX_SIDE;
 use crate::llv::{EdgePoints, GreyImage, Segment};
 
 /// Everything the report shows about one image number of a survey.
@@ -30,16 +32,55 @@ pub struct ImageReport {
     pub notes: Vec<String>,
 }
 
+/// Most pixels an edge image may have: 2^26, e.g. 8192 × 8192, 256 times a
+/// 512 × 512 cell picture. An edge image is allocated from a size that a file
+/// header or the manifest states, not from pixels read, so the size is
+/// checked first; its PostScript is already 128 MiB of hex at this limit.
+pub const MAX_PICTURE_PIXELS: usize = 1 << 26;
+
+/// A picture size the report will not allocate an image for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "a picture of {width} x {height} pixels cannot be drawn: the report draws 1 to {MAX_SIDE} \
+     pixels a side and at most {MAX_PICTURE_PIXELS} in all"
+)]
+pub struct PictureSizeError {
+    pub width: usize,
+    pub height: usize,
+}
+
+/// Checks a picture size before an image of that size is allocated: each
+/// side 1 to [`MAX_SIDE`] (the `.img` and edge-file limit) and at most
+/// [`MAX_PICTURE_PIXELS`] in all.
+pub fn check_picture_size(width: usize, height: usize) -> Result<(), PictureSizeError> {
+    let side = |v: usize| (1..=MAX_SIDE).contains(&v);
+    if side(width) && side(height) && width.saturating_mul(height) <= MAX_PICTURE_PIXELS {
+        Ok(())
+    } else {
+        Err(PictureSizeError { width, height })
+    }
+}
+
 /// Renders edge points as a grey image the size of the picture: white paper,
 /// each point a dark pixel (darker for a stronger response), so the edge
-/// image prints with the same `image` operator as a grey image.
-pub fn edge_image(e: &EdgePoints, width: usize, height: usize) -> Option<GreyImage> {
+/// image prints with the same `image` operator as a grey image. The size is
+/// the edge file's, or `width × height` when the file gives none; it is
+/// checked with [`check_picture_size`] before anything is allocated.
+pub fn edge_image(
+    e: &EdgePoints,
+    width: usize,
+    height: usize,
+) -> Result<GreyImage, PictureSizeError> {
     let (w, h) = if e.width > 0 && e.height > 0 {
         (e.width, e.height)
     } else {
         (width, height)
     };
-    let mut img = GreyImage::filled(w, h, 255).ok()?;
+    check_picture_size(w, h)?;
+    let mut img = GreyImage::filled(w, h, 255).map_err(|_| PictureSizeError {
+        width: w,
+        height: h,
+    })?;
     let max = e
         .points
         .iter()
@@ -66,7 +107,7 @@ pub fn edge_image(e: &EdgePoints, width: usize, height: usize) -> Option<GreyIma
             *px = v as u8;
         }
     }
-    Some(img)
+    Ok(img)
 }
 
 /// Text safe for a PostScript string or an XML attribute: printable ASCII
@@ -116,6 +157,30 @@ mod tests {
         assert_eq!(img.size(), (20, 10));
         assert_eq!(img.get(3, 4), Some(0));
         assert_eq!(img.data().iter().filter(|&&v| v < 255).count(), 1);
+    }
+
+    #[test]
+    fn edge_image_refuses_sizes_it_cannot_allocate() {
+        let e = |width, height| EdgePoints {
+            width,
+            height,
+            ..Default::default()
+        };
+        // From the edge file's header, or the fallback size when it has none.
+        for (edges, w, h) in [
+            (e(100_000, 100_000), 10, 10),
+            (e(usize::MAX, usize::MAX), 10, 10),
+            (e(MAX_SIDE, MAX_SIDE), 10, 10),
+            (e(0, 0), 4_000_000_000, 4_000_000_000),
+            (e(0, 0), 0, 0),
+        ] {
+            let err = edge_image(&edges, w, h).unwrap_err();
+            assert!(err.to_string().contains("cannot be drawn"), "{err}");
+        }
+        assert_eq!(edge_image(&e(0, 5), 8, 6).unwrap().size(), (8, 6));
+        assert!(check_picture_size(8192, 8192).is_ok());
+        assert!(check_picture_size(MAX_SIDE, 1024).is_ok());
+        assert!(check_picture_size(MAX_SIDE + 1, 1).is_err());
     }
 
     #[test]

@@ -202,8 +202,8 @@ proptest! {
     #[test]
     fn edges_round_trip(
         dir in prop_oneof![Just(None), Just(Some(ScanDir::Horizontal)), Just(Some(ScanDir::Vertical))],
-        width in 0usize..100_000,
-        height in 0usize..100_000,
+        width in 0usize..=vss::formats::edgefile::MAX_SIDE,
+        height in 0usize..=vss::formats::edgefile::MAX_SIDE,
         pts in proptest::collection::vec(
             (any::<f32>(), any::<f32>(), any::<f32>()).prop_filter("finite", |(x, y, r)| x.is_finite() && y.is_finite() && r.is_finite()),
             0..200)

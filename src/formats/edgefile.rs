@@ -12,7 +12,8 @@
 //! pixel), the response is the signed Lee response, so line extraction can be
 //! re-run from the file alone. The file size must be exactly header + 12 ×
 //! count: the count is checked against the real size before anything is
-//! allocated, and every value must be finite.
+//! allocated, and every value must be finite. Width and height are at most
+//! [`MAX_SIDE`], the largest an `.img` can hold; 0 means "not known".
 
 use std::path::Path;
 
@@ -27,6 +28,11 @@ pub const VERSION: u32 = 1;
 const MAX_HEADER: usize = 128;
 /// Bytes per point.
 pub const POINT_LEN: usize = 12;
+/// Largest width or height a header may give: 65535 pixels, the most an
+/// `.img` can hold (its size fields are 16-bit, formats.md §2), so every edge
+/// file of a cell image fits and no header can promise a larger picture than
+/// the grey images it came from.
+pub const MAX_SIDE: usize = u16::MAX as usize;
 
 fn dir_letter(d: Option<ScanDir>) -> char {
     match d {
@@ -138,6 +144,18 @@ pub fn parse_edges(bytes: &[u8], path: &Path) -> Result<EdgePoints, FormatError>
         num(h, "height")?,
         num(count, "point count")?,
     );
+    for (what, v) in [("width", width), ("height", height)] {
+        if v > MAX_SIDE {
+            return Err(FormatError::at_byte(
+                path,
+                0,
+                K::Range,
+                format!(
+                    "header gives an image {what} of {v} pixels; at most {MAX_SIDE} (the largest .img)"
+                ),
+            ));
+        }
+    }
     let body = bytes.get(nl + 1..).unwrap_or(&[]);
     let need = (count as u64).saturating_mul(POINT_LEN as u64);
     if body.len() as u64 != need {
@@ -200,8 +218,20 @@ pub fn read_edges_header(path: &Path) -> Result<EdgePoints, FormatError> {
     Ok(e)
 }
 
-/// Writes a `.hpo`/`.vpo` file atomically; non-finite values are refused.
+/// Writes a `.hpo`/`.vpo` file atomically; non-finite values and a width or
+/// height over [`MAX_SIDE`] (which [`read_edges`] would refuse) are refused.
 pub fn write_edges(path: &Path, e: &EdgePoints) -> Result<(), FormatError> {
+    if e.width > MAX_SIDE || e.height > MAX_SIDE {
+        return Err(FormatError::new(
+            path,
+            super::Location::None,
+            K::Range,
+            format!(
+                "image of {} x {} pixels is too large for an edge file (at most {MAX_SIDE} a side)",
+                e.width, e.height
+            ),
+        ));
+    }
     if let Some(k) = e
         .points
         .iter()
@@ -251,5 +281,31 @@ mod tests {
         let b = b"VSSEDGE 1 H 10 10 18446744073709551615\n\0\0\0\0";
         let e = parse_edges(b, Path::new("a.hpo")).unwrap_err();
         assert_eq!(e.kind, K::Truncated);
+    }
+
+    #[test]
+    fn image_size_over_the_img_limit_refused_at_the_header() {
+        let point = [1.0f32, 1.0, 10.0].map(f32::to_le_bytes).concat();
+        let file = |w: &str, h: &str| {
+            let mut b = format!("VSSEDGE 1 H {w} {h} 1\n").into_bytes();
+            b.extend_from_slice(&point);
+            parse_edges(&b, Path::new("cube1.hpo"))
+        };
+        for (w, h) in [
+            ("65536", "10"),
+            ("10", "100000"),
+            ("1000000000000", "1"),
+            ("18446744073709551615", "18446744073709551615"),
+        ] {
+            let e = file(w, h).unwrap_err();
+            assert_eq!(e.kind, K::Range, "{w} x {h}");
+            assert_eq!(e.location, crate::formats::Location::Byte(0));
+            let text = e.to_string();
+            assert!(text.starts_with("cube1.hpo: byte 0: "), "{text}");
+            assert!(text.contains("at most 65535"), "{text}");
+        }
+        let e = file("65535", "0").unwrap();
+        assert_eq!((e.width, e.height), (MAX_SIDE, 0));
+        assert_eq!(e.points.len(), 1);
     }
 }

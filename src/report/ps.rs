@@ -10,6 +10,7 @@
 
 use std::fmt::Write as _;
 
+use super::clip::DrawBox;
 use super::{ImageReport, edge_image, encode, printable};
 use crate::llv::{GreyImage, Segment};
 
@@ -101,20 +102,23 @@ impl PsDoc {
     /// The survey report pages of one image: its grey and edge images, then
     /// the raw and connected lines side by side with the notes below.
     pub fn image_report(&mut self, r: &ImageReport) {
-        let edges: Vec<(String, GreyImage)> = [
+        // An edge image that cannot be drawn is left out with a note, like a
+        // file the report cannot read.
+        let mut notes = r.notes.clone();
+        let mut edges: Vec<(String, GreyImage)> = Vec::new();
+        for (e, what) in [
             (r.edges_h.as_ref(), "horizontal scan"),
             (r.edges_v.as_ref(), "vertical scan"),
-        ]
-        .into_iter()
-        .filter_map(|(e, what)| {
-            let e = e?;
-            let img = edge_image(e, r.width, r.height)?;
-            Some((
-                format!("{}: edges, {what} ({} points)", r.title, e.points.len()),
-                img,
-            ))
-        })
-        .collect();
+        ] {
+            let Some(e) = e else { continue };
+            match edge_image(e, r.width, r.height) {
+                Ok(img) => edges.push((
+                    format!("{}: edges, {what} ({} points)", r.title, e.points.len()),
+                    img,
+                )),
+                Err(err) => notes.push(format!("cannot show the edges, {what}: {err}")),
+            }
+        }
         let cells: Vec<(&str, &GreyImage)> = r
             .greys
             .iter()
@@ -145,7 +149,7 @@ impl PsDoc {
                 (2, 2),
             );
         }
-        let (first, rest) = r.notes.split_at(r.notes.len().min(NOTES_ON_LINE_PAGE));
+        let (first, rest) = notes.split_at(notes.len().min(NOTES_ON_LINE_PAGE));
         text_cell(&mut body, first, (0, 1), (1, 2));
         self.pages.push(body);
         if !rest.is_empty() {
@@ -255,12 +259,12 @@ fn lines_cell(
     let (w, h) = (width.max(1) as f64, height.max(1) as f64);
     let _ = writeln!(out, "gsave\n{w} {h} {col} {row} {nc} {nr} place");
     out.push_str("0 setlinewidth\nframe stroke\nframe clip newpath\n");
+    // Clipped to the drawing box, every number written is within [-1, 2]:
+    // Ghostscript refuses far larger ones (`/limitcheck`).
+    let bx = DrawBox::around(width, height);
     let mut gray = false;
-    for s in lines {
+    for s in lines.iter().filter_map(|s| bx.clip(s)) {
         let coords = [s.a.x / w, 1.0 - s.a.y / h, s.b.x / w, 1.0 - s.b.y / h];
-        if coords.iter().any(|c| !c.is_finite()) {
-            continue;
-        }
         // Shadow lines print grey: the operator sees them but they do not
         // read as object edges.
         if s.shadow != gray {

@@ -7,12 +7,15 @@
 //!
 //! LLV coordinates put the origin at the *centre* of the top-left pixel, SVG
 //! at its corner: the vector layers are shifted by half a pixel so lines sit
-//! on the pixels they were found on.
+//! on the pixels they were found on. Lines are clipped, and edge points far
+//! off the picture left out, by the same [`DrawBox`] as the PostScript, so
+//! no coordinate written is far beyond the picture.
 
 use std::fmt::Write as _;
 
+use super::clip::DrawBox;
 use super::{ImageReport, encode, printable};
-use crate::llv::{EdgePoints, GreyImage, Segment};
+use crate::llv::{EdgePoints, GreyImage, Point, Segment};
 
 /// Escapes text for XML content and attributes.
 fn xml(s: &str) -> String {
@@ -59,17 +62,18 @@ pub fn image_svg(r: &ImageReport) -> String {
         };
         grey_layer(&mut out, &id, caption, img, hidden);
     }
+    let bx = DrawBox::around(w, h);
     if let Some(e) = &r.edges_h {
-        edge_layer(&mut out, "edges-h", e, "#00a0ff");
+        edge_layer(&mut out, "edges-h", e, "#00a0ff", &bx);
     }
     if let Some(e) = &r.edges_v {
-        edge_layer(&mut out, "edges-v", e, "#ff8000");
+        edge_layer(&mut out, "edges-v", e, "#ff8000", &bx);
     }
     if let Some(l) = &r.lines_raw {
-        lines_layer(&mut out, "lines-raw", l, "#00c000", 1.0);
+        lines_layer(&mut out, "lines-raw", l, "#00c000", 1.0, &bx);
     }
     if let Some(l) = &r.lines {
-        lines_layer(&mut out, "lines", l, "#ff0000", 1.0);
+        lines_layer(&mut out, "lines", l, "#ff0000", 1.0, &bx);
     }
     out.push_str("</svg>\n");
     out
@@ -126,13 +130,13 @@ fn grey_layer(out: &mut String, id: &str, caption: &str, img: &GreyImage, hidden
     );
 }
 
-fn edge_layer(out: &mut String, id: &str, e: &EdgePoints, colour: &str) {
+fn edge_layer(out: &mut String, id: &str, e: &EdgePoints, colour: &str, bx: &DrawBox) {
     let _ = writeln!(
         out,
         "<g id=\"{id}\" fill=\"{colour}\" transform=\"translate(0.5 0.5)\">"
     );
     for p in &e.points {
-        if p.x.is_finite() && p.y.is_finite() {
+        if bx.contains(Point::new(f64::from(p.x), f64::from(p.y))) {
             let _ = writeln!(
                 out,
                 "<rect x=\"{:.2}\" y=\"{:.2}\" width=\"0.8\" height=\"0.8\"/>",
@@ -144,24 +148,29 @@ fn edge_layer(out: &mut String, id: &str, e: &EdgePoints, colour: &str) {
     out.push_str("</g>\n");
 }
 
-fn lines_layer(out: &mut String, id: &str, lines: &[Segment], colour: &str, width: f64) {
+fn lines_layer(
+    out: &mut String,
+    id: &str,
+    lines: &[Segment],
+    colour: &str,
+    width: f64,
+    bx: &DrawBox,
+) {
     let _ = writeln!(
         out,
         "<g id=\"{id}\" stroke=\"{colour}\" stroke-width=\"{width}\" stroke-linecap=\"round\" fill=\"none\" transform=\"translate(0.5 0.5)\">"
     );
-    for s in lines {
-        if [s.a.x, s.a.y, s.b.x, s.b.y].iter().all(|c| c.is_finite()) {
-            let dash = if s.shadow {
-                " stroke-dasharray=\"2 2\""
-            } else {
-                ""
-            };
-            let _ = writeln!(
-                out,
-                "<line x1=\"{:.3}\" y1=\"{:.3}\" x2=\"{:.3}\" y2=\"{:.3}\"{dash}/>",
-                s.a.x, s.a.y, s.b.x, s.b.y
-            );
-        }
+    for s in lines.iter().filter_map(|s| bx.clip(s)) {
+        let dash = if s.shadow {
+            " stroke-dasharray=\"2 2\""
+        } else {
+            ""
+        };
+        let _ = writeln!(
+            out,
+            "<line x1=\"{:.3}\" y1=\"{:.3}\" x2=\"{:.3}\" y2=\"{:.3}\"{dash}/>",
+            s.a.x, s.a.y, s.b.x, s.b.y
+        );
     }
     out.push_str("</g>\n");
 }
@@ -169,7 +178,6 @@ fn lines_layer(out: &mut String, id: &str, lines: &[Segment], colour: &str, widt
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::llv::Point;
 
     #[test]
     fn layers_have_ids_and_view_box_is_pixels() {

@@ -7,7 +7,7 @@
 use super::progress::{OutputState, output_state};
 use super::{Session, SessionError};
 use crate::formats;
-use crate::report::ImageReport;
+use crate::report::{ImageReport, check_picture_size};
 
 impl Session {
     /// The report of image `k`.
@@ -47,10 +47,19 @@ impl Session {
                 Err(e) => notes.push(format!("cannot show {}: {e}", g.file)),
             }
         }
+        // Sizes that come from the manifest or an edge header, not from
+        // pixels read, are checked before the report draws with them.
         if let Some((_, img)) = r.greys.first() {
             (r.width, r.height) = img.size();
         } else if let Some(g) = rec.grey.first() {
-            (r.width, r.height) = (g.width as usize, g.height as usize);
+            let (w, h) = (g.width as usize, g.height as usize);
+            match check_picture_size(w, h) {
+                Ok(()) => (r.width, r.height) = (w, h),
+                Err(e) => notes.push(format!(
+                    "cannot use the size of {} recorded in the manifest: {e}",
+                    g.file
+                )),
+            }
         }
         let mut read_edges = |ext: &str| {
             let file = self.file_name(k, None, ext);
@@ -58,9 +67,17 @@ impl Session {
             if !p.exists() {
                 return None;
             }
-            formats::edgefile::read_edges(&p)
+            let e = formats::edgefile::read_edges(&p)
                 .map_err(|e| notes.push(format!("cannot show {file}: {e}")))
-                .ok()
+                .ok()?;
+            if e.width > 0
+                && e.height > 0
+                && let Err(err) = check_picture_size(e.width, e.height)
+            {
+                notes.push(format!("cannot show {file}: {err}"));
+                return None;
+            }
+            Some(e)
         };
         r.edges_h = read_edges("hpo");
         r.edges_v = read_edges("vpo");
