@@ -71,6 +71,23 @@ fn longest_digit_run(text: &str) -> usize {
         .unwrap_or(0)
 }
 
+/// `vss report sess/cube --image 1 --ps r.ps --svg r.svg` in `dir`.
+fn report_of_image_1(dir: &Path) -> Output {
+    vss_limited(
+        dir,
+        &[
+            "report",
+            "sess/cube",
+            "--image",
+            "1",
+            "--ps",
+            "r.ps",
+            "--svg",
+            "r.svg",
+        ],
+    )
+}
+
 #[test]
 fn huge_edge_header_size_is_a_note_naming_the_file_not_a_crash() {
     let dir = tempfile::tempdir().unwrap();
@@ -87,19 +104,7 @@ fn huge_edge_header_size_is_a_note_naming_the_file_not_a_crash() {
         ("65535", "65535", "cannot be drawn"),
     ] {
         write_edge_file(&sess.join("cube1.hpo"), w, h);
-        let out = vss_limited(
-            dir.path(),
-            &[
-                "report",
-                "sess/cube",
-                "--image",
-                "1",
-                "--ps",
-                "r.ps",
-                "--svg",
-                "r.svg",
-            ],
-        );
+        let out = report_of_image_1(dir.path());
         assert_clean_success(&out, &format!("edge header {w} x {h}"));
         let ps = std::fs::read_to_string(dir.path().join("r.ps")).unwrap();
         let note = ps
@@ -134,19 +139,7 @@ fn huge_image_size_in_the_manifest_is_a_note_not_a_crash() {
     );
     std::fs::write(&manifest, text).unwrap();
     write_edge_file(&sess.join("cube1.hpo"), "0", "0");
-    let out = vss_limited(
-        dir.path(),
-        &[
-            "report",
-            "sess/cube",
-            "--image",
-            "1",
-            "--ps",
-            "r.ps",
-            "--svg",
-            "r.svg",
-        ],
-    );
+    let out = report_of_image_1(dir.path());
     assert_clean_success(&out, "manifest size 4000000000 x 4000000000");
     let ps = std::fs::read_to_string(dir.path().join("r.ps")).unwrap();
     let note = ps
