@@ -1,6 +1,6 @@
 //! LLV benchmarks (divan): each stage and the whole single-image pipeline at
 //! 512² and 2048², on one core, on a realistic scene (anti-aliased polygons
-//! with noise σ = 2, `tests/support/llv_scene.rs`). Lens correction uses a
+//! with noise σ = 2, `tests/it/support/llv_scene.rs`). Lens correction uses a
 //! precomputed map of a distorting camera. Run: `cargo bench --bench llv`.
 
 use divan::{Bencher, black_box};
@@ -11,7 +11,7 @@ use vss::llv::lines::{LineScratch, extract_into};
 use vss::llv::pipeline::{Input, StageOutputs, Workspace};
 use vss::llv::{EdgePoints, GreyImage, Params, ScanDir};
 
-#[path = "../tests/support/llv_scene.rs"]
+#[path = "../tests/it/support/llv_scene.rs"]
 mod llv_scene;
 
 const SIZES: [usize; 2] = [512, 2048];

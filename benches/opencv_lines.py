@@ -1,7 +1,7 @@
 """OpenCV's line detectors on the LLV bench scene, for scale (issue 3).
 
 Times FLD, EDLines and LSD on one core on the same 512² image the LLV
-benchmarks use (`tests/support/llv_scene.rs`, noise σ 2, seed 42), so that
+benchmarks use (`tests/it/support/llv_scene.rs`, noise σ 2, seed 42), so that
 their figures and `cargo bench --bench llv` come from the same machine:
 
     pip install opencv-contrib-python-headless

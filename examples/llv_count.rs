@@ -22,7 +22,7 @@ use vss::llv::lines::{LineScratch, extract_into};
 use vss::llv::pipeline::{Input, Workspace};
 use vss::llv::{EdgePoints, Params, ScanDir};
 
-#[path = "../tests/support/llv_scene.rs"]
+#[path = "../tests/it/support/llv_scene.rs"]
 mod llv_scene;
 
 fn main() {

@@ -1,6 +1,6 @@
 //! Issue 3's accuracy floors, on the synthetic scenes: 12 scenes of 512 × 512
 //! per noise level, blur σ = 1, the default profile's LLV parameters, scored
-//! with the matching rule of issue 3 (`vss::llv::synth::score`).
+//! with the matching rule of the LLV core (`vss::llv::synth::score`).
 //!
 //! The scenes are rendered and the pipeline run once for the whole file (a
 //! `OnceLock`); each test asserts one floor and prints the figures it saw.

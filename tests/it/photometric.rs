@@ -1,4 +1,4 @@
-//! Proof of llv.md §2.6 on synthetic scenes (issue 6): twelve seeded scenes
+//! Proof of llv.md §2.6 on synthetic scenes (several lightings): twelve seeded scenes
 //! of cubes, boxes and L-brackets, each rendered under four point lights (one
 //! at a time, with the default ambient light) plus an ambient-only image, all
 //! with Gaussian noise σ = 5 grey levels. The combination of the four lit
@@ -9,7 +9,7 @@
 //! - mean endpoint distance from the true lines no worse (+0.05 px slack for
 //!   the rounding of a pooled mean).
 //!
-//! Run with `cargo test --test photometric -- --nocapture` for the figures.
+//! Run with `cargo test --test it photometric:: -- --nocapture` for the figures.
 
 use vss::llv::pipeline::{self, Input, StageOutputs};
 use vss::llv::synth::{self, Camera, PointLight, RenderOptions, Scene, Tally};

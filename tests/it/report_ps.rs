@@ -2,8 +2,7 @@
 //! without error and the rendered pages show the lines and images where they
 //! belong, on A4 and on Letter (device-independent scaling).
 
-#[path = "support/gs.rs"]
-mod gs;
+use crate::support::gs;
 
 use vss::llv::{EdgePoint, EdgePoints, GreyImage, Point, ScanDir, Segment};
 use vss::report::{ImageReport, ps};

@@ -1,5 +1,5 @@
 //! `vss llv --auto` and the line attributes as an operator sees them
-//! (issue 6): four lightings plus an ambient image of a synthetic scene.
+//! (several lightings): four lightings plus an ambient image of a synthetic scene.
 
 use std::path::Path;
 

@@ -1,4 +1,4 @@
-//! Shadow lines (llv.md §6, issue 6): a box seen from above casts a shadow
+//! Shadow lines (llv.md §6, several lightings): a box seen from above casts a shadow
 //! on the floor; two images lit by lights close together move the shadow's
 //! outline a few pixels while the box's own edges stay. The pipeline's lines
 //! of both images go through `shadow::flag_shadows`, and the flags are
@@ -10,7 +10,7 @@
 //! detached (a plate held above the floor). The attached one meets the box at
 //! shallow corners, which the line extractor currently runs through, merging
 //! box and shadow edges into one line; those tests wait for the extractor's
-//! stray-point check (see the issue6 report) and run with `--ignored`.
+//! stray-point check and run with `--ignored`.
 
 use vss::llv::pipeline::{self, Input};
 use vss::llv::shadow::{ShadowParams, flag_shadows};

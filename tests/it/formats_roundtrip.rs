@@ -1,5 +1,5 @@
-//! Property tests: every format survives write → read unchanged (formats.md;
-//! issue 2). Generated values cover the whole of what each format can hold:
+//! Property tests: every format survives write → read unchanged (formats.md).
+//! Generated values cover the whole of what each format can hold:
 //! any size and pixels, any 8-bit comment, any corner; any finite number.
 
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! Corner closing measured on synthetic scenes (llv.md §6, issue 6): twelve
+//! Corner closing measured on synthetic scenes (llv.md §6, several lightings): twelve
 //! seeded scenes under their own lights with noise σ = 5, through the
 //! pipeline with `connect.corner_radius` 0 (off) and on. Measured:
 //! - endpoint→corner: the mean distance from the nearest true corner of the
@@ -10,7 +10,7 @@
 //!   can move off it while the corner's other endpoints come much closer;
 //! - precision and recall of the lines (synth's matching rule).
 //!
-//! `cargo test --test issue6_corners -- --nocapture` prints the figures.
+//! `cargo test --test it llv_corners:: -- --nocapture` prints the figures.
 
 use vss::llv::pipeline::{self, Input};
 use vss::llv::synth::{self, RenderOptions};

@@ -1,9 +1,9 @@
-//! Automatic parameters (llv.md §6, issue 6) on synthetic scenes with noise
+//! Automatic parameters (llv.md §6, several lightings) on synthetic scenes with noise
 //! σ = 5: `lines=N` lands near N, and `clean` removes noise lines while the
 //! true edges stay (checked against synth's known edges, which the search
 //! itself never sees).
 //!
-//! `cargo test --test issue6_auto -- --nocapture` prints the figures.
+//! `cargo test --test it llv_auto:: -- --nocapture` prints the figures.
 
 use vss::llv::auto::{self, Target};
 use vss::llv::pipeline::{self, Input};

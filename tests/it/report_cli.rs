@@ -1,8 +1,7 @@
 //! `vss report` end to end: single line and image files (ldr2ps, img2ps) and
 //! a whole session, rendered by Ghostscript and parsed by usvg.
 
-#[path = "support/gs.rs"]
-mod gs;
+use crate::support::gs;
 
 use std::path::Path;
 use std::process::Command;

@@ -5,8 +5,7 @@
 //! gives PostScript that Ghostscript renders and SVG without 300-digit
 //! numbers.
 
-#[path = "support/gs.rs"]
-mod gs;
+use crate::support::gs;
 
 use std::path::{Path, PathBuf};
 use std::process::Output;

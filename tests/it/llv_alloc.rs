@@ -3,43 +3,57 @@
 //! with a precomputed map, edges, lines, CONNECT) in a warm `Workspace`,
 //! for one image and for several lightings plus an ambient image (the
 //! photometric combination of llv.md §2.6, with and without lens).
-//! This file is its own test binary, so the allocator sees only this test.
+//! The allocator is the whole test binary's, and counts per thread: the
+//! other tests running beside these on other threads do not touch the
+//! counts, and the pipeline runs on the calling thread (`threads = 1`).
 //!
-//! `GlobalAlloc` is an unsafe trait: this file is the one place of the crate
-//! that allows `unsafe_code` (Cargo.toml denies it everywhere else). The
-//! impl only forwards to `System` and counts.
+//! `GlobalAlloc` is an unsafe trait: this module is the one place of the
+//! crate that allows `unsafe_code` (Cargo.toml denies it everywhere else).
+//! The impl only forwards to `System` and counts.
 
 #![allow(unsafe_code)]
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 use vss::llv::lens::{CameraModel, LensMap};
 use vss::llv::pipeline::{Input, Workspace};
 use vss::llv::{GreyImage, Params};
 
-#[path = "support/llv_scene.rs"]
-mod llv_scene;
+use crate::support::llv_scene;
 
 struct Counting;
 
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
-static BYTES: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    /// This thread's allocations: (count, bytes). A `const` thread-local of
+    /// a `Cell` has no destructor and never allocates.
+    static COUNTS: Cell<(usize, usize)> = const { Cell::new((0, 0)) };
+}
+
+fn count(bytes: usize) {
+    // `try_with`: during a thread's teardown the slot may be gone.
+    let _ = COUNTS.try_with(|c| {
+        let (n, b) = c.get();
+        c.set((n + 1, b + bytes));
+    });
+}
+
+fn counts() -> (usize, usize) {
+    COUNTS.with(Cell::get)
+}
 
 // SAFETY: every method forwards to `System` with the caller's arguments
-// unchanged; the counters are atomics and never allocate.
+// unchanged; the counters are thread-local cells and never allocate.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::Relaxed);
-        BYTES.fetch_add(layout.size(), Ordering::Relaxed);
+        count(layout.size());
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::Relaxed);
-        BYTES.fetch_add(new_size, Ordering::Relaxed);
+        count(new_size);
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
@@ -47,13 +61,11 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-/// Allocations (count, bytes) made by `f`. The tests of this binary run
-/// one after the other (`a_single_test_thread` below) so the counts are
-/// only `f`'s.
+/// Allocations (count, bytes) made by `f` on this thread.
 fn allocations(f: impl FnOnce()) -> (usize, usize) {
-    let (a0, b0) = (ALLOCS.load(Ordering::SeqCst), BYTES.load(Ordering::SeqCst));
+    let (a0, b0) = counts();
     f();
-    let (a1, b1) = (ALLOCS.load(Ordering::SeqCst), BYTES.load(Ordering::SeqCst));
+    let (a1, b1) = counts();
     (a1 - a0, b1 - b0)
 }
 
@@ -71,14 +83,7 @@ fn camera(n: usize) -> LensMap {
     LensMap::new(&m, n, n)
 }
 
-/// One test function runs both cases in turn: the allocator counts are
-/// process-wide, and a second test thread would allocate into them.
 #[test]
-fn a_single_test_thread() {
-    a_warm_workspace_does_not_allocate();
-    a_warm_workspace_does_not_allocate_for_several_lightings();
-}
-
 fn a_warm_workspace_does_not_allocate_for_several_lightings() {
     let n = 256;
     // Two takes of four lightings each (other noise) plus their ambient
@@ -125,6 +130,7 @@ fn a_warm_workspace_does_not_allocate_for_several_lightings() {
     }
 }
 
+#[test]
 fn a_warm_workspace_does_not_allocate() {
     let n = 256;
     let images = [
@@ -146,18 +152,12 @@ fn a_warm_workspace_does_not_allocate() {
     }
     let lines_before = ws.outputs().lines.len();
     assert!(lines_before > 10, "the scene has lines");
-    let (a0, b0) = (ALLOCS.load(Ordering::SeqCst), BYTES.load(Ordering::SeqCst));
-    for k in [0, 1, 0, 1] {
-        ws.run(&input(k), &p).unwrap();
-    }
-    let (a1, b1) = (ALLOCS.load(Ordering::SeqCst), BYTES.load(Ordering::SeqCst));
-    assert_eq!(
-        a1 - a0,
-        0,
-        "{} allocations ({} bytes) in warm runs",
-        a1 - a0,
-        b1 - b0
-    );
+    let (count, bytes) = allocations(|| {
+        for k in [0, 1, 0, 1] {
+            ws.run(&input(k), &p).unwrap();
+        }
+    });
+    assert_eq!(count, 0, "{count} allocations ({bytes} bytes) in warm runs");
     let corrected = &ws.outputs().corrected;
     assert!(
         corrected.len() == 1 && corrected[0].valid_mask().is_some(),

@@ -1,8 +1,9 @@
 //! A realistic test image for benchmarks and allocation tests, until the
 //! synthetic scenes of `llv::synth` are available everywhere: anti-aliased
 //! convex polygons of different brightness on a shaded ground, slightly
-//! blurred by the anti-aliasing ramp, with seeded noise. Shared by
-//! `benches/llv.rs` and `tests/llv_alloc.rs` through `#[path]`.
+//! blurred by the anti-aliasing ramp, with seeded noise. Shared by the
+//! tests (`support::llv_scene`), `benches/llv.rs` and `examples/llv_count.rs`
+//! (through `#[path]`).
 
 #![allow(dead_code)]
 

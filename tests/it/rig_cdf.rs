@@ -1,7 +1,7 @@
 //! The published `.cdf` files of the simulated cameras (`profiles/sim/`)
 //! must describe exactly the cameras the simulator renders through, so they
 //! never drift. Regenerate deliberately with `VSS_REGEN_CDF=1 cargo test
-//! --test rig_cdf`.
+//! --test it rig_cdf::`.
 
 use std::path::PathBuf;
 

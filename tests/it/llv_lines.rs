@@ -68,8 +68,7 @@ fn a_straight_edge_at_any_angle_gives_one_accurate_line() {
     );
 }
 
-#[path = "support/llv_scene.rs"]
-mod llv_scene;
+use crate::support::llv_scene;
 
 #[test]
 fn the_benchmark_scene_gives_its_polygon_edges() {

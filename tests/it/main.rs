@@ -1,0 +1,40 @@
+//! The integration tests of `vss`, one binary with a module per area:
+//! linking one executable instead of one per file keeps a build after a
+//! one-line edit short. Run one area with `cargo test --test it NAME::`.
+//! Shared helpers live in `support/`.
+
+mod support;
+
+mod accuracy;
+mod accuracy_cli;
+mod cli_formats;
+mod cli_pipe;
+mod formats_malformed;
+mod formats_roundtrip;
+mod llv_alloc;
+mod llv_auto;
+mod llv_auto_cli;
+mod llv_cli;
+mod llv_corners;
+mod llv_lines;
+mod llv_shadow;
+mod photometric;
+mod profile;
+mod report_cli;
+mod report_ps;
+mod report_svg;
+mod rig_cdf;
+mod rig_cli;
+mod rig_faults;
+mod rig_images;
+mod rig_lights;
+mod rig_protocol;
+mod robust_report;
+mod robust_session;
+mod session_api;
+mod session_cli;
+mod session_crash;
+mod session_redo;
+mod tui_device;
+mod tui_pty;
+mod tui_screens;
