@@ -6,126 +6,6 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::LlvError;
-
-/// Lens correction (llv.md §1, lens.md).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct LensParams {
-    /// Apply lens correction when a `.cdf` with distortion is given.
-    pub enabled: bool,
-}
-
-impl Default for LensParams {
-    fn default() -> Self {
-        LensParams { enabled: true }
-    }
-}
-
-/// Lee's edge detector and the adaptive threshold (llv.md §2).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct EdgeParams {
-    /// Kernel half-width `A` (pixels), 3–7.
-    pub half_width: u32,
-    /// Floor threshold `T` (grey levels): no peak at or below it is kept.
-    pub floor: f64,
-    /// `M`: edge pixels kept per region by the adaptive threshold.
-    pub per_region: u32,
-    /// Scan lines per region of the adaptive threshold (1 = one scan line).
-    pub region_lines: u32,
-    /// Photometric combination (llv.md §2.6): an image's noise level `τ` is
-    /// this multiple of its median absolute kernel response.
-    pub noise_factor: f64,
-}
-
-impl Default for EdgeParams {
-    fn default() -> Self {
-        EdgeParams {
-            half_width: 4,
-            floor: 2.0,
-            per_region: 8,
-            region_lines: 1,
-            noise_factor: 5.0,
-        }
-    }
-}
-
-/// The line extractor (llv.md §3).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct LineParams {
-    /// Rows (columns) a line may skip without an edge point.
-    pub max_gap: u32,
-    /// Half-width of the search window around the predicted point (px).
-    pub search_width: f64,
-    /// Segments not longer than this are dropped (px).
-    pub min_length: f64,
-    /// Minimum angle between a line and the scan direction (degrees; π/8 = 22.5°).
-    pub min_scan_angle_deg: f64,
-    /// Line significance (grey levels): a segment whose points' mean
-    /// |response| is below this is dropped as noise. Not in the original VSS:
-    /// with the floor `T` at its default 2 grey levels, `M` points per scan
-    /// line promote noise peaks in rows with few edges, and their chains make
-    /// short lines of mean |response| 3–4 at noise σ = 2. 0 switches it off.
-    pub min_response: f64,
-}
-
-impl Default for LineParams {
-    fn default() -> Self {
-        LineParams {
-            max_gap: 3,
-            search_width: 2.0,
-            min_length: 8.0,
-            min_scan_angle_deg: 22.5,
-            min_response: 6.0,
-        }
-    }
-}
-
-/// CONNECT, the automatic post-processing (llv.md §4), and the corner closing
-/// of §6.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ConnectParams {
-    /// Run CONNECT at all.
-    pub enabled: bool,
-    /// Environment length beyond each endpoint, along the segment (px).
-    pub wl: f64,
-    /// Environment half-width to each side of the segment (px).
-    pub wd: f64,
-    /// Largest direction difference of two segments that merge (degrees).
-    pub max_angle_deg: f64,
-    /// Segments shorter than this are dropped after merging (px).
-    pub min_line_length: f64,
-    /// Corner closing radius (px): endpoints of different lines within it move
-    /// to the lines' intersection. 0 switches corner closing off.
-    pub corner_radius: f64,
-}
-
-impl Default for ConnectParams {
-    fn default() -> Self {
-        ConnectParams {
-            enabled: true,
-            wl: 6.0,
-            wd: 1.5,
-            max_angle_deg: 3.0,
-            min_line_length: 12.0,
-            corner_radius: 5.0,
-        }
-    }
-}
-
-/// All LLV parameters, grouped as in the profile's `[llv.*]` tables.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    pub lens: LensParams,
-    pub edges: EdgeParams,
-    pub lines: LineParams,
-    pub connect: ConnectParams,
-}
-
 /// The stage a parameter belongs to: changing it re-runs that stage and
 /// everything after it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
@@ -177,194 +57,215 @@ fn fmt_num(v: f64) -> String {
     }
 }
 
-macro_rules! spec {
-    ($key:literal, $kind:ident, $stage:ident, $unit:literal, $min:expr, $max:expr, $step:expr, $doc:literal) => {
-        ParamSpec {
-            key: $key,
-            kind: Kind::$kind,
-            stage: Stage::$stage,
-            unit: $unit,
-            min: $min,
-            max: $max,
-            step: $step,
-            doc: $doc,
+/// How a field's Rust type maps to a parameter's number (bools are 0 and 1).
+trait Value: Copy {
+    const KIND: Kind;
+    fn to_f64(self) -> f64;
+    /// From a number already checked against the range and kind.
+    fn from_f64(v: f64) -> Self;
+}
+
+impl Value for bool {
+    const KIND: Kind = Kind::Bool;
+    fn to_f64(self) -> f64 {
+        if self { 1.0 } else { 0.0 }
+    }
+    fn from_f64(v: f64) -> Self {
+        v != 0.0
+    }
+}
+
+impl Value for u32 {
+    const KIND: Kind = Kind::Int;
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    fn from_f64(v: f64) -> Self {
+        v as u32
+    }
+}
+
+impl Value for f64 {
+    const KIND: Kind = Kind::Float;
+    fn to_f64(self) -> f64 {
+        self
+    }
+    fn from_f64(v: f64) -> Self {
+        v
+    }
+}
+
+/// Declares every parameter once: its group's struct and field (with the
+/// field's doc), its default, and its row of [`PARAMS`] (unit, range, step
+/// of a console key press, the one-line description). The key is
+/// `group.field`, the kind follows from the field's type, the stage from the
+/// group. [`Params::get`] and [`Params::set`] are generated from the same
+/// rows, so a parameter cannot be in the struct and missing from the table.
+macro_rules! params {
+    ($(
+        $(#[$sdoc:meta])*
+        $group:ident: $Struct:ident, $Stage:ident {
+            $(
+                $(#[$fdoc:meta])*
+                $field:ident: $ty:ty = $default:expr,
+                    $unit:literal, $min:literal ..= $max:literal, step $step:literal, $doc:literal;
+            )*
+        }
+    )*) => {
+        $(
+            $(#[$sdoc])*
+            #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+            #[serde(deny_unknown_fields, default)]
+            pub struct $Struct {
+                $( $(#[$fdoc])* pub $field: $ty, )*
+            }
+
+            impl Default for $Struct {
+                fn default() -> Self {
+                    $Struct { $( $field: $default, )* }
+                }
+            }
+        )*
+
+        /// All LLV parameters, grouped as in the profile's `[llv.*]` tables.
+        #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+        #[serde(deny_unknown_fields, default)]
+        pub struct Params {
+            $( pub $group: $Struct, )*
+        }
+
+        /// Every tunable LLV parameter, in the order the console shows them.
+        pub const PARAMS: &[ParamSpec] = &[
+            $($(
+                ParamSpec {
+                    key: concat!(stringify!($group), ".", stringify!($field)),
+                    kind: <$ty as Value>::KIND,
+                    stage: Stage::$Stage,
+                    unit: $unit,
+                    min: $min,
+                    max: $max,
+                    step: $step,
+                    doc: $doc,
+                },
+            )*)*
+        ];
+
+        impl Params {
+            /// The value of a parameter as a number (bools are 0 and 1).
+            pub fn get(&self, key: &str) -> Option<f64> {
+                $($(
+                    if key == concat!(stringify!($group), ".", stringify!($field)) {
+                        return Some(Value::to_f64(self.$group.$field));
+                    }
+                )*)*
+                None
+            }
+
+            /// Stores an already checked value.
+            fn store(&mut self, key: &str, value: f64) {
+                $($(
+                    if key == concat!(stringify!($group), ".", stringify!($field)) {
+                        self.$group.$field = <$ty as Value>::from_f64(value);
+                        return;
+                    }
+                )*)*
+            }
         }
     };
 }
 
-/// Every tunable LLV parameter, in the order the console shows them.
-pub const PARAMS: &[ParamSpec] = &[
-    spec!(
-        "lens.enabled",
-        Bool,
-        Lens,
-        "",
-        0.0,
-        1.0,
-        1.0,
-        "apply lens correction when the camera's .cdf has distortion"
-    ),
-    spec!(
-        "edges.half_width",
-        Int,
-        Edges,
-        "px",
-        3.0,
-        7.0,
-        1.0,
-        "Lee kernel half-width A; wider smooths more"
-    ),
-    spec!(
-        "edges.floor",
-        Float,
-        Edges,
-        "grey levels",
-        0.0,
-        255.0,
-        0.5,
-        "floor threshold T: weaker peaks are never edges"
-    ),
-    spec!(
-        "edges.per_region",
-        Int,
-        Edges,
-        "points",
-        1.0,
-        4096.0,
-        1.0,
-        "adaptive threshold M: strongest edge points kept per region"
-    ),
-    spec!(
-        "edges.region_lines",
-        Int,
-        Edges,
-        "lines",
-        1.0,
-        4096.0,
-        1.0,
-        "scan lines per adaptive-threshold region"
-    ),
-    spec!(
-        "edges.noise_factor",
-        Float,
-        Edges,
-        "× median",
-        0.5,
-        20.0,
-        0.25,
-        "several lightings: noise level tau as a multiple of the median |response|"
-    ),
-    spec!(
-        "lines.max_gap",
-        Int,
-        Lines,
-        "rows",
-        1.0,
-        20.0,
-        1.0,
-        "rows a line may bridge without an edge point"
-    ),
-    spec!(
-        "lines.search_width",
-        Float,
-        Lines,
-        "px",
-        0.5,
-        10.0,
-        0.25,
-        "half-width of the search window around the predicted point"
-    ),
-    spec!(
-        "lines.min_length",
-        Float,
-        Lines,
-        "px",
-        0.0,
-        1000.0,
-        1.0,
-        "extracted segments must be longer than this"
-    ),
-    spec!(
-        "lines.min_scan_angle_deg",
-        Float,
-        Lines,
-        "deg",
-        0.0,
-        45.0,
-        0.5,
-        "least angle between a line and the scan direction"
-    ),
-    spec!(
-        "lines.min_response",
-        Float,
-        Lines,
-        "grey levels",
-        0.0,
-        255.0,
-        0.5,
-        "lines whose mean |edge response| is below this are noise; 0 is off"
-    ),
-    spec!(
-        "connect.enabled",
-        Bool,
-        Connect,
-        "",
-        0.0,
-        1.0,
-        1.0,
-        "run CONNECT post-processing"
-    ),
-    spec!(
-        "connect.wl",
-        Float,
-        Connect,
-        "px",
-        0.0,
-        100.0,
-        0.5,
-        "environment length beyond each endpoint"
-    ),
-    spec!(
-        "connect.wd",
-        Float,
-        Connect,
-        "px",
-        0.0,
-        20.0,
-        0.25,
-        "environment half-width to each side"
-    ),
-    spec!(
-        "connect.max_angle_deg",
-        Float,
-        Connect,
-        "deg",
-        0.0,
-        45.0,
-        0.25,
-        "largest direction difference that still merges"
-    ),
-    spec!(
-        "connect.min_line_length",
-        Float,
-        Connect,
-        "px",
-        0.0,
-        1000.0,
-        1.0,
-        "merged segments shorter than this are dropped"
-    ),
-    spec!(
-        "connect.corner_radius",
-        Float,
-        Connect,
-        "px",
-        0.0,
-        50.0,
-        0.5,
-        "corner closing radius; 0 is off"
-    ),
-];
+params! {
+    /// Lens correction (llv.md §1, lens.md).
+    lens: LensParams, Lens {
+        /// Apply lens correction when a `.cdf` with distortion is given.
+        enabled: bool = true,
+            "", 0.0..=1.0, step 1.0,
+            "apply lens correction when the camera's .cdf has distortion";
+    }
+
+    /// Lee's edge detector and the adaptive threshold (llv.md §2).
+    edges: EdgeParams, Edges {
+        /// Kernel half-width `A` (pixels), 3–7.
+        half_width: u32 = 4,
+            "px", 3.0..=7.0, step 1.0,
+            "Lee kernel half-width A; wider smooths more";
+        /// Floor threshold `T` (grey levels): no peak at or below it is kept.
+        floor: f64 = 2.0,
+            "grey levels", 0.0..=255.0, step 0.5,
+            "floor threshold T: weaker peaks are never edges";
+        /// `M`: edge pixels kept per region by the adaptive threshold.
+        per_region: u32 = 8,
+            "points", 1.0..=4096.0, step 1.0,
+            "adaptive threshold M: strongest edge points kept per region";
+        /// Scan lines per region of the adaptive threshold (1 = one scan line).
+        region_lines: u32 = 1,
+            "lines", 1.0..=4096.0, step 1.0,
+            "scan lines per adaptive-threshold region";
+        /// Photometric combination (llv.md §2.6): an image's noise level `τ` is
+        /// this multiple of its median absolute kernel response.
+        noise_factor: f64 = 5.0,
+            "× median", 0.5..=20.0, step 0.25,
+            "several lightings: noise level tau as a multiple of the median |response|";
+    }
+
+    /// The line extractor (llv.md §3).
+    lines: LineParams, Lines {
+        /// Rows (columns) a line may skip without an edge point.
+        max_gap: u32 = 3,
+            "rows", 1.0..=20.0, step 1.0,
+            "rows a line may bridge without an edge point";
+        /// Half-width of the search window around the predicted point (px).
+        search_width: f64 = 2.0,
+            "px", 0.5..=10.0, step 0.25,
+            "half-width of the search window around the predicted point";
+        /// Segments not longer than this are dropped (px).
+        min_length: f64 = 8.0,
+            "px", 0.0..=1000.0, step 1.0,
+            "extracted segments must be longer than this";
+        /// Minimum angle between a line and the scan direction (degrees; π/8 = 22.5°).
+        min_scan_angle_deg: f64 = 22.5,
+            "deg", 0.0..=45.0, step 0.5,
+            "least angle between a line and the scan direction";
+        /// Line significance (grey levels): a segment whose points' mean
+        /// |response| is below this is dropped as noise. Not in the original VSS:
+        /// with the floor `T` at its default 2 grey levels, `M` points per scan
+        /// line promote noise peaks in rows with few edges, and their chains make
+        /// short lines of mean |response| 3–4 at noise σ = 2. 0 switches it off.
+        min_response: f64 = 6.0,
+            "grey levels", 0.0..=255.0, step 0.5,
+            "lines whose mean |edge response| is below this are noise; 0 is off";
+    }
+
+    /// CONNECT, the automatic post-processing (llv.md §4), and the corner closing
+    /// of §6.
+    connect: ConnectParams, Connect {
+        /// Run CONNECT at all.
+        enabled: bool = true,
+            "", 0.0..=1.0, step 1.0,
+            "run CONNECT post-processing";
+        /// Environment length beyond each endpoint, along the segment (px).
+        wl: f64 = 6.0,
+            "px", 0.0..=100.0, step 0.5,
+            "environment length beyond each endpoint";
+        /// Environment half-width to each side of the segment (px).
+        wd: f64 = 1.5,
+            "px", 0.0..=20.0, step 0.25,
+            "environment half-width to each side";
+        /// Largest direction difference of two segments that merge (degrees).
+        max_angle_deg: f64 = 3.0,
+            "deg", 0.0..=45.0, step 0.25,
+            "largest direction difference that still merges";
+        /// Segments shorter than this are dropped after merging (px).
+        min_line_length: f64 = 12.0,
+            "px", 0.0..=1000.0, step 1.0,
+            "merged segments shorter than this are dropped";
+        /// Corner closing radius (px): endpoints of different lines within it move
+        /// to the lines' intersection. 0 switches corner closing off.
+        corner_radius: f64 = 5.0,
+            "px", 0.0..=50.0, step 0.5,
+            "corner closing radius; 0 is off";
+    }
+}
 
 /// The spec of a dotted key, if it names a parameter.
 pub fn spec(key: &str) -> Option<&'static ParamSpec> {
@@ -372,31 +273,6 @@ pub fn spec(key: &str) -> Option<&'static ParamSpec> {
 }
 
 impl Params {
-    /// The value of a parameter as a number (bools are 0 and 1).
-    pub fn get(&self, key: &str) -> Option<f64> {
-        let b = |v: bool| if v { 1.0 } else { 0.0 };
-        Some(match key {
-            "lens.enabled" => b(self.lens.enabled),
-            "edges.half_width" => self.edges.half_width as f64,
-            "edges.floor" => self.edges.floor,
-            "edges.per_region" => self.edges.per_region as f64,
-            "edges.region_lines" => self.edges.region_lines as f64,
-            "edges.noise_factor" => self.edges.noise_factor,
-            "lines.max_gap" => self.lines.max_gap as f64,
-            "lines.search_width" => self.lines.search_width,
-            "lines.min_length" => self.lines.min_length,
-            "lines.min_scan_angle_deg" => self.lines.min_scan_angle_deg,
-            "lines.min_response" => self.lines.min_response,
-            "connect.enabled" => b(self.connect.enabled),
-            "connect.wl" => self.connect.wl,
-            "connect.wd" => self.connect.wd,
-            "connect.max_angle_deg" => self.connect.max_angle_deg,
-            "connect.min_line_length" => self.connect.min_line_length,
-            "connect.corner_radius" => self.connect.corner_radius,
-            _ => return None,
-        })
-    }
-
     /// Sets a parameter from a number, checking its range (and, for integer
     /// and boolean parameters, that the number is whole / 0 or 1).
     pub fn set(&mut self, key: &str, value: f64) -> Result<(), ParamError> {
@@ -413,28 +289,7 @@ impl Params {
                 range: sp.range_text(),
             });
         }
-        let u = value as u32;
-        let on = value != 0.0;
-        match key {
-            "lens.enabled" => self.lens.enabled = on,
-            "edges.half_width" => self.edges.half_width = u,
-            "edges.floor" => self.edges.floor = value,
-            "edges.per_region" => self.edges.per_region = u,
-            "edges.region_lines" => self.edges.region_lines = u,
-            "edges.noise_factor" => self.edges.noise_factor = value,
-            "lines.max_gap" => self.lines.max_gap = u,
-            "lines.search_width" => self.lines.search_width = value,
-            "lines.min_length" => self.lines.min_length = value,
-            "lines.min_scan_angle_deg" => self.lines.min_scan_angle_deg = value,
-            "lines.min_response" => self.lines.min_response = value,
-            "connect.enabled" => self.connect.enabled = on,
-            "connect.wl" => self.connect.wl = value,
-            "connect.wd" => self.connect.wd = value,
-            "connect.max_angle_deg" => self.connect.max_angle_deg = value,
-            "connect.min_line_length" => self.connect.min_line_length = value,
-            "connect.corner_radius" => self.connect.corner_radius = value,
-            _ => return Err(ParamError::UnknownKey(key.to_string())),
-        }
+        self.store(sp.key, value);
         Ok(())
     }
 
@@ -474,19 +329,6 @@ impl Params {
             .map(|sp| sp.stage)
             .min()
     }
-
-    /// The kernel half-width as the edge stage uses it, checked.
-    pub fn half_width(&self) -> Result<usize, LlvError> {
-        let a = self.edges.half_width;
-        if !(3..=7).contains(&a) {
-            return Err(LlvError::Param {
-                name: "edges.half_width",
-                value: a as f64,
-                range: "3 to 7",
-            });
-        }
-        Ok(a as usize)
-    }
 }
 
 /// A parameter that cannot be set as asked.
@@ -523,6 +365,31 @@ mod tests {
             assert_eq!(q, p, "{}", sp.key);
             assert!(q.set(sp.key, sp.max + 1.0).is_err(), "{}", sp.key);
         }
+    }
+
+    /// Every field the profile can hold (serde's view of the structs) is a
+    /// row of the table, and every row a field.
+    #[test]
+    fn every_field_is_a_row() {
+        let v = serde_json::to_value(Params::default()).unwrap();
+        let mut fields: Vec<String> = v
+            .as_object()
+            .unwrap()
+            .iter()
+            .flat_map(|(g, t)| {
+                t.as_object()
+                    .unwrap()
+                    .keys()
+                    .map(move |f| format!("{g}.{f}"))
+            })
+            .collect();
+        let mut keys: Vec<String> = PARAMS.iter().map(|p| p.key.to_string()).collect();
+        fields.sort();
+        keys.sort();
+        assert_eq!(fields, keys);
+        assert_eq!(spec("edges.half_width").unwrap().kind, Kind::Int);
+        assert_eq!(spec("lens.enabled").unwrap().kind, Kind::Bool);
+        assert_eq!(spec("connect.wd").unwrap().stage, Stage::Connect);
     }
 
     #[test]

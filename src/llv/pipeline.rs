@@ -143,7 +143,8 @@ impl Workspace {
         p: &Params,
     ) -> Result<&StageOutputs, LlvError> {
         let size = check_input(input)?;
-        let a = p.half_width()?;
+        // The kernel checks the half-width (`edges::check_half_width`).
+        let a = p.edges.half_width as usize;
         let prev_fits = self.valid
             && self.out.edges_h.width == size.0
             && self.out.edges_h.height == size.1
@@ -452,5 +453,33 @@ mod tests {
             ..Input::single(&img)
         };
         assert!(run(&input, &p).is_err());
+    }
+
+    /// A half-width outside 3–7 set around the table's check is the kernel's
+    /// error, for one image and several, not a panic.
+    #[test]
+    fn a_bad_half_width_is_an_error() {
+        let imgs = [square(32, 32), square(32, 32)];
+        let mut p = Params::default();
+        for a in [0, 2, 8, 1000] {
+            p.edges.half_width = a;
+            for n in [1, 2] {
+                let input = Input {
+                    images: &imgs[..n],
+                    ambient: None,
+                    lens: None,
+                };
+                assert!(
+                    matches!(
+                        run(&input, &p),
+                        Err(LlvError::Param {
+                            name: "edges.half_width",
+                            ..
+                        })
+                    ),
+                    "A = {a}, {n} images"
+                );
+            }
+        }
     }
 }
