@@ -10,6 +10,7 @@
 //! - [`session`]: a survey on disk; [`report`]: PostScript and SVG.
 //! - [`cli`]: headless subcommands; [`tui`]: the operator console.
 
+pub mod calib;
 pub mod cli;
 pub mod formats;
 pub mod fsutil;
