@@ -1,5 +1,4 @@
-//! Scoring detected lines against true edges, with the matching rule of
-//! issue 3.
+//! Scoring detected lines against true edges, with the matching rule below.
 //!
 //! A detected segment *supports* a true edge along the part of it that lies
 //! within [`DIST`] px of the true segment (distance to the segment, not to its
