@@ -12,6 +12,7 @@
 //! ([`Session::redo`]).
 
 pub mod check;
+pub mod input;
 pub mod lock;
 pub mod manifest;
 pub mod outputs;
@@ -32,6 +33,7 @@ use crate::llv::{LlvError, Segment};
 use crate::profile::Profile;
 
 pub use check::CheckReport;
+pub use input::{FrameRule, PipelineInput, Runner};
 pub use lock::{Lock, LockInfo};
 pub use manifest::Manifest;
 pub use outputs::OutputSet;
