@@ -18,7 +18,6 @@ pub mod manifest;
 pub mod outputs;
 pub mod progress;
 pub mod redo;
-pub mod reporting;
 pub mod stamp;
 #[doc(hidden)]
 pub mod torture;

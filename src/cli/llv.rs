@@ -169,7 +169,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             if super::is_broken_pipe(&e) {
                 return Err(e);
             }
-            eprintln!("vss: error: {}: {e:#}", grp.stem);
+            errln!("vss: error: {}: {e:#}", grp.stem);
             failed += 1;
         }
     }

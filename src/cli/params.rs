@@ -66,7 +66,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             match out {
                 Some(o) => {
                     write_par(&o, &f)?;
-                    eprintln!(
+                    errln!(
                         "vss: wrote {} ({} parameters, set \"{}\")",
                         o.display(),
                         f.entries.len(),
@@ -93,7 +93,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             })?;
             let (params, notes) = import_params(text, &file, &base.llv)?;
             for n in notes {
-                eprintln!("vss: note: {}: {n}", file.display());
+                errln!("vss: note: {}: {n}", file.display());
             }
             match out {
                 Some(o) => {
@@ -103,13 +103,13 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                     let moved = o.parent().map(|d| d.canonicalize().ok())
                         != base_path.parent().map(|d| d.canonicalize().ok());
                     if moved && base.survey.cdf.iter().any(|c| c.is_relative()) {
-                        eprintln!(
+                        errln!(
                             "vss: note: {} is in another folder than {}: its relative survey.cdf paths now point elsewhere",
                             o.display(),
                             base_path.display()
                         );
                     }
-                    eprintln!(
+                    errln!(
                         "vss: wrote {} ({} from {})",
                         o.display(),
                         changed_text(&base.llv, &params),
