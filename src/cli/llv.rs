@@ -189,7 +189,13 @@ fn run_group(
     let files: Vec<ImgFile> = grp
         .files
         .iter()
-        .map(|f| imageio::read_any(f))
+        .map(|f| {
+            // The size from the header, before the pixels are read.
+            imageio::read_any_sized(f, |w, h| {
+                crate::llv::image::check_stage_size(w, h).map_err(|e| e.to_string())
+            })
+            .map(|(f, _)| f)
+        })
         .collect::<Result<_, _>>()?;
     // Sizes first: a lens map is made for the size before the stages run.
     for (path, f) in grp.files.iter().zip(&files) {
@@ -199,6 +205,11 @@ fn run_group(
     }
     let images: Vec<GreyImage> = files.iter().map(|f| f.image.clone()).collect();
     let size = images.first().map(GreyImage::size).unwrap_or_default();
+    if let (Some(m), Some(cdf_path)) = (camera, &a.cdf) {
+        if !maps.contains_key(&size) {
+            cdf::check_camera_area(m, size.0, size.1, cdf_path)?;
+        }
+    }
     let map = camera.map(|m| {
         &*maps
             .entry(size)

@@ -120,10 +120,15 @@ impl Session {
         let Some(cdf) = self.manifest.image(k).and_then(|r| r.cdf.as_ref()) else {
             return Ok(None);
         };
-        let c = formats::cdf::read_cdf(&self.path(&cdf.file))?;
-        Ok(c.camera_model()
-            .filter(|m| !m.is_identity())
-            .map(|m| LensMap::new(&m, width, height)))
+        let path = self.path(&cdf.file);
+        let c = formats::cdf::read_cdf(&path)?;
+        match c.camera_model().filter(|m| !m.is_identity()) {
+            Some(m) => {
+                formats::cdf::check_camera_area(&m, width, height, &path)?;
+                Ok(Some(LensMap::new(&m, width, height)))
+            }
+            None => Ok(None),
+        }
     }
 
     /// Re-runs image `k` from stage `from` with `params` and saves the
