@@ -80,11 +80,12 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         Cmd::Import { file, out } => {
             let base_name = g.profile.as_deref().unwrap_or("default");
             let base_path = resolve(base_name)?;
-            let base_text = std::fs::read_to_string(&base_path)
-                .with_context(|| format!("cannot read profile {}", base_path.display()))?;
+            let base_text =
+                crate::fsutil::read_input_text(&base_path, crate::profile::MAX_LEN as u64)
+                    .with_context(|| format!("cannot read profile {}", base_path.display()))?;
             let base = Profile::from_toml(&base_text, &base_path)?;
-            let text =
-                std::fs::read(&file).with_context(|| format!("cannot read {}", file.display()))?;
+            let text = crate::fsutil::read_input(&file, crate::formats::max_len(&file))
+                .with_context(|| format!("cannot read {}", file.display()))?;
             let text = std::str::from_utf8(&text).map_err(|_| {
                 anyhow::anyhow!(
                     "{}: not UTF-8 text; expected a parameter file",

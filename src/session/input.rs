@@ -263,7 +263,15 @@ impl Session {
         if input.images.is_empty() {
             return Err(self.missing(k, "no grey image captured yet: capture it first".into()));
         }
-        Ok(input.with_camera(self.camera_model(k)?))
+        let camera = self.camera_model(k)?;
+        if let (Some(m), Some(cdf)) = (&camera, self.manifest.image(k).and_then(|r| r.cdf.as_ref()))
+        {
+            // A camera that leaves (almost) nothing of the image is the
+            // .cdf's fault: say so before a lens map is made.
+            let (w, h) = input.size();
+            formats::cdf::check_camera_area(m, w, h, &self.path(&cdf.file))?;
+        }
+        Ok(input.with_camera(camera))
     }
 
     /// Runs image `k`'s stages from `from` with `params` through `runner`,

@@ -29,6 +29,8 @@ mod rig_faults;
 mod rig_images;
 mod rig_lights;
 mod rig_protocol;
+mod robust_fs;
+mod robust_inputs;
 mod robust_report;
 mod robust_session;
 mod session_api;
