@@ -154,7 +154,14 @@ impl Workspace {
         let size = check_input(input)?;
         // The kernel checks the half-width (`edges::check_half_width`).
         let a = p.edges.half_width as usize;
+        // The responses of a lens-corrected run with an ambient image are made
+        // from the corrected ambient, which a workspace built from earlier
+        // outputs alone (`with_outputs`) does not have: it corrects again.
+        let ambient_ready = input.ambient.is_none()
+            || self.out.corrected.is_empty()
+            || self.ambient_corrected.size() == size;
         let prev_fits = self.valid
+            && ambient_ready
             && self.out.edges_h.width == size.0
             && self.out.edges_h.height == size.1
             && self.out.response_h.covers(size.0, size.1);
@@ -449,6 +456,50 @@ mod tests {
         q.edges.per_region = 3;
         let again = rerun(first, Stage::Edges, &input, &q).unwrap();
         assert_eq!(again.edges_h, run(&input, &q).unwrap().edges_h);
+    }
+
+    /// Several lightings with an ambient image and lens correction: a
+    /// rerun from the edges (a new half-width) on earlier outputs once
+    /// failed on the missing corrected ambient ("image sizes differ: (96,
+    /// 80) and (0, 0)"); it now matches a full run, on fresh outputs and in
+    /// a workspace kept between runs.
+    #[test]
+    fn rerun_with_lens_and_ambient_matches_a_full_run() {
+        let imgs = [square(96, 80), square(96, 80)];
+        let ambient = GreyImage::filled(96, 80, 30).unwrap();
+        let model = crate::llv::lens::CameraModel {
+            cx: 48.0,
+            cy: 40.0,
+            sx: 0.01,
+            sy: 0.01,
+            f: 8.0,
+            distortion: Some([-0.02, 0.0, 0.0, 0.0, 0.0]),
+        };
+        let map = LensMap::new(&model, 96, 80);
+        let input = Input {
+            images: &imgs,
+            ambient: Some(&ambient),
+            lens: Some(&map),
+        };
+        let p = Params::default();
+        let first = run(&input, &p).unwrap();
+        assert!(!first.corrected.is_empty());
+        for change in [
+            |q: &mut Params| q.edges.half_width = 5,
+            |q: &mut Params| q.edges.noise_factor = 6.0,
+            |q: &mut Params| q.edges.per_region = 3,
+        ] {
+            let mut q = p.clone();
+            change(&mut q);
+            let full = run(&input, &q).unwrap();
+            let again = rerun(first.clone(), Stage::Edges, &input, &q).unwrap();
+            assert_eq!(again.lines, full.lines);
+            let mut ws = Workspace::new();
+            ws.run(&input, &p).unwrap();
+            let kept = ws.rerun(Stage::Edges, &input, &q).unwrap();
+            assert_eq!(kept.edges_h, full.edges_h);
+            assert_eq!(kept.lines, full.lines);
+        }
     }
 
     #[test]

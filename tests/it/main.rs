@@ -36,5 +36,7 @@ mod session_cli;
 mod session_crash;
 mod session_redo;
 mod tui_device;
+mod tui_harness;
 mod tui_pty;
+mod tui_pty_tuning;
 mod tui_screens;
