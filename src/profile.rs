@@ -86,6 +86,11 @@ pub struct RelayConfig {
     pub timeout_ms: u64,
     /// Wait after switching before a freeze (ms).
     pub settle_ms: u64,
+    /// Relays on the board: 1, 2, 4, 8, 16 or 32. A Numato board's mask
+    /// width follows it (learned from the board when not given); an LCUS
+    /// board cannot be asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub channels: Option<u32>,
 }
 
 impl Default for RelayConfig {
@@ -96,6 +101,7 @@ impl Default for RelayConfig {
             baud: 19200,
             timeout_ms: 500,
             settle_ms: 200,
+            channels: None,
         }
     }
 }
