@@ -195,15 +195,7 @@ fn stated_scale(profile: &crate::profile::Profile, cam: u32) -> anyhow::Result<(
         bail!("the profile names no .cdf for camera {cam}, so no scale S: {hint}");
     };
     let c = cdf::read_cdf(&path).with_context(|| format!("the scale S: {hint}"))?;
-    let s = c
-        .get("S")
-        .filter(|p| p.available())
-        .map(|p| p.values().collect::<Vec<_>>())
-        .unwrap_or_default();
-    match s[..] {
-        [x, y] if x > 0.0 && y > 0.0 => Ok((x, y)),
-        _ => bail!("{} has no scale S: {hint}", path.display()),
-    }
+    calib::scale_of(&c).with_context(|| format!("{} has no scale S: {hint}", path.display()))
 }
 
 fn print_calibration(c: &Calibration) -> anyhow::Result<()> {

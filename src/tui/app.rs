@@ -12,7 +12,9 @@ use super::event::{
 };
 use super::keymap::{self, Action, Scope, ScreenId};
 use super::mode::Look;
-use super::screens::{CaptureScreen, EditScreen, PipelineScreen, SessionScreen, SurveyScreen};
+use super::screens::{
+    CalibrateScreen, CaptureScreen, EditScreen, PipelineScreen, SessionScreen, SurveyScreen,
+};
 use super::text::clean;
 use crate::llv::edit::LineEditor;
 use crate::llv::lens::CameraModel;
@@ -52,6 +54,8 @@ pub enum PromptPurpose {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Pending {
     RedoImage(u32),
+    /// Replace the camera's `.cdf` with the calibration shown.
+    CalibWrite,
 }
 
 /// How the log pane is shown.
@@ -118,6 +122,9 @@ pub struct App {
     pub pipeline: PipelineScreen,
     pub edit: EditScreen,
     pub files: SessionScreen,
+    pub calib: CalibrateScreen,
+    /// The profile's `.cdf` of each camera (index 0 is camera 1), resolved.
+    pub cdf_paths: Vec<Option<std::path::PathBuf>>,
     pub log: Log,
     pub log_view: LogView,
     pub help: bool,
@@ -170,6 +177,10 @@ impl App {
             pipeline: PipelineScreen::default(),
             edit: EditScreen::default(),
             files: SessionScreen::default(),
+            calib: CalibrateScreen::default(),
+            cdf_paths: (1..=profile.survey.cameras.max(1))
+                .map(|k| profile.cdf_path(k))
+                .collect(),
             log: Log::default(),
             log_view: LogView::Line,
             help: false,
@@ -262,6 +273,7 @@ impl App {
                 self.edit.handle_key(key, size)
             }
             ScreenId::Session => self.files.handle_key(key),
+            ScreenId::Calibrate => self.calib.handle_key(key),
         };
         let action = if scope == Scope::Confirm {
             keymap::lookup(scope, &key)
@@ -420,6 +432,12 @@ impl App {
                 vec![Cmd::Store(StoreCmd::Export)]
             }
             Action::Refresh => vec![Cmd::Store(StoreCmd::Refresh)],
+            Action::CalibPlate
+            | Action::CalibKeep
+            | Action::CalibDrop
+            | Action::CalibSolve
+            | Action::CalibCentre
+            | Action::CalibAccept => self.calib_action(a),
             // Preview navigation is handled by the screens themselves.
             _ => Vec::new(),
         }
@@ -435,6 +453,7 @@ impl App {
         }
         match on_yes {
             Pending::RedoImage(k) => self.redo_confirmed(k),
+            Pending::CalibWrite => self.calib_write(),
         }
     }
 

@@ -165,6 +165,9 @@ pub enum DeviceCmd {
     },
     AllOff,
     Lighting(char),
+    /// Show a calibration plate in the simulated cell's view (`None`: the
+    /// bare cell); a real cell ignores it, with a note.
+    SimTarget(Option<crate::rig::sim::plate::PlateTarget>),
     /// Stop the transfer under way (and the live view).
     Cancel,
 }

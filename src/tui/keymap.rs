@@ -12,15 +12,17 @@ pub enum ScreenId {
     Pipeline,
     Edit,
     Session,
+    Calibrate,
 }
 
 impl ScreenId {
-    pub const ALL: [ScreenId; 5] = [
+    pub const ALL: [ScreenId; 6] = [
         ScreenId::Survey,
         ScreenId::Capture,
         ScreenId::Pipeline,
         ScreenId::Edit,
         ScreenId::Session,
+        ScreenId::Calibrate,
     ];
     pub fn title(self) -> &'static str {
         match self {
@@ -29,6 +31,7 @@ impl ScreenId {
             ScreenId::Pipeline => "Pipeline",
             ScreenId::Edit => "Edit",
             ScreenId::Session => "Session/Report",
+            ScreenId::Calibrate => "Calibrate",
         }
     }
 }
@@ -107,6 +110,13 @@ pub enum Action {
     // Session / report
     Export,
     Refresh,
+    // Calibrate
+    CalibPlate,
+    CalibKeep,
+    CalibDrop,
+    CalibSolve,
+    CalibCentre,
+    CalibAccept,
     // Modal
     Yes,
     No,
@@ -226,6 +236,7 @@ const CA: Scope = Scope::Screen(S::Capture);
 const PI: Scope = Scope::Screen(S::Pipeline);
 const ED: Scope = Scope::Screen(S::Edit);
 const SE: Scope = Scope::Screen(S::Session);
+const CB: Scope = Scope::Screen(S::Calibrate);
 
 /// The key table. Screen rows come before global rows so a screen may
 /// reuse a key; the first match wins.
@@ -289,6 +300,52 @@ pub const KEYMAP: &[Binding] = &[
     b(SU, ch('c'), A::CameraNext, "next camera", "camera"),
     b(SU, ch('p'), A::LocationNext, "next camera location", ""),
     b(SU, k(K::Esc), A::Cancel, "cancel the transfer", ""),
+    // Calibrate.
+    b(
+        CB,
+        ch('p'),
+        A::CalibPlate,
+        "simulated cell: calibration plate in view / away",
+        "plate",
+    ),
+    b(CB, ch('v'), A::ToggleLive, "live view on/off", "live"),
+    b(CB, ch('g'), A::Grab, "grab one frame", "grab"),
+    b(CB, ch('c'), A::CameraNext, "next camera", "camera"),
+    b(
+        CB,
+        ch(' '),
+        A::CalibKeep,
+        "keep this view (its grid was found)",
+        "keep",
+    ),
+    b(
+        CB,
+        k(K::Backspace),
+        A::CalibDrop,
+        "drop the last view kept",
+        "",
+    ),
+    b(
+        CB,
+        ch('s'),
+        A::CalibCentre,
+        "centre C: solved / stated at the image's middle",
+        "centre",
+    ),
+    b(
+        CB,
+        k(K::Enter),
+        A::CalibSolve,
+        "compute the calibration from the views kept",
+        "compute",
+    ),
+    b(
+        CB,
+        ch('a'),
+        A::CalibAccept,
+        "accept: write camN.cdf (asks before replacing)",
+        "accept",
+    ),
     // Capture.
     b(CA, ch('v'), A::ToggleLive, "live view on/off", "live"),
     b(CA, ch('g'), A::Grab, "grab one frame", "grab"),
@@ -452,6 +509,7 @@ pub const KEYMAP: &[Binding] = &[
     b(G, ch('3'), A::GoTo(S::Pipeline), "Pipeline screen", ""),
     b(G, ch('4'), A::GoTo(S::Edit), "Edit screen", ""),
     b(G, ch('5'), A::GoTo(S::Session), "Session/Report screen", ""),
+    b(G, ch('6'), A::GoTo(S::Calibrate), "Calibrate screen", ""),
     b(G, ch('?'), A::Help, "help: every key", "help"),
     b(
         G,
@@ -588,7 +646,7 @@ mod tests {
         let md = markdown();
         // `cargo test markdown_lists -- --nocapture` prints it for the README.
         println!("{md}");
-        assert_eq!(md.lines().count(), 8);
+        assert_eq!(md.lines().count(), 9);
         assert!(md.contains("`?` help: every key"));
     }
 

@@ -13,12 +13,14 @@ use super::app::{App, Level, LogView, Modal};
 use super::keymap::{self, Action, Scope, ScreenId};
 use super::widgets::preview::Viewport;
 
+mod calibrate;
 mod capture;
 mod edit;
 mod pipeline;
 mod session;
 mod survey;
 
+pub use calibrate::CalibrateScreen;
 pub use capture::CaptureScreen;
 pub use edit::EditScreen;
 pub use pipeline::{PipelineScreen, StageView};
@@ -226,6 +228,7 @@ impl Widget for &App {
             ScreenId::Pipeline => pipeline::render(self, body, buf),
             ScreenId::Edit => edit::render(self, body, buf),
             ScreenId::Session => session::render(self, body, buf),
+            ScreenId::Calibrate => calibrate::render(self, body, buf),
         }
         self.log_pane(log, buf);
         self.status_bar(status, buf);

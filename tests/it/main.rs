@@ -9,6 +9,7 @@ mod accuracy;
 mod accuracy_cli;
 mod calib;
 mod calib_cli;
+mod calib_console;
 mod cli_formats;
 mod cli_pipe;
 mod formats_malformed;

@@ -98,6 +98,9 @@ impl App {
                     }
                     FramePurpose::Live | FramePurpose::Snapshot => {
                         self.live = Some((camera, image));
+                        if self.screen == crate::tui::keymap::ScreenId::Calibrate {
+                            self.calib_frame();
+                        }
                         Vec::new()
                     }
                 }
