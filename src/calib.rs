@@ -25,6 +25,7 @@
 
 pub mod detect;
 pub mod extrinsic;
+mod lm;
 pub mod model;
 pub mod plate;
 mod quads;
