@@ -7,6 +7,7 @@ mod support;
 
 mod accuracy;
 mod accuracy_cli;
+mod accuracy_yard;
 mod cli_formats;
 mod cli_pipe;
 mod formats_malformed;

@@ -12,11 +12,20 @@ use crate::llv::synth::eval::yard::YardReport;
 /// The breakdown columns' header: strong recall, close recall, off-angle.
 const BREAKDOWN: &str = "strong R close R off-angle";
 
+/// The three breakdowns; "—" where there is nothing to measure (no strong
+/// edges, no close pairs: the cube scenes keep edges 8 px apart).
 fn breakdown(m: &Metrics) -> String {
+    let frac = |v: f64, len: f64| {
+        if len > 0.0 {
+            format!("{v:.3}")
+        } else {
+            "—".into()
+        }
+    };
     format!(
-        "{:>8.3} {:>7.3} {:>8.2} %",
-        m.recall_strong,
-        m.recall_close,
+        "{:>8} {:>7} {:>8.2} %",
+        frac(m.recall_strong, m.strong_length),
+        frac(m.recall_close, m.close_length),
         100.0 * m.off_angle
     )
 }
