@@ -278,6 +278,17 @@ fn another_detectors_segments_are_scored_with_dont_care_edges() {
     assert!(block[3].contains('—'), "{table}");
 }
 
+/// `vss selftest --score DIR`, which must fail, printing nothing but the
+/// reason: its stderr.
+fn score_fails(dir: &Path) -> String {
+    let out = vss()
+        .args(["selftest", "--score", dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success() && out.stdout.is_empty());
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
 #[test]
 fn bad_or_missing_segment_files_are_named() {
     let dir = tempfile::tempdir().unwrap();
@@ -285,35 +296,18 @@ fn bad_or_missing_segment_files_are_named() {
     let lvl = dir.path().join("cubes/s2");
     std::fs::write(lvl.join("s00.odd.seg"), "1 2 3 4\n5 6 seven 8\n").unwrap();
     std::fs::write(lvl.join("s01.odd.seg"), "").unwrap();
-    let out = vss()
-        .args(["selftest", "--score", dir.path().to_str().unwrap()])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
+    let err = score_fails(dir.path());
     assert!(err.contains("s00.odd.seg:2"), "{err}");
     std::fs::remove_file(lvl.join("s00.odd.seg")).unwrap();
     std::fs::remove_file(lvl.join("s01.odd.seg")).unwrap();
     std::fs::write(lvl.join("s00.half.seg"), "1 2 3 4\n").unwrap();
-    let out = vss()
-        .args(["selftest", "--score", dir.path().to_str().unwrap()])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
+    let err = score_fails(dir.path());
     assert!(
         err.contains("s01.half.seg") && err.contains("half"),
         "{err}"
     );
     // Not an export at all.
     let empty = tempfile::tempdir().unwrap();
-    let out = vss()
-        .args(["selftest", "--score", empty.path().to_str().unwrap()])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        !out.status.success() && err.contains("manifest.json"),
-        "{err}"
-    );
+    let err = score_fails(empty.path());
+    assert!(err.contains("manifest.json"), "{err}");
 }

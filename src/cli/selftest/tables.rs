@@ -30,6 +30,20 @@ fn breakdown(m: &Metrics) -> String {
     )
 }
 
+/// Recall, precision, F, endpoint mean / p95, angle and the breakdowns.
+fn scores(m: &Metrics) -> String {
+    format!(
+        "{:>6.3} {:>9.3} {:>6.3}  {:>6.3} / {:<5.3}  {:>7.3}  {}",
+        m.recall,
+        m.precision,
+        m.f_score(),
+        m.endpoint_mean,
+        m.endpoint_p95,
+        m.angle_mean_deg,
+        breakdown(m)
+    )
+}
+
 /// The cube family's report as a table.
 pub fn table(r: &EvalReport, profile: &str) -> String {
     let c = &r.config;
@@ -56,16 +70,10 @@ pub fn table(r: &EvalReport, profile: &str) -> String {
         for (name, m) in [("subpixel", &l.subpixel), ("whole-pixel", &l.whole_pixel)] {
             let _ = writeln!(
                 s,
-                "{:>6}  {:<11} {:>6.3} {:>9.3} {:>6.3}  {:>6.3} / {:<5.3}  {:>7.3}  {}  {:>6.0} {:>6.1}",
+                "{:>6}  {:<11} {}  {:>6.0} {:>6.1}",
                 l.noise,
                 name,
-                m.recall,
-                m.precision,
-                m.f_score(),
-                m.endpoint_mean,
-                m.endpoint_p95,
-                m.angle_mean_deg,
-                breakdown(m),
+                scores(m),
                 l.edge_points,
                 l.lines
             );
@@ -128,15 +136,9 @@ pub fn yard_table(r: &YardReport, profile: &str) -> String {
         let m = &l.metrics;
         let _ = writeln!(
             s,
-            "{:>6}  {:>6.3} {:>9.3} {:>6.3}  {:>6.3} / {:<5.3}  {:>7.3}  {}  {:>6.0} {:>6.1}",
+            "{:>6}  {}  {:>6.0} {:>6.1}",
             l.noise.to_string(),
-            m.recall,
-            m.precision,
-            m.f_score(),
-            m.endpoint_mean,
-            m.endpoint_p95,
-            m.angle_mean_deg,
-            breakdown(m),
+            scores(m),
             l.edge_points,
             l.lines
         );
