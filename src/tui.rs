@@ -1,4 +1,4 @@
-//! The operator console (issue 7): a keyboard-driven TUI over the survey,
+//! The operator console: a keyboard-driven TUI over the survey,
 //! the capture hardware, the LLV pipeline, the line editor and the reports.
 //!
 //! "Functional core, imperative shell": [`app::App`] holds the state and

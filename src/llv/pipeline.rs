@@ -78,6 +78,15 @@ impl<'a> Input<'a> {
     }
 }
 
+/// A saved stage result to run the later stages from ([`Workspace::run_saved`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Saved {
+    /// Edge points of both scan directions: line extraction and CONNECT run.
+    Edges { h: EdgePoints, v: EdgePoints },
+    /// Extracted lines (a `.lex`): CONNECT runs.
+    Lines(Vec<Segment>),
+}
+
 /// Reusable buffers for the whole pipeline, and the outputs of the last run.
 #[derive(Clone, Debug, Default)]
 pub struct Workspace {
@@ -145,7 +154,14 @@ impl Workspace {
         let size = check_input(input)?;
         // The kernel checks the half-width (`edges::check_half_width`).
         let a = p.edges.half_width as usize;
+        // The responses of a lens-corrected run with an ambient image are made
+        // from the corrected ambient, which a workspace built from earlier
+        // outputs alone (`with_outputs`) does not have: it corrects again.
+        let ambient_ready = input.ambient.is_none()
+            || self.out.corrected.is_empty()
+            || self.ambient_corrected.size() == size;
         let prev_fits = self.valid
+            && ambient_ready
             && self.out.edges_h.width == size.0
             && self.out.edges_h.height == size.1
             && self.out.response_h.covers(size.0, size.1);
@@ -182,36 +198,70 @@ impl Workspace {
             self.out.timings.edges_us = micros(t);
         }
         if from <= Stage::Lines {
-            let t = Instant::now();
-            extract_into(
-                &self.out.edges_h,
-                &p.lines,
-                &mut self.out.lines_raw,
-                &mut self.lines,
-            );
-            extract_into(&self.out.edges_v, &p.lines, &mut self.tmp, &mut self.lines);
-            self.out.lines_raw.extend_from_slice(&self.tmp);
-            self.out.timings.lines_us = micros(t);
+            self.extract_lines(p);
         }
-        {
-            let t = Instant::now();
-            connect_into(
-                &self.out.lines_raw,
-                &p.connect,
-                &mut self.out.lines,
-                &mut self.connect,
-            );
-            if p.connect.corner_radius > 0.0 {
-                close_corners_with(
-                    &mut self.out.lines,
-                    p.connect.corner_radius,
-                    &mut self.corners,
-                );
-            }
-            self.out.timings.connect_us = micros(t);
-        }
+        self.connect_lines(p);
         self.valid = true;
         Ok(&self.out)
+    }
+
+    /// Runs the stages after a saved result (`vss llv --from-edges`, `vss
+    /// session redo --from lines|connect`): line extraction and CONNECT from
+    /// edge points, or CONNECT alone from extracted lines. The outputs have no
+    /// images or responses (nor edge points, from lines), so a later
+    /// [`Workspace::rerun`] runs every stage.
+    pub fn run_saved(&mut self, saved: Saved, p: &Params) -> &StageOutputs {
+        self.valid = false;
+        self.out.corrected.clear();
+        self.out.response_h = Response::default();
+        self.out.response_v = Response::default();
+        self.out.params = p.clone();
+        self.out.timings = Timings::default();
+        match saved {
+            Saved::Edges { h, v } => {
+                self.out.edges_h = h;
+                self.out.edges_v = v;
+                self.extract_lines(p);
+            }
+            Saved::Lines(raw) => {
+                self.out.edges_h = EdgePoints::default();
+                self.out.edges_v = EdgePoints::default();
+                self.out.lines_raw = raw;
+            }
+        }
+        self.connect_lines(p);
+        &self.out
+    }
+
+    fn extract_lines(&mut self, p: &Params) {
+        let t = Instant::now();
+        extract_into(
+            &self.out.edges_h,
+            &p.lines,
+            &mut self.out.lines_raw,
+            &mut self.lines,
+        );
+        extract_into(&self.out.edges_v, &p.lines, &mut self.tmp, &mut self.lines);
+        self.out.lines_raw.extend_from_slice(&self.tmp);
+        self.out.timings.lines_us = micros(t);
+    }
+
+    fn connect_lines(&mut self, p: &Params) {
+        let t = Instant::now();
+        connect_into(
+            &self.out.lines_raw,
+            &p.connect,
+            &mut self.out.lines,
+            &mut self.connect,
+        );
+        if p.connect.corner_radius > 0.0 {
+            close_corners_with(
+                &mut self.out.lines,
+                p.connect.corner_radius,
+                &mut self.corners,
+            );
+        }
+        self.out.timings.connect_us = micros(t);
     }
 
     fn lens(&mut self, input: &Input, p: &Params) -> Result<(), LlvError> {
@@ -320,30 +370,13 @@ fn check_input(input: &Input) -> Result<(usize, usize), LlvError> {
 /// --from-edges`): the outputs have no images or responses.
 pub fn lines_from_edges(edges_h: EdgePoints, edges_v: EdgePoints, p: &Params) -> StageOutputs {
     let mut ws = Workspace::new();
-    ws.out.edges_h = edges_h;
-    ws.out.edges_v = edges_v;
-    ws.out.params = p.clone();
-    let t = Instant::now();
-    extract_into(
-        &ws.out.edges_h,
-        &p.lines,
-        &mut ws.out.lines_raw,
-        &mut ws.lines,
+    ws.run_saved(
+        Saved::Edges {
+            h: edges_h,
+            v: edges_v,
+        },
+        p,
     );
-    extract_into(&ws.out.edges_v, &p.lines, &mut ws.tmp, &mut ws.lines);
-    ws.out.lines_raw.extend_from_slice(&ws.tmp);
-    ws.out.timings.lines_us = micros(t);
-    let t = Instant::now();
-    connect_into(
-        &ws.out.lines_raw,
-        &p.connect,
-        &mut ws.out.lines,
-        &mut ws.connect,
-    );
-    if p.connect.corner_radius > 0.0 {
-        close_corners_with(&mut ws.out.lines, p.connect.corner_radius, &mut ws.corners);
-    }
-    ws.out.timings.connect_us = micros(t);
     ws.take_outputs()
 }
 
@@ -423,6 +456,50 @@ mod tests {
         q.edges.per_region = 3;
         let again = rerun(first, Stage::Edges, &input, &q).unwrap();
         assert_eq!(again.edges_h, run(&input, &q).unwrap().edges_h);
+    }
+
+    /// Several lightings with an ambient image and lens correction: a
+    /// rerun from the edges (a new half-width) on earlier outputs once
+    /// failed on the missing corrected ambient ("image sizes differ: (96,
+    /// 80) and (0, 0)"); it now matches a full run, on fresh outputs and in
+    /// a workspace kept between runs.
+    #[test]
+    fn rerun_with_lens_and_ambient_matches_a_full_run() {
+        let imgs = [square(96, 80), square(96, 80)];
+        let ambient = GreyImage::filled(96, 80, 30).unwrap();
+        let model = crate::llv::lens::CameraModel {
+            cx: 48.0,
+            cy: 40.0,
+            sx: 0.01,
+            sy: 0.01,
+            f: 8.0,
+            distortion: Some([-0.02, 0.0, 0.0, 0.0, 0.0]),
+        };
+        let map = LensMap::new(&model, 96, 80);
+        let input = Input {
+            images: &imgs,
+            ambient: Some(&ambient),
+            lens: Some(&map),
+        };
+        let p = Params::default();
+        let first = run(&input, &p).unwrap();
+        assert!(!first.corrected.is_empty());
+        for change in [
+            |q: &mut Params| q.edges.half_width = 5,
+            |q: &mut Params| q.edges.noise_factor = 6.0,
+            |q: &mut Params| q.edges.per_region = 3,
+        ] {
+            let mut q = p.clone();
+            change(&mut q);
+            let full = run(&input, &q).unwrap();
+            let again = rerun(first.clone(), Stage::Edges, &input, &q).unwrap();
+            assert_eq!(again.lines, full.lines);
+            let mut ws = Workspace::new();
+            ws.run(&input, &p).unwrap();
+            let kept = ws.rerun(Stage::Edges, &input, &q).unwrap();
+            assert_eq!(kept.edges_h, full.edges_h);
+            assert_eq!(kept.lines, full.lines);
+        }
     }
 
     #[test]

@@ -1,10 +1,10 @@
-//! Synthetic scenes with known edges (issue 3): polyhedra (cube, box,
+//! Synthetic scenes with known edges: polyhedra (cube, box,
 //! L-bracket) on a floor plate, Lambertian faces under point lights plus
 //! ambient light, seen by pinhole cameras with Weng lens distortion; rendered
 //! with area sampling, blur and seeded noise; plus the true visible edges, the
 //! visible corners, and the scoring of detected lines against them.
 //!
-//! The simulated cell (issue 4), the accuracy tests and `vss selftest` all
+//! The simulated cell, the accuracy tests and `vss selftest` all
 //! draw their images from here. Everything is deterministic for a seed.
 //!
 //! Brightness model (grey levels, before blur, noise and clamping to 0–255):

@@ -93,6 +93,9 @@ pub struct Loaded {
     /// Hand-edited lines read back from the session (resume), used instead
     /// of the first pipeline result's lines.
     pub saved_lines: Option<Vec<crate::llv::Segment>>,
+    /// Why the newest run failed (`None` after a run that worked): the
+    /// outputs shown are then an older run's.
+    pub failed: Option<String>,
 }
 
 /// The whole console state.
@@ -395,7 +398,7 @@ impl App {
                 });
                 Vec::new()
             }
-            Action::SaveOutputs => self.save_outputs(),
+            Action::SaveOutputs => self.save_outputs().unwrap_or_default(),
             Action::LineNext
             | Action::LinePrev
             | Action::LineNearest
@@ -560,23 +563,61 @@ impl App {
         self.generation > self.shown_generation && self.current.is_some()
     }
 
-    fn save_outputs(&mut self) -> Vec<Cmd> {
+    /// Why the outputs on screen are not those of the panel's values (a run
+    /// still out, the newest run failed, or no run yet), for view titles;
+    /// `None` when they are.
+    pub fn outputs_stale(&self) -> Option<&'static str> {
+        let cur = self.current.as_ref()?;
+        if cur.failed.is_some() {
+            Some("stale: last run failed")
+        } else if self.pipeline_busy() {
+            Some("stale: running")
+        } else if cur.outputs.is_some() && cur.outputs_params.as_ref() != Some(&self.params) {
+            Some("stale: other values")
+        } else {
+            None
+        }
+    }
+
+    /// The commands that save the outputs on screen, or `None` (said in the
+    /// log) when there is nothing to save or they were not made with the
+    /// panel's values: what is saved is always what the panel shows.
+    pub(crate) fn save_outputs(&mut self) -> Option<Vec<Cmd>> {
         let Some(cur) = self.current.as_ref() else {
             self.log
                 .push(Level::Warn, "nothing to save: no image processed yet");
-            return Vec::new();
+            return None;
         };
         let (Some(out), Some(params)) = (cur.outputs.clone(), cur.outputs_params.clone()) else {
             self.log.push(
                 Level::Warn,
                 "nothing to save: the pipeline has not finished",
             );
-            return Vec::new();
+            return None;
         };
+        if let Some(e) = &cur.failed {
+            let e = e.clone();
+            self.log.push(
+                Level::Error,
+                format!(
+                    "not saved: the last run failed ({e}); the outputs on screen were made \
+                     with other values than the panel's — change a value to run again"
+                ),
+            );
+            return None;
+        }
+        if params != self.params || self.pipeline_busy() {
+            self.log.push(
+                Level::Warn,
+                "not saved: the outputs on screen were not made with the panel's values yet \
+                 (a run is still out) — try again when it has finished",
+            );
+            return None;
+        }
         if self.session.is_none() {
             self.log
                 .push(Level::Warn, "no session open: outputs are not saved");
-            return Vec::new();
+            return None;
         }
         // A new .ldr replaces the edited one and clears the session's edit
         // log, so manual edits made since are recorded again on top.
@@ -598,7 +639,7 @@ impl App {
                 lines,
             }));
         }
-        cmds
+        Some(cmds)
     }
 }
 

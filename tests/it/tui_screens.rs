@@ -563,3 +563,59 @@ fn resumed_hand_edited_lines_win_over_the_first_rerun() {
         &edited[..]
     );
 }
+
+/// A run that fails leaves the older outputs on screen: the views say so,
+/// and neither the save key nor accept writes them as if they were the
+/// panel's values.
+#[test]
+fn a_failed_run_is_stale_and_is_never_saved() {
+    let mut app = reviewed();
+    key(&mut app, '3');
+    code(&mut app, KeyCode::Down); // edges.half_width
+    let cmds = key(&mut app, '+');
+    let Some(Cmd::Pipeline(req)) = cmds.into_iter().next() else {
+        panic!("a parameter step asks for a run");
+    };
+    let (s, _) = draw(&app, 80, 24);
+    assert!(s.contains("stale: running"), "{s}");
+    app.update(Msg::Pipeline(PipelineResult {
+        generation: req.generation,
+        image_key: req.image_key,
+        params: req.params.clone(),
+        outcome: Err(vss::llv::LlvError::SizeMismatch {
+            a: (96, 96),
+            b: (0, 0),
+        }
+        .to_string()),
+    }));
+    let (s, _) = draw(&app, 80, 24);
+    assert!(s.contains("stale: last run failed"), "{s}");
+    let save = vss::tui::keymap::KEYMAP
+        .iter()
+        .find(|b| b.action == vss::tui::keymap::Action::SaveOutputs)
+        .unwrap()
+        .key;
+    let KeyCode::Char(c) = save.code else {
+        panic!("a letter saves")
+    };
+    let cmds = app.update(Msg::Key(KeyEvent::new(
+        KeyCode::Char(c),
+        if save.ctrl {
+            KeyModifiers::CONTROL
+        } else {
+            KeyModifiers::NONE
+        },
+    )));
+    assert!(
+        !cmds.iter().any(|c| matches!(c, Cmd::Store(_))),
+        "nothing saved: {cmds:?}"
+    );
+    assert!(app.log.last().unwrap().text.contains("not saved"));
+    key(&mut app, '1');
+    let cmds = key(&mut app, 'a');
+    assert!(
+        !cmds.iter().any(|c| matches!(c, Cmd::Store(_))),
+        "accept saves nothing: {cmds:?}"
+    );
+    assert_eq!(app.work.phase, Phase::Review, "still reviewing image 1");
+}

@@ -1,6 +1,5 @@
-//! Scoring detected lines against true edges, with the LLV core's matching
-//! rule, don't-care edges, and the breakdowns that say where a detector
-//! loses.
+//! Scoring detected lines against true edges with the matching rule below,
+//! don't-care edges, and the breakdowns that say where a detector loses.
 //!
 //! A detected segment *supports* a true edge along the part of it that lies
 //! within [`DIST`] px of the true segment (distance to the segment, not to its

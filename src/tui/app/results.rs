@@ -36,10 +36,12 @@ impl App {
                 cur.edits = 0;
                 cur.outputs = Some(out);
                 cur.outputs_params = Some(r.params);
+                cur.failed = None;
                 self.edit.selected.clear();
                 self.pipeline_done()
             }
             Err(e) => {
+                cur.failed = Some(e.clone());
                 self.log.push(Level::Error, format!("pipeline: {e}"));
                 self.pipeline_failed()
             }

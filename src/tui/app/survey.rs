@@ -79,7 +79,9 @@ impl App {
                     );
                     return Vec::new();
                 }
-                let cmds = self.save_outputs();
+                let Some(cmds) = self.save_outputs() else {
+                    return Vec::new();
+                };
                 self.log
                     .push(Level::Info, format!("image {} accepted", self.work.k));
                 self.work.k += 1;
@@ -316,6 +318,7 @@ impl Loaded {
             editor: None,
             edits: 0,
             saved_lines: None,
+            failed: None,
         }
     }
 }

@@ -91,7 +91,11 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         .block(block(app, "lines"))
         .render(panel, buf);
     let [view, _] = Layout::vertical([Constraint::Min(1), Constraint::Length(0)]).areas(right);
-    let b = block(app, "lines over grey");
+    let title = match app.outputs_stale() {
+        Some(why) => format!("lines over grey — {why}"),
+        None => "lines over grey".to_string(),
+    };
+    let b = block(app, &title);
     let inner = b.inner(view);
     b.render(view, buf);
     if let (Some(c), Some(ls)) = (cur, lines)

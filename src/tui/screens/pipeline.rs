@@ -150,7 +150,11 @@ fn stage_view(app: &App, cur: &Loaded, v: StageView, area: Rect, buf: &mut Buffe
         (StageView::Lines | StageView::Overlay, Some(o)) => format!(" {}", o.lines.len()),
         _ => String::new(),
     };
-    let b = block(app, &format!("{}{count}", v.title()));
+    let stale = match (v, app.outputs_stale()) {
+        (StageView::Grey, _) | (_, None) => String::new(),
+        (_, Some(why)) => format!(" — {why}"),
+    };
+    let b = block(app, &format!("{}{count}{stale}", v.title()));
     let inner = b.inner(area);
     b.render(area, buf);
     match layer {

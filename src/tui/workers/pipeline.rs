@@ -1,15 +1,16 @@
 //! The pipeline worker: runs the LLV stages off the UI thread. Latest wins —
 //! a request waiting when a newer one arrives is dropped unseen — and when
 //! only parameters changed on the same images it re-runs from the first
-//! affected stage (`pipeline::rerun`). Results carry the request's
+//! affected stage (`Workspace::rerun`). Results carry the request's
 //! generation so the UI never lets an older run overwrite a newer one.
 
 use std::sync::{Arc, Condvar, Mutex};
 
 use super::send;
+use crate::llv::GreyImage;
 use crate::llv::lens::{CameraModel, LensMap};
-use crate::llv::pipeline::{self, Input, StageOutputs};
-use crate::llv::{GreyImage, Params};
+use crate::llv::params::Stage;
+use crate::llv::pipeline::{Input, StageOutputs, Workspace};
 use crate::tui::event::{ImageKey, Msg, PipelineRequest, PipelineResult};
 
 #[derive(Default)]
@@ -84,10 +85,15 @@ fn next(shared: &(Mutex<Slot>, Condvar)) -> Option<PipelineRequest> {
 }
 
 /// What the worker keeps between runs so a parameter tweak re-runs only
-/// the stages it affects.
+/// the stages it affects: one [`Workspace`] (every buffer, the lens-corrected
+/// ambient image included) and the image set it last ran on completely.
 #[derive(Default)]
 pub struct Engine {
-    prev: Option<(ImageKey, Option<CameraModel>, Params, Arc<StageOutputs>)>,
+    ws: Workspace,
+    /// The images and camera of the workspace's last complete run, and that
+    /// run's outputs as the UI got them. Cleared while a run is under way,
+    /// so a failed run leaves nothing to re-run from (the next is full).
+    last: Option<(ImageKey, Option<CameraModel>, Arc<StageOutputs>)>,
     lens: Option<(CameraModel, (usize, usize), Arc<LensMap>)>,
 }
 
@@ -109,25 +115,20 @@ impl Engine {
             ambient: req.ambient.as_deref(),
             lens: lens.as_deref(),
         };
-        let same_images = self
-            .prev
-            .as_ref()
-            .is_some_and(|(k, cam, _, _)| *k == req.image_key && *cam == req.camera);
-        let out = match (same_images, self.prev.take()) {
-            (true, Some((k, cam, p, out))) => match p.first_changed_stage(&req.params) {
-                None => {
-                    self.prev = Some((k, cam, p, out.clone()));
-                    return Ok(out);
+        let from = match self.last.take() {
+            Some((k, cam, out)) if k == req.image_key && cam == req.camera => {
+                match out.params.first_changed_stage(&req.params) {
+                    None => {
+                        self.last = Some((k, cam, out.clone()));
+                        return Ok(out);
+                    }
+                    Some(stage) => stage,
                 }
-                Some(stage) => {
-                    let owned = Arc::try_unwrap(out).unwrap_or_else(|a| (*a).clone());
-                    pipeline::rerun(owned, stage, &input, &req.params)?
-                }
-            },
-            _ => pipeline::run(&input, &req.params)?,
+            }
+            _ => Stage::Lens,
         };
-        let out = Arc::new(out);
-        self.prev = Some((req.image_key, req.camera, req.params.clone(), out.clone()));
+        let out = Arc::new(self.ws.rerun(from, &input, &req.params)?.clone());
+        self.last = Some((req.image_key, req.camera, out.clone()));
         Ok(out)
     }
 
