@@ -115,7 +115,10 @@ pub enum Command {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => crate::tui::run(&cli.global, cli.preview.as_deref()),
+        None => cli
+            .global
+            .load_profile()
+            .and_then(|p| crate::tui::run(p, crate::tui::mode::from_env(cli.preview.as_deref()))),
         Some(cmd) => run(&cli.global, cmd),
     };
     match result {

@@ -39,6 +39,7 @@ mod session_cli;
 mod session_crash;
 mod session_redo;
 mod tui_device;
+mod tui_flow;
 mod tui_harness;
 mod tui_pty;
 mod tui_pty_tuning;
