@@ -8,6 +8,8 @@ mod support;
 mod accuracy;
 mod accuracy_cli;
 mod accuracy_yard;
+mod calib;
+mod calib_cli;
 mod cli_formats;
 mod cli_pipe;
 mod formats_malformed;
