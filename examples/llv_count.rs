@@ -73,6 +73,7 @@ fn main() {
             nm,
             p.edges.floor,
             p.lines.track_sigmas,
+            p.edges.noise_sigmas,
             &mut PeakScratch::default(),
         );
     }
@@ -112,7 +113,7 @@ fn main() {
                     (&warm.response_v, &warm.noise_v, &mut mv, &mut ev),
                 ] {
                     let k = r.keys(&mut kh);
-                    m.build_into(&k, nm, p.edges.floor, t, &mut ps);
+                    m.build_into(&k, nm, p.edges.floor, t, p.edges.noise_sigmas, &mut ps);
                     peaks_into(&k, nm, m, &p.edges, e, &mut ps);
                     check += e.points.len();
                 }

@@ -168,7 +168,8 @@ pub fn track_into(
         let map = if map.fits(&k, floor, p.track_sigmas) {
             map
         } else {
-            own.build_into(&k, noise, floor, p.track_sigmas, &mut s.peaks);
+            let t = p.track_sigmas;
+            own.build_into(&k, noise, floor, t, t, &mut s.peaks);
             &own
         };
         track_keys(&k, noise, map, seeds, half_width, p, out, s);
@@ -469,8 +470,7 @@ fn segment_of(
         z.clear();
         z.extend(piece.iter().map(|q| q.z));
         let n = (last.v - first.v).abs() as usize + 1;
-        let significant = nfa.log10_nfa(n, z) <= p.log_nfa;
-        if !significant {
+        if !nfa.significant(n, z, p.log_nfa) {
             return None;
         }
     }

@@ -141,8 +141,13 @@ impl NoiseMap {
             for tx in 0..self.nx {
                 let x0 = tx * self.tw;
                 let x1 = if tx + 1 == self.nx { w } else { x0 + self.tw };
-                s.hist.clear();
-                s.hist.resize(BINS, 0);
+                if s.hist.len() == BINS {
+                    s.hist.fill(0);
+                } else {
+                    s.hist.clear();
+                    s.hist.resize(BINS, 0);
+                }
+                let hist: &mut [u16; BINS] = (&mut s.hist[..]).try_into().expect("BINS bins");
                 let mut n = 0usize;
                 let mut y = y0 + 1;
                 while y < y1 {
@@ -151,7 +156,7 @@ impl NoiseMap {
                     while x < x1 {
                         let key = row[x];
                         if key != NONE {
-                            s.hist[(key.max(0) as usize).min(BINS - 1)] += 1;
+                            hist[(key.max(0) as usize).min(BINS - 1)] += 1;
                             n += 1;
                         }
                         x += COLUMN_STEP;
@@ -160,7 +165,7 @@ impl NoiseMap {
                 }
                 let t = ty * self.nx + tx;
                 self.sigma[t] = if n >= MIN_SAMPLES {
-                    let sigma = median_bin(&s.hist, n) * k.scale * MEDIAN_TO_SIGMA;
+                    let sigma = median_bin(hist, n) * k.scale * MEDIAN_TO_SIGMA;
                     s.known.push(sigma);
                     sigma
                 } else {

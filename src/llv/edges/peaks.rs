@@ -34,9 +34,8 @@ pub struct PeakScratch {
     /// Per tile, the largest key that is not above the threshold; per
     /// column of a row of tiles, the same.
     thr: Vec<i32>,
+    strong_thr: Vec<i32>,
     cols: Vec<i16>,
-    /// The tile column of each image column.
-    tile_x: Vec<u32>,
     /// Per region: candidate count, then the smallest key kept.
     count: Vec<u32>,
     lim: Vec<i16>,
@@ -111,7 +110,8 @@ pub fn detect_into(
     {
         let k = resp.keys(&mut buf);
         noise.estimate_into(&k, &mut ns);
-        map.build_into(&k, noise, p.floor, track_sigmas.min(p.noise_sigmas), s);
+        let low = track_sigmas.min(p.noise_sigmas);
+        map.build_into(&k, noise, p.floor, low, p.noise_sigmas, s);
         peaks_into(&k, noise, map, p, out, s);
     }
     s.keys = buf;
@@ -130,9 +130,13 @@ pub struct PeakMap {
     dir: Option<ScanDir>,
     floor: f64,
     sigmas: f64,
+    strong_sigmas: f64,
     /// Positive and negative peaks.
     pub(crate) pos: Vec<u64>,
     pub(crate) neg: Vec<u64>,
+    /// The peaks above the strong threshold (the edge points' candidates):
+    /// image index and key, in image order.
+    strong: Vec<(u32, i16)>,
 }
 
 impl PeakMap {
@@ -145,13 +149,15 @@ impl PeakMap {
             && self.pos.len() == (k.width * k.height).div_ceil(64)
     }
 
-    /// The peaks of `k` above `floor` grey levels and `sigmas` noise sigmas.
+    /// The peaks of `k` above `floor` grey levels and `sigmas` noise sigmas,
+    /// and the list of those above `strong_sigmas` (with their keys).
     pub fn build_into(
         &mut self,
         k: &Keys,
         noise: &NoiseMap,
         floor: f64,
         sigmas: f64,
+        strong_sigmas: f64,
         s: &mut PeakScratch,
     ) {
         self.width = k.width;
@@ -159,6 +165,7 @@ impl PeakMap {
         self.dir = Some(k.dir);
         self.floor = floor;
         self.sigmas = sigmas;
+        self.strong_sigmas = strong_sigmas;
         let words = (k.width * k.height).div_ceil(64);
         for bits in [&mut self.pos, &mut self.neg] {
             bits.clear();
@@ -169,26 +176,28 @@ impl PeakMap {
         }
         let (nx, ny) = noise.tiles();
         s.thr.clear();
+        s.strong_thr.clear();
         for t in 0..nx * ny {
-            let limit = (floor as f32).max(sigmas as f32 * noise.sigma(t));
-            s.thr.push(key_floor(limit, k.scale));
+            let limit = |n: f64| key_floor((floor as f32).max(n as f32 * noise.sigma(t)), k.scale);
+            s.thr.push(limit(sigmas));
+            s.strong_thr.push(limit(strong_sigmas));
         }
-        let (pos, neg) = (&mut self.pos, &mut self.neg);
-        for_each_peak(k, noise, &s.thr, &mut s.cols, |i, _| {
-            let bits = if k.sums[i] > 0 { &mut *pos } else { &mut *neg };
-            bits[i / 64] |= 1 << (i % 64);
-        });
-    }
-
-    /// Calls `f(i)` for every peak's image index, in order.
-    fn for_each(&self, mut f: impl FnMut(usize)) {
-        for (j, (&p, &n)) in self.pos.iter().zip(&self.neg).enumerate() {
-            let mut bits = p | n;
-            while bits != 0 {
-                f(j * 64 + bits.trailing_zeros() as usize);
-                bits &= bits - 1;
-            }
-        }
+        self.strong.clear();
+        let (pos, neg, strong) = (&mut self.pos, &mut self.neg, &mut self.strong);
+        for_each_peak(
+            k,
+            noise,
+            &s.thr,
+            &s.strong_thr,
+            &mut s.cols,
+            |i, key, big| {
+                let bits = if k.sums[i] > 0 { &mut *pos } else { &mut *neg };
+                bits[i / 64] |= 1 << (i % 64);
+                if big {
+                    strong.push((i as u32, key));
+                }
+            },
+        );
     }
 }
 
@@ -218,28 +227,30 @@ pub fn peaks_into(
     if w < 3 || h < 3 || k.keys.len() != w * h || k.sums.len() != w * h || p.floor.is_nan() {
         return;
     }
-    // Per tile, the key a candidate must exceed.
-    let (nx, ny) = noise.tiles();
-    s.thr.clear();
-    for t in 0..nx * ny {
-        let limit = (p.floor as f32).max(p.noise_sigmas as f32 * noise.sigma(t));
-        s.thr.push(key_floor(limit, k.scale));
-    }
+    // The map's strong peaks, when it was made at these sigmas; else its
+    // peaks above them, one tile lookup each.
     let mut cand = std::mem::take(&mut s.cand);
-    s.tile_x.clear();
-    s.tile_x.extend((0..w).map(|x| noise.tile_of(x, 0) as u32));
-    let (mut row, mut row_start, mut row_tile) = (0, 0, noise.tile_of(0, 0));
-    map.for_each(|i| {
-        while i >= row_start + w {
-            row += 1;
-            row_start += w;
-            row_tile = noise.tile_of(0, row);
+    if map.strong_sigmas.to_bits() == p.noise_sigmas.to_bits() {
+        cand.extend_from_slice(&map.strong);
+    } else {
+        let (nx, ny) = noise.tiles();
+        s.thr.clear();
+        for t in 0..nx * ny {
+            let limit = (p.floor as f32).max(p.noise_sigmas as f32 * noise.sigma(t));
+            s.thr.push(key_floor(limit, k.scale));
         }
-        let key = k.keys[i];
-        if i32::from(key) > s.thr[row_tile + s.tile_x[i - row_start] as usize] {
-            cand.push((i as u32, key));
+        for (j, (&a, &b)) in map.pos.iter().zip(&map.neg).enumerate() {
+            let mut bits = a | b;
+            while bits != 0 {
+                let i = j * 64 + bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let key = k.keys[i];
+                if i32::from(key) > s.thr[noise.tile_of(i % w, i / w)] {
+                    cand.push((i as u32, key));
+                }
+            }
         }
-    });
+    }
     let rl = p.region_lines.max(1) as usize;
     let m = p.per_region.max(1) as usize;
     let region = |i: u32| -> usize {
@@ -293,18 +304,22 @@ fn candidates(
     cols: &mut Vec<i16>,
     cand: &mut Vec<(u32, i16)>,
 ) {
-    for_each_peak(k, noise, thr, cols, |i, key| cand.push((i as u32, key)));
+    for_each_peak(k, noise, thr, thr, cols, |i, key, _| {
+        cand.push((i as u32, key))
+    });
 }
 
-/// Calls `f(i, key)`, in image order, for every pixel index `i` that is a
-/// peak along the scan above its tile's threshold (`thr`, per tile of
-/// `noise`, as keys); `cols` is a buffer.
+/// Calls `f(i, key, strong)`, in image order, for every pixel index `i`
+/// that is a peak along the scan above its tile's threshold `thr` (per
+/// tile of `noise`, as keys), with `strong` whether it is above `strong`
+/// too (both thresholds in one pass); `cols` is a buffer.
 pub(crate) fn for_each_peak(
     k: &Keys,
     noise: &NoiseMap,
     thr: &[i32],
+    strong: &[i32],
     cols: &mut Vec<i16>,
-    mut f: impl FnMut(usize, i16),
+    mut f: impl FnMut(usize, i16, bool),
 ) {
     let (w, h) = (k.width, k.height);
     let keys = k.keys;
@@ -316,30 +331,26 @@ pub(crate) fn for_each_peak(
         ScanDir::Horizontal => 0..h,
         ScanDir::Vertical => 1..h - 1,
     };
+    let as_key = |t: Option<&i32>| t.copied().unwrap_or(i32::MAX).clamp(-1, i32::from(NONE)) as i16;
     for y in rows {
-        // The threshold of every column of this row's tiles.
+        // The thresholds of every column of this row's tiles: `cols[..w]`
+        // the peaks', `cols[w..]` the strong ones'.
         let t0 = noise.tile_of(0, y);
         if t0 != tile_row {
             tile_row = t0;
             cols.clear();
-            cols.extend((0..w).map(|x| {
-                let t = thr.get(noise.tile_of(x, y)).copied().unwrap_or(i32::MAX);
-                t.clamp(-1, i32::from(NONE)) as i16
-            }));
+            cols.extend((0..w).map(|x| as_key(thr.get(noise.tile_of(x, y)))));
+            cols.extend((0..w).map(|x| as_key(strong.get(noise.tile_of(x, y)))));
         }
+        let (low, high) = cols.split_at(w);
         let at = y * w;
         match k.dir {
             ScanDir::Horizontal => {
                 let row = &keys[at..at + w];
-                peak_bits(
-                    &row[..w - 2],
-                    &row[1..w - 1],
-                    &row[2..],
-                    &cols[1..w - 1],
-                    |x| {
-                        f(at + x + 1, row[x + 1]);
-                    },
-                );
+                let (lo, mid, hi) = (&row[..w - 2], &row[1..w - 1], &row[2..]);
+                peak_bits([lo, mid, hi], &low[1..w - 1], &high[1..w - 1], |x, s| {
+                    f(at + x + 1, row[x + 1], s);
+                });
             }
             ScanDir::Vertical => {
                 let (up, row, dn) = (
@@ -347,18 +358,29 @@ pub(crate) fn for_each_peak(
                     &keys[at..at + w],
                     &keys[at + w..at + 2 * w],
                 );
-                peak_bits(up, row, dn, cols, |x| f(at + x, row[x]));
+                peak_bits([up, row, dn], low, high, |x, s| f(at + x, row[x], s));
             }
         }
     }
 }
 
-/// Calls `f(i)`, in order, for every `i` with `mid[i] > lo[i]`, `mid[i] ≥
-/// hi[i]`, `mid[i] > thr[i]` and `mid[i] ≠ NONE` (all slices as long).
+/// Calls `f(i, strong)`, in order, for every `i` with `mid[i] > lo[i]`,
+/// `mid[i] ≥ hi[i]`, `mid[i] > thr[i]` and `mid[i] ≠ NONE`, where `strong`
+/// is `mid[i] > strong[i]` (all slices as long).
 #[inline(always)]
-fn peak_bits(lo: &[i16], mid: &[i16], hi: &[i16], thr: &[i16], mut f: impl FnMut(usize)) {
+fn peak_bits(
+    [lo, mid, hi]: [&[i16]; 3],
+    thr: &[i16],
+    strong: &[i16],
+    mut f: impl FnMut(usize, bool),
+) {
     use wide::{CmpEq, CmpGt, i16x16};
-    let n = mid.len().min(lo.len()).min(hi.len()).min(thr.len());
+    let n = mid
+        .len()
+        .min(lo.len())
+        .min(hi.len())
+        .min(thr.len())
+        .min(strong.len());
     let load = |s: &[i16], i: usize| i16x16::new(*s[i..].first_chunk::<16>().expect("16 lanes"));
     let none = i16x16::splat(NONE);
     let mut i = 0;
@@ -367,16 +389,20 @@ fn peak_bits(lo: &[i16], mid: &[i16], hi: &[i16], thr: &[i16], mut f: impl FnMut
         let c = k0.cmp_gt(load(lo, i)) & k0.cmp_gt(load(thr, i));
         let c = c & !(load(hi, i).cmp_gt(k0) | k0.cmp_eq(none));
         let mut bits = c.move_mask() as u32 & 0xFFFF;
-        while bits != 0 {
-            f(i + bits.trailing_zeros() as usize);
-            bits &= bits - 1;
+        if bits != 0 {
+            let big = (c & k0.cmp_gt(load(strong, i))).move_mask() as u32;
+            while bits != 0 {
+                let b = bits.trailing_zeros();
+                f(i + b as usize, big >> b & 1 != 0);
+                bits &= bits - 1;
+            }
         }
         i += 16;
     }
     for j in i..n {
         let k0 = mid[j];
         if k0 > lo[j] && k0 >= hi[j] && k0 > thr[j] && k0 != NONE {
-            f(j);
+            f(j, k0 > strong[j]);
         }
     }
 }

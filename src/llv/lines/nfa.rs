@@ -91,6 +91,18 @@ impl Nfa {
         t
     }
 
+    /// Whether a segment spanning `n` scan lines whose points have the
+    /// noise sigmas `z` has `log10 NFA ≤ log_eps`: the levels are tried
+    /// from the most selective down, and the first that suffices decides
+    /// (most edges are significant at their own level at once).
+    pub fn significant(&self, n: usize, z: &[f32], log_eps: f64) -> bool {
+        let need = log_eps - self.log10_tests;
+        self.levels[..self.count].iter().rev().any(|&(level, p)| {
+            let k = z.iter().filter(|&&v| v >= level).count();
+            log10_binomial_tail(n, k, p) <= need
+        })
+    }
+
     /// `log10 NFA` of a segment spanning `n` scan lines whose points have
     /// the noise sigmas `z` (one point a scan line at most).
     pub fn log10_nfa(&self, n: usize, z: &[f32]) -> f64 {
@@ -196,6 +208,20 @@ mod tests {
         assert!(ok(40, &[2.2; 40]));
         assert!(!ok(60, &[2.2; 12]));
         assert!(ok(80, &[3.0; 50]));
+        // The early-exit test agrees with the full count.
+        for (n, z) in [
+            (10, vec![6.0f32; 10]),
+            (10, vec![2.2; 10]),
+            (60, vec![2.6; 30]),
+        ] {
+            for eps in [-5.0, 0.0, 5.0] {
+                assert_eq!(
+                    t.significant(n, &z, eps),
+                    t.log10_nfa(n, &z) <= eps,
+                    "{n} {eps}"
+                );
+            }
+        }
     }
 
     /// The table itself: a fresh simulation of the peak test on white noise
