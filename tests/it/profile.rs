@@ -172,8 +172,8 @@ fn wrong_types_name_line_key_and_range() {
 #[test]
 fn unknown_keys_name_line_and_key() {
     assert_names(
-        "per_region = 8 ",
-        "per_regoin = 8 ",
+        "per_region = 16 ",
+        "per_regoin = 16 ",
         "per_regoin",
         &["llv.edges"],
     );
