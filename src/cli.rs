@@ -40,6 +40,7 @@ macro_rules! errln {
     }};
 }
 
+pub mod calibrate;
 pub mod convert;
 pub mod grab;
 pub mod info;
@@ -105,6 +106,8 @@ pub enum Command {
     Grab(grab::Args),
     /// Switch and read the lights.
     Lights(lights::Args),
+    /// Calibrate a camera from images of a calibration plate (writes its .cdf).
+    Calibrate(calibrate::Args),
     /// Create, show, check and redo survey sessions.
     Session(session::Args),
     /// Write PostScript and SVG reports.
@@ -115,7 +118,10 @@ pub enum Command {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => crate::tui::run(&cli.global, cli.preview.as_deref()),
+        None => cli
+            .global
+            .load_profile()
+            .and_then(|p| crate::tui::run(p, crate::tui::mode::from_env(cli.preview.as_deref()))),
         Some(cmd) => run(&cli.global, cmd),
     };
     match result {
@@ -156,6 +162,7 @@ fn run(g: &Global, cmd: Command) -> anyhow::Result<ExitCode> {
         Command::Sim(a) => sim::run(g, a),
         Command::Grab(a) => grab::run(g, a),
         Command::Lights(a) => lights::run(g, a),
+        Command::Calibrate(a) => calibrate::run(g, a),
         Command::Session(a) => session::run(g, a),
         Command::Report(a) => report::run(g, a),
     }

@@ -11,6 +11,7 @@
 //! - [`cli`]: headless subcommands; [`tui`]: the operator console.
 //! - [`text`]: the one sanitiser of text shown to a person.
 
+pub mod calib;
 pub mod cli;
 pub mod formats;
 pub mod fsutil;

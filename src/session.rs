@@ -472,6 +472,20 @@ impl Session {
         self.commit()
     }
 
+    /// Takes back the last manual edit of `k`: writes `lines` (the set
+    /// before it) as the new `NAMEk.ldr` and drops the edit from the log,
+    /// so the log holds the edits in effect and an undo is not an edit.
+    pub fn undo_edit(&mut self, k: u32, lines: &[Segment]) -> Result<(), SessionError> {
+        self.writable()?;
+        check_image_number(k)?;
+        let file = self.file_name(k, None, "ldr");
+        let bytes = formats::lines::format_lines(lines).into_bytes();
+        self.write_file(&file, &bytes)?;
+        let r = self.record_mut(k)?;
+        r.edit.pop();
+        self.commit()
+    }
+
     /// The current lines of `k` (`.ldr`), with their attributes when no
     /// manual edit changed them since the outputs were made.
     pub fn load_lines(&self, k: u32) -> Result<Vec<Segment>, SessionError> {

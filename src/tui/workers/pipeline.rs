@@ -55,7 +55,7 @@ pub fn spawn(ui: std::sync::mpsc::Sender<Msg>) -> std::io::Result<PipelineHandle
                 let generation = req.generation;
                 let image_key = req.image_key;
                 let params = req.params.clone();
-                let outcome = engine.process(&req).map_err(|e| e.to_string());
+                let outcome = engine.process(&req);
                 send(
                     &ui,
                     Msg::Pipeline(PipelineResult {
