@@ -436,31 +436,18 @@ impl Store {
             }
             Err(_) => format!("; there is no {} yet", ps.display()),
         };
-        let reports = s.reports().map_err(|e| StoreError::Report {
-            why: e.to_string(),
-            old: old(&ps),
-        })?;
-        if reports.is_empty() {
+        if s.manifest().image.is_empty() {
             return Err(StoreError::Report {
                 why: "the session has no images yet".into(),
                 old: old(&ps),
             });
         }
-        let title = format!("survey {name}");
-        let mut paths = Vec::new();
-        let write = |path: &Path, text: &str| {
-            crate::fsutil::write_atomic(path, text.as_bytes()).map_err(|e| StoreError::Report {
-                why: format!("{}: {e}", path.display()),
-                old: old(path),
-            })
-        };
-        write(&ps, &report::ps::survey_report(&title, &reports))?;
-        paths.push(ps);
-        for r in &reports {
-            let svg = s.path(&format!("{}.svg", r.title));
-            write(&svg, &report::svg::image_svg(r))?;
-            paths.push(svg);
-        }
-        Ok(paths)
+        // The one report writer, the one `vss report` uses.
+        report::survey::write(s, None, &report::survey::Targets::in_session(s)).map_err(|e| {
+            StoreError::Report {
+                why: e.to_string(),
+                old: old(&ps),
+            }
+        })
     }
 }
