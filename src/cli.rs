@@ -7,11 +7,19 @@ use clap::{Parser, Subcommand};
 
 /// `println!` that hands a failed write back (`?`, as a [`StdoutError`])
 /// instead of panicking: a reader that goes away (`vss info FILE | head
-/// -2`) ends the command quietly (see [`main`]).
+/// -2`) ends the command quietly (see [`main`]). What it prints goes
+/// through the one sanitiser ([`crate::text::sanitize_lines`]): text from
+/// files (a note, a light name, a comment) never reaches the terminal with
+/// an escape sequence in it.
 macro_rules! outln {
+    () => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout()).map_err($crate::cli::StdoutError)?
+    }};
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        writeln!(std::io::stdout(), $($arg)*).map_err($crate::cli::StdoutError)?
+        let text = $crate::text::sanitize_lines(&format!($($arg)*));
+        writeln!(std::io::stdout(), "{text}").map_err($crate::cli::StdoutError)?
     }};
 }
 
@@ -19,7 +27,16 @@ macro_rules! outln {
 macro_rules! out {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        write!(std::io::stdout(), $($arg)*).map_err($crate::cli::StdoutError)?
+        let text = $crate::text::sanitize_lines(&format!($($arg)*));
+        write!(std::io::stdout(), "{text}").map_err($crate::cli::StdoutError)?
+    }};
+}
+
+/// `eprintln!` through the one sanitiser: notes and errors name files and
+/// quote what they hold.
+macro_rules! errln {
+    ($($arg:tt)*) => {{
+        eprintln!("{}", $crate::text::sanitize_lines(&format!($($arg)*)))
     }};
 }
 
@@ -110,7 +127,7 @@ pub fn main() -> ExitCode {
         // wanted, so stop quietly, as a pipeline expects.
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("vss: error: {e:#}");
+            errln!("vss: error: {e:#}");
             ExitCode::FAILURE
         }
     }

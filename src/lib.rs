@@ -9,6 +9,7 @@
 //! - [`rig`]: the frame grabber and relay-board drivers, and the simulated cell.
 //! - [`session`]: a survey on disk; [`report`]: PostScript and SVG.
 //! - [`cli`]: headless subcommands; [`tui`]: the operator console.
+//! - [`text`]: the one sanitiser of text shown to a person.
 
 pub mod cli;
 pub mod formats;
@@ -18,4 +19,5 @@ pub mod profile;
 pub mod report;
 pub mod rig;
 pub mod session;
+pub mod text;
 pub mod tui;

@@ -12,12 +12,12 @@
 //! ([`Session::redo`]).
 
 pub mod check;
+pub mod input;
 pub mod lock;
 pub mod manifest;
 pub mod outputs;
 pub mod progress;
 pub mod redo;
-pub mod reporting;
 pub mod stamp;
 #[doc(hidden)]
 pub mod torture;
@@ -32,6 +32,7 @@ use crate::llv::{LlvError, Segment};
 use crate::profile::Profile;
 
 pub use check::CheckReport;
+pub use input::{FrameRule, PipelineInput, Runner};
 pub use lock::{Lock, LockInfo};
 pub use manifest::Manifest;
 pub use outputs::OutputSet;
@@ -292,10 +293,12 @@ impl Session {
             Some(take_over) => Some(Lock::acquire(&dir.join(format!("{name}.lock")), take_over)?),
             None => None,
         };
-        let text = fs::read_to_string(&manifest_path).map_err(|source| SessionError::Io {
-            path: manifest_path.clone(),
-            source,
-        })?;
+        // Bounded, and not through a link: the size is refused unread.
+        let text = crate::fsutil::read_input_text(&manifest_path, manifest::MAX_LEN as u64)
+            .map_err(|source| SessionError::Io {
+                path: manifest_path.clone(),
+                source,
+            })?;
         let manifest = Manifest::parse(&text, &manifest_path)?;
         if manifest.session.name != name.as_str() {
             return Err(SessionError::Manifest {
@@ -575,7 +578,9 @@ impl Session {
         };
         let ses_file = format!("{}.ses", self.name);
         let ses_text = formats::ses::format_ses(&ses);
-        if fs::read_to_string(self.path(&ses_file)).ok().as_deref() != Some(ses_text.as_str()) {
+        let ses_path = self.path(&ses_file);
+        let on_disk = crate::fsutil::read_input_text(&ses_path, formats::max_len(&ses_path));
+        if on_disk.ok().as_deref() != Some(ses_text.as_str()) {
             self.write_file(&ses_file, ses_text.as_bytes())?;
         }
         let manifest_file = format!("{}.toml", self.name);

@@ -78,6 +78,15 @@ impl<'a> Input<'a> {
     }
 }
 
+/// A saved stage result to run the later stages from ([`Workspace::run_saved`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Saved {
+    /// Edge points of both scan directions: line extraction and CONNECT run.
+    Edges { h: EdgePoints, v: EdgePoints },
+    /// Extracted lines (a `.lex`): CONNECT runs.
+    Lines(Vec<Segment>),
+}
+
 /// Reusable buffers for the whole pipeline, and the outputs of the last run.
 #[derive(Clone, Debug, Default)]
 pub struct Workspace {
@@ -189,36 +198,70 @@ impl Workspace {
             self.out.timings.edges_us = micros(t);
         }
         if from <= Stage::Lines {
-            let t = Instant::now();
-            extract_into(
-                &self.out.edges_h,
-                &p.lines,
-                &mut self.out.lines_raw,
-                &mut self.lines,
-            );
-            extract_into(&self.out.edges_v, &p.lines, &mut self.tmp, &mut self.lines);
-            self.out.lines_raw.extend_from_slice(&self.tmp);
-            self.out.timings.lines_us = micros(t);
+            self.extract_lines(p);
         }
-        {
-            let t = Instant::now();
-            connect_into(
-                &self.out.lines_raw,
-                &p.connect,
-                &mut self.out.lines,
-                &mut self.connect,
-            );
-            if p.connect.corner_radius > 0.0 {
-                close_corners_with(
-                    &mut self.out.lines,
-                    p.connect.corner_radius,
-                    &mut self.corners,
-                );
-            }
-            self.out.timings.connect_us = micros(t);
-        }
+        self.connect_lines(p);
         self.valid = true;
         Ok(&self.out)
+    }
+
+    /// Runs the stages after a saved result (`vss llv --from-edges`, `vss
+    /// session redo --from lines|connect`): line extraction and CONNECT from
+    /// edge points, or CONNECT alone from extracted lines. The outputs have no
+    /// images or responses (nor edge points, from lines), so a later
+    /// [`Workspace::rerun`] runs every stage.
+    pub fn run_saved(&mut self, saved: Saved, p: &Params) -> &StageOutputs {
+        self.valid = false;
+        self.out.corrected.clear();
+        self.out.response_h = Response::default();
+        self.out.response_v = Response::default();
+        self.out.params = p.clone();
+        self.out.timings = Timings::default();
+        match saved {
+            Saved::Edges { h, v } => {
+                self.out.edges_h = h;
+                self.out.edges_v = v;
+                self.extract_lines(p);
+            }
+            Saved::Lines(raw) => {
+                self.out.edges_h = EdgePoints::default();
+                self.out.edges_v = EdgePoints::default();
+                self.out.lines_raw = raw;
+            }
+        }
+        self.connect_lines(p);
+        &self.out
+    }
+
+    fn extract_lines(&mut self, p: &Params) {
+        let t = Instant::now();
+        extract_into(
+            &self.out.edges_h,
+            &p.lines,
+            &mut self.out.lines_raw,
+            &mut self.lines,
+        );
+        extract_into(&self.out.edges_v, &p.lines, &mut self.tmp, &mut self.lines);
+        self.out.lines_raw.extend_from_slice(&self.tmp);
+        self.out.timings.lines_us = micros(t);
+    }
+
+    fn connect_lines(&mut self, p: &Params) {
+        let t = Instant::now();
+        connect_into(
+            &self.out.lines_raw,
+            &p.connect,
+            &mut self.out.lines,
+            &mut self.connect,
+        );
+        if p.connect.corner_radius > 0.0 {
+            close_corners_with(
+                &mut self.out.lines,
+                p.connect.corner_radius,
+                &mut self.corners,
+            );
+        }
+        self.out.timings.connect_us = micros(t);
     }
 
     fn lens(&mut self, input: &Input, p: &Params) -> Result<(), LlvError> {
@@ -327,30 +370,13 @@ fn check_input(input: &Input) -> Result<(usize, usize), LlvError> {
 /// --from-edges`): the outputs have no images or responses.
 pub fn lines_from_edges(edges_h: EdgePoints, edges_v: EdgePoints, p: &Params) -> StageOutputs {
     let mut ws = Workspace::new();
-    ws.out.edges_h = edges_h;
-    ws.out.edges_v = edges_v;
-    ws.out.params = p.clone();
-    let t = Instant::now();
-    extract_into(
-        &ws.out.edges_h,
-        &p.lines,
-        &mut ws.out.lines_raw,
-        &mut ws.lines,
+    ws.run_saved(
+        Saved::Edges {
+            h: edges_h,
+            v: edges_v,
+        },
+        p,
     );
-    extract_into(&ws.out.edges_v, &p.lines, &mut ws.tmp, &mut ws.lines);
-    ws.out.lines_raw.extend_from_slice(&ws.tmp);
-    ws.out.timings.lines_us = micros(t);
-    let t = Instant::now();
-    connect_into(
-        &ws.out.lines_raw,
-        &p.connect,
-        &mut ws.out.lines,
-        &mut ws.connect,
-    );
-    if p.connect.corner_radius > 0.0 {
-        close_corners_with(&mut ws.out.lines, p.connect.corner_radius, &mut ws.corners);
-    }
-    ws.out.timings.connect_us = micros(t);
     ws.take_outputs()
 }
 

@@ -58,6 +58,9 @@ pub struct SimOptions {
     /// Largest READ block the grabber serves.
     pub maxblock: u32,
     pub faults: Faults,
+    /// How long the relay board takes between a command's echo and its
+    /// answer and `>` prompt (real boards take up to tens of ms).
+    pub prompt_delay: std::time::Duration,
 }
 
 impl SimOptions {
@@ -92,9 +95,10 @@ impl SimOptions {
             noise: p.sim.noise.max(0.0),
             cameras: 4,
             lights,
-            relays: 16,
+            relays: p.relay.channels.unwrap_or(16),
             maxblock: 65536,
             faults: Faults::default(),
+            prompt_delay: std::time::Duration::ZERO,
         }
     }
 }
