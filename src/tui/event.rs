@@ -11,6 +11,7 @@ use ratatui::crossterm::event::{KeyEvent, MouseEvent};
 use crate::llv::lens::CameraModel;
 use crate::llv::pipeline::StageOutputs;
 use crate::llv::{GreyImage, LlvError, Params, Segment};
+use crate::session::input::PipelineInput;
 
 pub use super::workers::store::StoreError;
 
@@ -251,10 +252,9 @@ pub enum DeviceCmd {
 pub struct PipelineRequest {
     pub generation: u64,
     pub image_key: ImageKey,
-    /// Lit images (one or more), and the ambient one if the lighting set has it.
-    pub images: Arc<Vec<GreyImage>>,
-    pub ambient: Option<Arc<GreyImage>>,
-    pub camera: Option<CameraModel>,
+    /// The image's frames split by the profile's rule, with its camera
+    /// (the one input the session code and the CLI run too).
+    pub input: Arc<PipelineInput>,
     pub params: Params,
 }
 

@@ -46,3 +46,4 @@ mod tui_harness;
 mod tui_pty;
 mod tui_pty_tuning;
 mod tui_screens;
+mod tui_truth;

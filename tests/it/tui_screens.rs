@@ -13,7 +13,7 @@ use ratatui::backend::TestBackend;
 use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::style::Color;
 
-use vss::llv::pipeline::{self, Input};
+use vss::llv::pipeline;
 use vss::llv::{GreyImage, Params};
 use vss::profile::Profile;
 use vss::tui::app::{App, Phase};
@@ -146,15 +146,7 @@ pub fn view() -> SessionView {
 pub fn run(app: &mut App, cmds: Vec<Cmd>) {
     for c in cmds {
         if let Cmd::Pipeline(req) = c {
-            let out = pipeline::run(
-                &Input {
-                    images: &req.images,
-                    ambient: req.ambient.as_deref(),
-                    lens: None,
-                },
-                &req.params,
-            )
-            .unwrap();
+            let out = pipeline::run(&req.input.input(None), &req.params).unwrap();
             app.update(Msg::Pipeline(PipelineResult {
                 generation: req.generation,
                 image_key: req.image_key,
@@ -199,8 +191,11 @@ pub fn reviewed_in(v: SessionView) -> App {
             _ => None,
         })
         .expect("pipeline asked once all lightings are in");
-    assert_eq!(req.images.len(), 2, "lit images");
-    assert!(req.ambient.is_some(), "lighting c is ambient");
+    assert_eq!(req.input.letters, vec!['a', 'b'], "lit images");
+    assert!(
+        req.input.ambient.as_ref().is_some_and(|a| a.0 == 'c'),
+        "lighting c is ambient"
+    );
     run(&mut app, cmds);
     assert_eq!(app.session.work.phase, Phase::Review);
     app

@@ -5,6 +5,7 @@
 use crate::llv::GreyImage;
 use crate::llv::lens::CameraModel;
 use crate::profile::Profile;
+use crate::session::input::FrameRule;
 use crate::tui::event::FramePurpose;
 use crate::tui::text::clean;
 
@@ -30,6 +31,8 @@ pub struct CellState {
     /// Lighting letters of the profile, and which one is ambient (no light on).
     pub letters: Vec<char>,
     pub ambient: Option<char>,
+    /// Which frames are lit and which is ambient: the session code's rule.
+    pub rule: FrameRule,
     /// Light names and relay channels, in profile order.
     pub lights: Vec<(String, u32)>,
     /// Lighting configuration letter → names of the lights on.
@@ -43,13 +46,10 @@ pub struct CellState {
 
 impl CellState {
     pub fn new(profile: &Profile) -> CellState {
-        let ambient = profile
-            .lighting
-            .iter()
-            .find(|l| l.on.is_empty())
-            .map(|l| l.letter)
-            .filter(|_| profile.lighting.len() > 1);
+        let rule = FrameRule::of_profile(profile);
+        let ambient = rule.ambient();
         CellState {
+            rule,
             profile_name: clean(&profile.name),
             letters: profile.lighting.iter().map(|l| l.letter).collect(),
             ambient,

@@ -10,6 +10,7 @@ use super::{Ctx, Pending};
 use crate::llv::edit::LineEditor;
 use crate::llv::pipeline::StageOutputs;
 use crate::llv::{GreyImage, Params, Segment};
+use crate::session::input::PipelineInput;
 use crate::tui::event::{Cmd, ImageKey, PipelineRequest, StoreCmd};
 
 /// The grey images of one image number and what the pipeline made of them.
@@ -40,6 +41,8 @@ pub struct Loaded {
     pub edit_confirmed: bool,
     /// Lightings whose saved grey image is damaged, with why.
     pub damaged: Vec<(char, String)>,
+    /// The pipeline input made of `frames` (and for which version of them).
+    pub input: Option<(u64, Arc<PipelineInput>)>,
 }
 
 impl Loaded {
@@ -59,6 +62,7 @@ impl Loaded {
             accepted: false,
             edit_confirmed: false,
             damaged: Vec::new(),
+            input: None,
         }
     }
 
@@ -134,41 +138,33 @@ impl Tracker {
         }
     }
 
-    /// A pipeline request for the current image (`None` when there is none).
+    /// A pipeline request for the current image (`None` when there is none):
+    /// its frames split by the profile's rule, as the session code splits
+    /// them.
     pub fn request(&mut self, cell: &super::CellState) -> Option<Cmd> {
-        let cur = self.current.as_ref()?;
+        let cur = self.current.as_mut()?;
         if cur.frames.is_empty() {
             return None;
         }
-        let mut images = Vec::new();
-        let mut amb = None;
-        // Letter order, as the session names the corrected images.
-        let mut frames: Vec<&(char, GreyImage)> = cur.frames.iter().collect();
-        frames.sort_by_key(|(l, _)| {
-            cell.letters
-                .iter()
-                .position(|x| x == l)
-                .unwrap_or(usize::MAX)
-        });
-        for (l, g) in frames {
-            if Some(*l) == cell.ambient {
-                amb = Some(Arc::new(g.clone()));
-            } else {
-                images.push(g.clone());
+        let camera = cell.camera_model(cur.camera);
+        let input = match &cur.input {
+            Some((v, input)) if *v == cur.version && input.camera == camera => input.clone(),
+            _ => {
+                let input = Arc::new(
+                    cell.rule
+                        .split(cur.frames.iter().cloned())
+                        .with_camera(camera),
+                );
+                cur.input = Some((cur.version, input.clone()));
+                input
             }
-        }
-        if images.is_empty() {
-            // Only an ambient image: use it as the one image.
-            images.extend(amb.take().map(|a| (*a).clone()));
-        }
-        let (k, version, camera) = (cur.k, cur.version, cell.camera_model(cur.camera));
+        };
+        let (k, version) = (cur.k, cur.version);
         self.generation += 1;
         Some(Cmd::Pipeline(PipelineRequest {
             generation: self.generation,
             image_key: ImageKey { k, version },
-            images: Arc::new(images),
-            ambient: amb,
-            camera,
+            input,
             params: self.params.clone(),
         }))
     }

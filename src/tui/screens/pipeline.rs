@@ -137,16 +137,11 @@ fn stage_view(
 ) {
     let out = cur.outputs.as_deref();
     let img: &GreyImage = &grey.image;
-    // The corrected image of the lighting shown (lit lightings only).
+    // The corrected image of the lighting shown (lit lightings only, in
+    // the order the frame rule gives the pipeline its images).
     let corrected = |o: &'_ crate::llv::pipeline::StageOutputs| -> Option<usize> {
         let l = grey.letter?;
-        let lit: Vec<char> = app
-            .cell
-            .letters
-            .iter()
-            .copied()
-            .filter(|c| Some(*c) != app.cell.ambient && cur.frame(*c).is_some())
-            .collect();
+        let lit = app.cell.rule.lit_letters(cur.frames.iter().map(|f| f.0));
         lit.iter()
             .position(|c| *c == l)
             .filter(|&i| i < o.corrected.len())

@@ -16,8 +16,7 @@ use crate::formats::img::ImgFile;
 use crate::llv::lens::CameraModel;
 use crate::profile::Profile;
 use crate::report;
-use crate::session::manifest::TimingsRecord;
-use crate::session::{CheckReport, OutputSet, Session, SessionError};
+use crate::session::{CheckReport, Session, SessionError};
 use crate::tui::event::{Msg, SessionEntry, StoreCmd, StoreEvent};
 
 mod load;
@@ -112,13 +111,18 @@ impl Store {
     }
 
     fn run(mut self, rx: Receiver<StoreCmd>) {
-        self.reply(StoreEvent::Cameras(self.camera_models()));
+        self.cameras();
         if let Some(p) = logfile::state_path() {
             self.use_log(p);
         }
         while let Ok(cmd) = rx.recv() {
             self.handle(cmd);
         }
+    }
+
+    /// Reports the camera models of the profile's `.cdf` files.
+    pub fn cameras(&self) {
+        self.reply(StoreEvent::Cameras(self.camera_models()));
     }
 
     fn reply(&self, e: StoreEvent) {
@@ -207,21 +211,7 @@ impl Store {
             }
             StoreCmd::SaveOutputs { k, outputs, params } => {
                 let s = self.session_mut()?;
-                let t = &outputs.timings;
-                let set = OutputSet {
-                    corrected: &outputs.corrected,
-                    edges_h: Some(&outputs.edges_h),
-                    edges_v: Some(&outputs.edges_v),
-                    lines_raw: Some(&outputs.lines_raw),
-                    lines: Some(&outputs.lines),
-                    timings: TimingsRecord {
-                        lens_us: t.lens_us,
-                        edges_us: t.edges_us,
-                        lines_us: t.lines_us,
-                        connect_us: t.connect_us,
-                    },
-                };
-                s.save_output_set(k, &set, &params)
+                s.save_outputs(k, &outputs, &params)
                     .map_err(session_err(format!("outputs of image {k} NOT saved")))?;
                 let files: Vec<String> = ["hpo", "vpo", "lex", "ldr"]
                     .iter()
@@ -417,36 +407,30 @@ impl Store {
             .collect()
     }
 
-    /// Writes the survey report `NAME.ps` and one `NAMEk.svg` per image,
-    /// from the session's own report pages (those `vss report` writes).
+    /// Writes the survey report `NAME.ps` and one `NAMEk.svg` per image in
+    /// the session folder, through the one report writer (`vss report`
+    /// writes the same pages). A failure says which file on disk is old.
     fn export(&mut self) -> Result<Vec<PathBuf>, StoreError> {
         let s = self.session.as_ref().ok_or(StoreError::NoSession)?;
-        let name = s.name().as_str().to_string();
-        let ps = s.path(&format!("{name}.ps"));
-        let old = |ps: &Path| match std::fs::metadata(ps).and_then(|m| m.modified()) {
-            Ok(t) => {
-                let secs = t
-                    .duration_since(std::time::UNIX_EPOCH)
-                    .map_or(0, |d| d.as_secs());
-                format!(
-                    "; {} on disk is the OLD report, written {}",
-                    ps.display(),
-                    crate::session::stamp::rfc3339(secs)
-                )
-            }
-            Err(_) => format!("; there is no {} yet", ps.display()),
-        };
-        if s.manifest().image.is_empty() {
-            return Err(StoreError::Report {
-                why: "the session has no images yet".into(),
-                old: old(&ps),
-            });
-        }
-        // The one report writer, the one `vss report` uses.
-        report::survey::write(s, None, &report::survey::Targets::in_session(s)).map_err(|e| {
+        let targets = report::survey::Targets::in_session(s);
+        let ps = targets.ps.clone().unwrap_or_default();
+        report::survey::write(s, None, &targets).map_err(|e| {
+            let old = match std::fs::metadata(&ps).and_then(|m| m.modified()) {
+                Ok(t) => {
+                    let secs = t
+                        .duration_since(std::time::UNIX_EPOCH)
+                        .map_or(0, |d| d.as_secs());
+                    format!(
+                        "; {} on disk is the OLD report, written {}",
+                        ps.display(),
+                        crate::session::stamp::rfc3339(secs)
+                    )
+                }
+                Err(_) => format!("; there is no {} yet", ps.display()),
+            };
             StoreError::Report {
                 why: e.to_string(),
-                old: old(&ps),
+                old,
             }
         })
     }
