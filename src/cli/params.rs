@@ -20,7 +20,7 @@ use super::Global;
 use crate::formats::par::{ParamSet, format_par, from_params, import_params, write_par};
 use crate::llv::Params;
 use crate::llv::params::{Kind, PARAMS};
-use crate::profile::{Profile, edit, resolve};
+use crate::profile::{Origin, Profile, edit};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -79,10 +79,12 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         }
         Cmd::Import { file, out } => {
             let base_name = g.profile.as_deref().unwrap_or("default");
-            let base_path = resolve(base_name)?;
-            let base_text = std::fs::read_to_string(&base_path)
-                .with_context(|| format!("cannot read profile {}", base_path.display()))?;
-            let base = Profile::from_toml(&base_text, &base_path)?;
+            let origin = crate::profile::locate(base_name)?;
+            let (base_text, base_path) = crate::profile::text_of(&origin)?;
+            let base = match origin {
+                Origin::File(_) => Profile::from_toml(&base_text, &base_path)?,
+                Origin::Builtin => Profile::builtin()?,
+            };
             let text =
                 std::fs::read(&file).with_context(|| format!("cannot read {}", file.display()))?;
             let text = std::str::from_utf8(&text).map_err(|_| {
@@ -102,7 +104,13 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                         .with_context(|| format!("cannot write {}", o.display()))?;
                     let moved = o.parent().map(|d| d.canonicalize().ok())
                         != base_path.parent().map(|d| d.canonicalize().ok());
-                    if moved && base.survey.cdf.iter().any(|c| c.is_relative()) {
+                    let relative = base.survey.cdf.iter().any(|c| c.is_relative());
+                    if base.builtin && relative {
+                        errln!(
+                            "vss: note: {} names the built-in cameras' .cdf files (sim/cam1.cdf, …), which are not files: put them beside it or change survey.cdf",
+                            o.display()
+                        );
+                    } else if moved && relative {
                         errln!(
                             "vss: note: {} is in another folder than {}: its relative survey.cdf paths now point elsewhere",
                             o.display(),

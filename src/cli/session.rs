@@ -7,7 +7,6 @@ use std::process::ExitCode;
 use anyhow::Context as _;
 
 use super::Global;
-use crate::profile::Profile;
 use crate::session::{OutputState, Session};
 
 #[derive(Debug, clap::Args)]
@@ -106,55 +105,29 @@ fn session_dir(g: &Global, dir: PathBuf) -> PathBuf {
     if dir.is_dir() || !bare {
         return dir;
     }
-    match profile(g) {
-        Ok((p, _)) if p.survey.dir.join(&dir).is_dir() => p.survey.dir.join(&dir),
+    match g.load_profile() {
+        Ok(p) if p.survey.dir.join(&dir).is_dir() => p.survey.dir.join(&dir),
         _ => dir,
     }
 }
 
-/// The profile named with --profile; without one, `default` if it exists,
-/// else the built-in defaults.
-fn profile(g: &Global) -> anyhow::Result<(Profile, Option<PathBuf>)> {
-    let name = g.profile.as_deref().unwrap_or("default");
-    match crate::profile::resolve(name) {
-        Ok(path) => {
-            let p = g.load_profile()?;
-            Ok((p, Some(path)))
-        }
-        Err(_) if g.profile.is_none() => Ok((Profile::default(), None)),
-        Err(e) => Err(e.into()),
-    }
-}
-
 fn new(g: &Global, name: &str, dir: Option<PathBuf>) -> anyhow::Result<ExitCode> {
-    let (profile, profile_path) = profile(g)?;
+    let profile = g.load_profile()?;
     let parent = dir.unwrap_or_else(|| profile.survey.dir.clone());
     let mut s = Session::create(&parent, name, &profile)?;
-    // Camera descriptions named by the profile (relative to it) go into the
-    // session as NAMEk.cdf for every planned image of that camera.
-    let base = profile_path
-        .as_deref()
-        .and_then(Path::parent)
-        .map(Path::to_path_buf)
-        .unwrap_or_default();
+    // The camera descriptions the profile names go into the session as
+    // NAMEk.cdf for every planned image of that camera.
     let cams = s.manifest().session.cameras.max(1);
     for k in 1..=s.manifest().session.planned_images {
         let cam = (k - 1) % cams + 1;
-        let cdf = profile
-            .survey
-            .cdf
-            .get((cam - 1) as usize)
-            .map(|c| base.join(c));
-        if let Some(c) = &cdf
-            && !c.is_file()
-        {
-            errln!(
-                "vss: warning: camera {cam}: {} not found; image {k} has no camera description",
-                c.display()
-            );
-            continue;
-        }
-        s.set_image_info(k, cam, (k - 1) / cams + 1, cdf.as_deref())?;
+        let cdf = match profile.camera_cdf(cam) {
+            Ok(c) => c,
+            Err(e) => {
+                errln!("vss: warning: {e}; image {k} has no camera description");
+                continue;
+            }
+        };
+        s.set_image_camera(k, cam, (k - 1) / cams + 1, cdf.as_ref())?;
     }
     if let Some(w) = s.name().dos_warning(s.manifest().session.planned_images) {
         errln!("vss: note: {w}");
@@ -303,7 +276,7 @@ fn check(dir: &Path, strict: bool) -> anyhow::Result<ExitCode> {
 }
 
 fn redo(g: &Global, dir: &Path, k: u32, from: &str, take_over: bool) -> anyhow::Result<ExitCode> {
-    let (profile, _) = profile(g)?;
+    let profile = g.load_profile()?;
     let stage = match from {
         "lens" => crate::llv::params::Stage::Lens,
         "edges" => crate::llv::params::Stage::Edges,

@@ -9,6 +9,7 @@ mod accuracy;
 mod accuracy_cli;
 mod cli_formats;
 mod cli_pipe;
+mod cli_standalone;
 mod formats_malformed;
 mod formats_roundtrip;
 mod llv_alloc;
