@@ -34,11 +34,11 @@ pub enum Cmd {
     List,
     /// Write a profile's LLV parameters as a parameter file (.par).
     Export {
-        /// Profile: a path to a .toml file or a name from profiles/.
+        /// Profile: a path to a .toml file or a name (as for --profile).
         profile: String,
-        /// Which parameters: lens, edges, lines, connect or all.
-        #[arg(long = "set", value_name = "SET", default_value = "all", value_parser = ["lens", "edges", "lines", "connect", "all"])]
-        set: String,
+        /// Which parameters.
+        #[arg(long = "set", value_name = "SET", value_enum, default_value_t = SetArg::All)]
+        set: SetArg,
         /// Output file (default: standard output).
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
@@ -53,6 +53,33 @@ pub enum Cmd {
     },
 }
 
+/// The parameter set `vss params export --set` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SetArg {
+    /// Lens correction (`vss lens`).
+    Lens,
+    /// Edge detection (`vss edges`).
+    Edges,
+    /// Line extraction (`vss lines`).
+    Lines,
+    /// CONNECT and corner closing (`vss connect`).
+    Connect,
+    /// Every parameter (`vss all`).
+    All,
+}
+
+impl From<SetArg> for ParamSet {
+    fn from(s: SetArg) -> ParamSet {
+        match s {
+            SetArg::Lens => ParamSet::Lens,
+            SetArg::Edges => ParamSet::Edges,
+            SetArg::Lines => ParamSet::Lines,
+            SetArg::Connect => ParamSet::Connect,
+            SetArg::All => ParamSet::All,
+        }
+    }
+}
+
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     match a.cmd {
         Cmd::List => {
@@ -61,7 +88,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         }
         Cmd::Export { profile, set, out } => {
             let p = Profile::load(&profile)?;
-            let set = ParamSet::parse(&set).context("unknown parameter set")?;
+            let set = ParamSet::from(set);
             let f = from_params(&p.llv, set);
             match out {
                 Some(o) => {

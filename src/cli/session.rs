@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use anyhow::Context as _;
 
 use super::Global;
+use crate::llv::params::Stage;
 use crate::session::{OutputState, Session};
 
 #[derive(Debug, clap::Args)]
@@ -41,8 +42,8 @@ pub enum Cmd {
         #[arg(long, value_name = "K")]
         image: u32,
         /// First stage to re-run.
-        #[arg(long, value_name = "STAGE", value_parser = ["lens", "edges", "lines", "connect"], default_value = "edges")]
-        from: String,
+        #[arg(long, value_name = "STAGE", value_enum, default_value_t = FromStage::Edges)]
+        from: FromStage,
         /// Take over the lock of a console that is gone.
         #[arg(long)]
         take_over: bool,
@@ -60,6 +61,30 @@ pub enum Cmd {
     },
 }
 
+/// The stage `vss session redo --from` starts at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FromStage {
+    /// Lens correction and everything after it, on the grey images.
+    Lens,
+    /// Edges and everything after them, on the grey images.
+    Edges,
+    /// Line extraction and CONNECT, on the saved .hpo and .vpo.
+    Lines,
+    /// CONNECT alone, on the saved .lex.
+    Connect,
+}
+
+impl From<FromStage> for Stage {
+    fn from(s: FromStage) -> Stage {
+        match s {
+            FromStage::Lens => Stage::Lens,
+            FromStage::Edges => Stage::Edges,
+            FromStage::Lines => Stage::Lines,
+            FromStage::Connect => Stage::Connect,
+        }
+    }
+}
+
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     match a.command {
         Cmd::New { name, dir } => new(g, &name, dir),
@@ -70,7 +95,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             image,
             from,
             take_over,
-        } => redo(g, &session_dir(g, dir), image, &from, take_over),
+        } => redo(g, &session_dir(g, dir), image, from.into(), take_over),
         Cmd::Torture { dir, seed, limit } => {
             use std::io::Write as _;
             let mut out = std::io::stdout().lock();
@@ -275,14 +300,8 @@ fn check(dir: &Path, strict: bool) -> anyhow::Result<ExitCode> {
     })
 }
 
-fn redo(g: &Global, dir: &Path, k: u32, from: &str, take_over: bool) -> anyhow::Result<ExitCode> {
+fn redo(g: &Global, dir: &Path, k: u32, stage: Stage, take_over: bool) -> anyhow::Result<ExitCode> {
     let profile = g.load_profile()?;
-    let stage = match from {
-        "lens" => crate::llv::params::Stage::Lens,
-        "edges" => crate::llv::params::Stage::Edges,
-        "lines" => crate::llv::params::Stage::Lines,
-        _ => crate::llv::params::Stage::Connect,
-    };
     let mut s = if take_over {
         Session::open_take_over(dir)?
     } else {

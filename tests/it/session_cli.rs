@@ -369,3 +369,27 @@ fn hostile_manifest_text_never_reaches_the_terminal() {
         assert!(found.is_empty(), "{f}: {found:?}");
     }
 }
+
+/// The choice arguments refuse what they do not know, listing what they do.
+#[test]
+fn choice_arguments_list_their_values() {
+    let d = tempfile::tempdir().unwrap();
+    for (args, values) in [
+        (
+            &["session", "redo", "x", "--image", "1", "--from", "sideways"][..],
+            "[possible values: lens, edges, lines, connect]",
+        ),
+        (
+            &["--preview", "sideways"][..],
+            "[possible values: ascii, braille, blocks]",
+        ),
+        (
+            &["params", "export", "default", "--set", "sideways"][..],
+            "[possible values: lens, edges, lines, connect, all]",
+        ),
+    ] {
+        let o = vss(args, d.path());
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(text(&o).contains(values), "{args:?}: {}", text(&o));
+    }
+}
