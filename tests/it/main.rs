@@ -12,6 +12,7 @@ mod calib;
 mod calib_cli;
 mod cli_formats;
 mod cli_pipe;
+mod cli_standalone;
 mod formats_malformed;
 mod formats_roundtrip;
 mod llv_alloc;
