@@ -123,10 +123,56 @@ impl FormatError {
     }
 }
 
-/// Reads a whole file (the size is the file's real size, so the allocation
-/// is bounded by what is on disk).
+/// The largest file of each kind a reader takes, from what its format
+/// allows (the cell's files are far smaller; these only stop a hostile or
+/// broken file from costing gigabytes):
+/// - `.img`/`.imc`: the 64-byte header, a 200-byte comment and 65535 × 65535
+///   pixels, the most its 16-bit size fields can describe;
+/// - `.hpo`/`.vpo`: a header line and 12 bytes for each of up to two points
+///   per pixel of the largest image the LLV stages take
+///   ([`crate::llv::image::MAX_PIXELS`]), 1.5 GiB;
+/// - PNG, PGM, TIFF, BMP: 512 MiB (the decoded image may have at most
+///   256 MiB, and none of these is larger than what it decodes to by much);
+/// - `.lex`/`.ldr`: 256 MiB of text (about 4 M segments);
+/// - `.cdf`, `.par`: 1 MiB of text; `.ses`: three numbers, 4 KiB;
+/// - anything else: 16 MiB.
+pub fn max_len(path: &Path) -> u64 {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    match ext.as_str() {
+        "img" | "imc" => img::max_file_len(),
+        "hpo" | "vpo" => edgefile::max_file_len(),
+        "png" | "pgm" | "pnm" | "tif" | "tiff" | "bmp" => 512 << 20,
+        "lex" | "ldr" => 256 << 20,
+        "cdf" | "par" => 1 << 20,
+        "ses" => 4 << 10,
+        _ => 16 << 20,
+    }
+}
+
+/// Reads a whole file through [`crate::fsutil::read_input`]: a regular file,
+/// not through a link, at most [`max_len`] bytes.
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, FormatError> {
-    std::fs::read(path).map_err(|e| FormatError::io(path, "read", &e))
+    read_bytes_within(path, max_len(path))
+}
+
+/// [`read_bytes`] with an explicit bound.
+pub(crate) fn read_bytes_within(path: &Path, limit: u64) -> Result<Vec<u8>, FormatError> {
+    crate::fsutil::read_input(path, limit).map_err(|e| input_err(path, &e))
+}
+
+/// An error opening or reading an input file: a file over its bound is a
+/// `Range` error, anything else `Io`.
+pub(crate) fn input_err(path: &Path, e: &std::io::Error) -> FormatError {
+    let kind = if e.kind() == std::io::ErrorKind::FileTooLarge {
+        FormatErrorKind::Range
+    } else {
+        FormatErrorKind::Io
+    };
+    FormatError::new(path, Location::None, kind, format!("cannot read: {e}"))
 }
 
 /// Writes a file atomically, mapping the error.
@@ -219,11 +265,9 @@ pub(crate) fn shorten(s: &str) -> String {
     out
 }
 
-/// A comment or name made safe to show to the operator: control characters
-/// removed (formats.md §2).
-pub fn sanitize(s: &str) -> String {
-    s.chars().filter(|c| !c.is_control()).collect()
-}
+/// A comment or name made safe to show to the operator (formats.md §2):
+/// the crate's one sanitiser.
+pub use crate::text::sanitize;
 
 #[cfg(test)]
 mod tests {

@@ -1,9 +1,33 @@
-//! Atomic file writes: temp file in the same folder, fsync, rename, fsync the
-//! folder. An interrupted save never corrupts the previous good file.
+//! The crate's one way to write a file and its one way to open a file it
+//! reads, because a session folder is a place others can write into too.
+//!
+//! Writing ([`write_atomic`]): a temporary file is *created* (never opened:
+//! `O_CREAT | O_EXCL | O_NOFOLLOW`, so a file or link planted under its name
+//! makes the creation fail instead of being written through) under a random
+//! name in the target's folder, filled, fsynced and renamed over the target,
+//! then the folder is fsynced. An interrupted save never corrupts the
+//! previous good file. The target name itself must be absent or a regular
+//! file: a symbolic link (or a FIFO, a device, a folder) there is refused
+//! with an error naming the path, so vss never writes through a link, even
+//! one that points back into its own folder. Temporary names embed the pid
+//! (and a hash of the host name), so the next write into a folder removes
+//! the temporary files of writers on this host that died (SIGKILL, power).
+//!
+//! Reading ([`read_input`], [`open_input`]): `O_NOFOLLOW | O_NONBLOCK`, then
+//! the opened file must be a regular file no larger than the caller's bound
+//! (each format says how large it can be). A FIFO cannot block a reader, a
+//! link to `/dev/zero` or to a file outside the folder is refused before a
+//! byte is read, and no reader allocates more than its bound.
 
-use std::fs::{self, File};
-use std::io::{self, Write};
-use std::path::Path;
+use std::ffi::OsStr;
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, Read, Write};
+use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
+use std::path::{Path, PathBuf};
+
+/// Marks a temporary file: `.NAME.tmp.PID.HHHHHHHHRRRRRRRR` (host hash,
+/// random part).
+const TMP_MARK: &str = ".tmp.";
 
 /// Writes `bytes` to `path` atomically. On error nothing at `path` changes and
 /// the temporary file is removed.
@@ -17,20 +41,14 @@ pub fn write_atomic_with(
     path: &Path,
     fill: impl FnOnce(&mut io::BufWriter<&mut File>) -> io::Result<()>,
 ) -> io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
+    let dir = parent_dir(path);
     let name = path
         .file_name()
         .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"))?;
-    let tmp = dir.join(format!(
-        ".{}.tmp.{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
+    check_target(path)?;
+    sweep_stale_temps(dir);
+    let (mut file, tmp) = create_temp(dir, name)?;
     let result = (|| {
-        let mut file = File::create(&tmp)?;
         {
             let mut w = io::BufWriter::new(&mut file);
             fill(&mut w)?;
@@ -50,29 +68,224 @@ pub fn write_atomic_with(
     result
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn replaces_whole_file_and_leaves_no_temp() {
-        let dir = tempfile::tempdir().unwrap();
-        let p = dir.path().join("a.txt");
-        write_atomic(&p, b"first").unwrap();
-        write_atomic(&p, b"second").unwrap();
-        assert_eq!(fs::read(&p).unwrap(), b"second");
-        let names: Vec<_> = fs::read_dir(dir.path()).unwrap().collect();
-        assert_eq!(names.len(), 1);
-    }
-
-    #[test]
-    fn failed_fill_keeps_previous_file() {
-        let dir = tempfile::tempdir().unwrap();
-        let p = dir.path().join("a.txt");
-        write_atomic(&p, b"good").unwrap();
-        let err = write_atomic_with(&p, |_| Err(io::Error::other("boom")));
-        assert!(err.is_err());
-        assert_eq!(fs::read(&p).unwrap(), b"good");
-        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
+/// The folder a path lives in (`.` for a bare name).
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
     }
 }
+
+/// What a non-regular file is, for messages.
+fn describe(t: fs::FileType) -> &'static str {
+    if t.is_symlink() {
+        "a symbolic link"
+    } else if t.is_dir() {
+        "a folder"
+    } else if t.is_fifo() {
+        "a FIFO (named pipe)"
+    } else if t.is_char_device() || t.is_block_device() {
+        "a device"
+    } else if t.is_socket() {
+        "a socket"
+    } else {
+        "not a regular file"
+    }
+}
+
+/// Refuses a write target that is anything but absent or a regular file:
+/// vss replaces files, it never writes through a link or into a device.
+pub fn check_target(path: &Path) -> io::Result<()> {
+    match fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_file() => Ok(()),
+        Ok(m) if m.file_type().is_symlink() => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "{} is a symbolic link; vss writes no file through a link — \
+                 remove the link or write to another name",
+                path.display()
+            ),
+        )),
+        Ok(m) => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "{} is {}, not a regular file; vss only replaces regular files",
+                path.display(),
+                describe(m.file_type())
+            ),
+        )),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e),
+    }
+}
+
+/// A hash of this host's name, so the temporary files of another host
+/// sharing the folder (NFS) are never taken for a dead writer's.
+fn host_tag() -> u32 {
+    let host = fs::read_to_string("/proc/sys/kernel/hostname")
+        .or_else(|_| fs::read_to_string("/etc/hostname"))
+        .unwrap_or_default();
+    crc32fast::hash(host.trim().as_bytes())
+}
+
+/// 32 unpredictable bits: std's hasher keys come from the OS's randomness.
+fn random_u32() -> u32 {
+    use std::hash::BuildHasher;
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let t = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos());
+    let h = std::hash::RandomState::new().hash_one((n, t));
+    (h ^ (h >> 32)) as u32
+}
+
+/// The temporary name for a file called `name`.
+fn temp_name(name: &OsStr) -> String {
+    format!(
+        ".{}{TMP_MARK}{}.{:08x}{:08x}",
+        name.to_string_lossy(),
+        std::process::id(),
+        host_tag(),
+        random_u32()
+    )
+}
+
+/// Creates a new temporary file for `name` in `dir`, exclusively: a name
+/// that exists (a file, a planted link) is never opened, another random
+/// name is tried.
+pub(crate) fn create_temp(dir: &Path, name: &OsStr) -> io::Result<(File, PathBuf)> {
+    let mut last = None;
+    for _ in 0..16 {
+        let tmp = dir.join(temp_name(name));
+        match create_exclusive(&tmp) {
+            Ok(f) => return Ok((f, tmp)),
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => last = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    Err(last.unwrap_or_else(|| io::Error::other("cannot create a temporary file")))
+}
+
+/// Creates `path`, failing if anything (a file, a link, even a dangling
+/// one) is there already.
+fn create_exclusive(path: &Path) -> io::Result<File> {
+    OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .custom_flags(libc::O_NOFOLLOW)
+        .open(path)
+}
+
+/// Who left a temporary file: its pid, and whether it names this host
+/// (files of the older `.NAME.tmp.PID` form had no host and were always
+/// made here).
+fn temp_owner(file_name: &str) -> Option<(u32, bool)> {
+    let rest = file_name.strip_prefix('.')?;
+    let at = rest.rfind(TMP_MARK)?;
+    let tail = rest.get(at + TMP_MARK.len()..)?;
+    let (pid, tag) = match tail.split_once('.') {
+        Some((pid, tag)) => (pid, Some(tag)),
+        None => (tail, None),
+    };
+    let pid: u32 = pid.parse().ok().filter(|&p| p > 0)?;
+    let here = match tag {
+        None => true,
+        Some(t) if t.len() == 16 && t.bytes().all(|b| b.is_ascii_hexdigit()) => {
+            u32::from_str_radix(t.get(..8)?, 16).ok()? == host_tag()
+        }
+        Some(_) => return None,
+    };
+    Some((pid, here))
+}
+
+/// Removes the temporary files in `dir` whose writer ran on this host and
+/// is gone. Returns how many went. Best effort: a folder that cannot be
+/// listed is left alone, and without `/proc` nothing is removed.
+pub fn sweep_stale_temps(dir: &Path) -> usize {
+    if !Path::new("/proc/self").exists() {
+        return 0;
+    }
+    let Ok(rd) = fs::read_dir(dir) else {
+        return 0;
+    };
+    let me = std::process::id();
+    let mut removed = 0;
+    for entry in rd.filter_map(Result::ok) {
+        let name = entry.file_name();
+        let Some((pid, here)) = name.to_str().and_then(temp_owner) else {
+            continue;
+        };
+        if !here || pid == me || Path::new(&format!("/proc/{pid}")).exists() {
+            continue;
+        }
+        // Only files and links (unlinking a link leaves its target alone).
+        let kind = entry.file_type();
+        if kind.is_ok_and(|t| t.is_file() || t.is_symlink())
+            && fs::remove_file(entry.path()).is_ok()
+        {
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// Opens a file to read it: not through a symbolic link, without blocking
+/// on a FIFO, and only if it is a regular file of at most `limit` bytes.
+/// Returns the file and its size. Errors say what the path is instead.
+pub fn open_input(path: &Path, limit: u64) -> io::Result<(File, u64)> {
+    let file = OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK)
+        .open(path)
+        .map_err(|e| {
+            if e.raw_os_error() == Some(libc::ELOOP) {
+                io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    "it is a symbolic link; vss reads no file through a link — name the file itself",
+                )
+            } else {
+                e
+            }
+        })?;
+    let meta = file.metadata()?;
+    if !meta.file_type().is_file() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("it is {}, not a regular file", describe(meta.file_type())),
+        ));
+    }
+    if meta.len() > limit {
+        return Err(too_large(meta.len(), limit));
+    }
+    Ok((file, meta.len()))
+}
+
+fn too_large(len: u64, limit: u64) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::FileTooLarge,
+        format!("it has {len} bytes, more than the {limit} this kind of file may have"),
+    )
+}
+
+/// Reads a whole file through [`open_input`]: at most `limit` bytes, even
+/// if the file grows while it is read.
+pub fn read_input(path: &Path, limit: u64) -> io::Result<Vec<u8>> {
+    let (file, len) = open_input(path, limit)?;
+    let mut bytes = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
+    file.take(limit.saturating_add(1)).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(bytes.len() as u64, limit));
+    }
+    Ok(bytes)
+}
+
+/// [`read_input`] of a UTF-8 text file.
+pub fn read_input_text(path: &Path, limit: u64) -> io::Result<String> {
+    String::from_utf8(read_input(path, limit)?)
+        .map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e.utf8_error()))
+}
+
+#[cfg(test)]
+mod tests;

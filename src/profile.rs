@@ -86,6 +86,11 @@ pub struct RelayConfig {
     pub timeout_ms: u64,
     /// Wait after switching before a freeze (ms).
     pub settle_ms: u64,
+    /// Relays on the board: 1, 2, 4, 8, 16 or 32. A Numato board's mask
+    /// width follows it (learned from the board when not given); an LCUS
+    /// board cannot be asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub channels: Option<u32>,
 }
 
 impl Default for RelayConfig {
@@ -96,6 +101,7 @@ impl Default for RelayConfig {
             baud: 19200,
             timeout_ms: 500,
             settle_ms: 200,
+            channels: None,
         }
     }
 }
@@ -181,6 +187,11 @@ impl Default for SimConfig {
     }
 }
 
+/// The largest profile read: 1 MiB (a fully commented profile is about
+/// 10 KiB; TOML parsing costs 25–50 times the text in memory, so a 12 MB
+/// file once took 576 MB). Larger files are refused unread.
+pub const MAX_LEN: usize = 1 << 20;
+
 /// A profile that could not be loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum ProfileError {
@@ -204,6 +215,16 @@ impl Profile {
     /// messages (and becomes [`Profile::source`]). Every error names the
     /// file, the line and the key, and says what is allowed.
     pub fn from_toml(text: &str, path: &Path) -> Result<Profile, ProfileError> {
+        if text.len() > MAX_LEN {
+            return Err(ProfileError::Invalid {
+                path: path.to_path_buf(),
+                line: 1,
+                message: format!(
+                    "the profile has {} bytes, more than the {MAX_LEN} a profile may have",
+                    text.len()
+                ),
+            });
+        }
         let mut p = check::parse_checked(text, path)?;
         p.source = Some(path.to_path_buf());
         Ok(p)
@@ -212,9 +233,12 @@ impl Profile {
     /// Loads a profile by path, or by name from the `profiles/` folder.
     pub fn load(name_or_path: &str) -> Result<Profile, ProfileError> {
         let path = resolve(name_or_path)?;
-        let text = std::fs::read_to_string(&path).map_err(|source| ProfileError::Io {
-            path: path.clone(),
-            source,
+        // Bounded, so a huge file is refused unread.
+        let text = crate::fsutil::read_input_text(&path, MAX_LEN as u64).map_err(|source| {
+            ProfileError::Io {
+                path: path.clone(),
+                source,
+            }
         })?;
         Profile::from_toml(&text, &path)
     }

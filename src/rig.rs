@@ -40,8 +40,9 @@ pub enum RigError {
     )]
     Vanished { port: String, source: io::Error },
     #[error(
-        "{port}: no reply to `{command}` within {timeout_ms} ms ({attempts} attempts) — \
-         is the device on, and is the baud rate right?"
+        "{port}: no reply to `{command}` within {timeout_ms} ms ({}) — \
+         is the device on, and is the baud rate right?",
+        tries(*attempts)
     )]
     Timeout {
         port: String,
@@ -57,7 +58,8 @@ pub enum RigError {
         text: String,
     },
     #[error(
-        "{port}: garbled reply to `{command}` ({detail}) after {attempts} attempts — check the cable and the baud rate"
+        "{port}: garbled reply to `{command}` ({detail}) after {} — check the cable and the baud rate",
+        tries(*attempts)
     )]
     Garbled {
         port: String,
@@ -102,10 +104,30 @@ pub enum RigError {
     },
     #[error("{port}: {detail}")]
     Board { port: String, detail: String },
+    #[error(
+        "{port}: the board echoed `{command}` but sent no `>` prompt within {timeout_ms} ms ({}) — \
+         raise the relay board's timeout_ms in the profile",
+        tries(*attempts)
+    )]
+    NoPrompt {
+        port: String,
+        command: String,
+        timeout_ms: u64,
+        attempts: u32,
+    },
     #[error("{0}")]
     Config(String),
     #[error("simulator: {0}")]
     Sim(String),
+}
+
+/// "1 attempt", "3 attempts".
+fn tries(n: u32) -> String {
+    if n == 1 {
+        "1 attempt".into()
+    } else {
+        format!("{n} attempts")
+    }
 }
 
 impl RigError {

@@ -18,7 +18,6 @@ pub mod manifest;
 pub mod outputs;
 pub mod progress;
 pub mod redo;
-pub mod reporting;
 pub mod stamp;
 #[doc(hidden)]
 pub mod torture;
@@ -294,10 +293,12 @@ impl Session {
             Some(take_over) => Some(Lock::acquire(&dir.join(format!("{name}.lock")), take_over)?),
             None => None,
         };
-        let text = fs::read_to_string(&manifest_path).map_err(|source| SessionError::Io {
-            path: manifest_path.clone(),
-            source,
-        })?;
+        // Bounded, and not through a link: the size is refused unread.
+        let text = crate::fsutil::read_input_text(&manifest_path, manifest::MAX_LEN as u64)
+            .map_err(|source| SessionError::Io {
+                path: manifest_path.clone(),
+                source,
+            })?;
         let manifest = Manifest::parse(&text, &manifest_path)?;
         if manifest.session.name != name.as_str() {
             return Err(SessionError::Manifest {
@@ -471,6 +472,20 @@ impl Session {
         self.commit()
     }
 
+    /// Takes back the last manual edit of `k`: writes `lines` (the set
+    /// before it) as the new `NAMEk.ldr` and drops the edit from the log,
+    /// so the log holds the edits in effect and an undo is not an edit.
+    pub fn undo_edit(&mut self, k: u32, lines: &[Segment]) -> Result<(), SessionError> {
+        self.writable()?;
+        check_image_number(k)?;
+        let file = self.file_name(k, None, "ldr");
+        let bytes = formats::lines::format_lines(lines).into_bytes();
+        self.write_file(&file, &bytes)?;
+        let r = self.record_mut(k)?;
+        r.edit.pop();
+        self.commit()
+    }
+
     /// The current lines of `k` (`.ldr`), with their attributes when no
     /// manual edit changed them since the outputs were made.
     pub fn load_lines(&self, k: u32) -> Result<Vec<Segment>, SessionError> {
@@ -563,7 +578,9 @@ impl Session {
         };
         let ses_file = format!("{}.ses", self.name);
         let ses_text = formats::ses::format_ses(&ses);
-        if fs::read_to_string(self.path(&ses_file)).ok().as_deref() != Some(ses_text.as_str()) {
+        let ses_path = self.path(&ses_file);
+        let on_disk = crate::fsutil::read_input_text(&ses_path, formats::max_len(&ses_path));
+        if on_disk.ok().as_deref() != Some(ses_text.as_str()) {
             self.write_file(&ses_file, ses_text.as_bytes())?;
         }
         let manifest_file = format!("{}.toml", self.name);

@@ -9,10 +9,12 @@
 //! surveying the same session is not written under, and every frame lands
 //! in the manifest with the camera and its `.cdf`. The image number, camera
 //! and lightings are checked before a new session is made, so a refused
-//! grab leaves nothing behind.
+//! grab leaves nothing behind. A lock whose holder is gone (a grab killed
+//! mid-frame) or on another host is taken over with `--take-over`, or when
+//! the person at the terminal says yes; a live holder here never.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -24,7 +26,7 @@ use crate::formats::img::ImgFile;
 use crate::formats::names::{SessionName, VssFile};
 use crate::rig::Cell;
 use crate::rig::sim::Faults;
-use crate::session::Session;
+use crate::session::{Session, SessionError};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -43,6 +45,11 @@ pub struct Args {
     /// Overwrite images that exist already.
     #[arg(long)]
     pub yes: bool,
+    /// Take the session over when the lock's holder is gone (a killed
+    /// grab, a console that crashed) or ran on another host. Without it, a
+    /// terminal is asked; a live holder on this host is never displaced.
+    #[arg(long)]
+    pub take_over: bool,
     /// Faults injected into an embedded simulated grabber (testing).
     #[arg(long, value_name = "SPEC", hide = true)]
     pub sim_faults: Option<String>,
@@ -90,8 +97,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     };
     // An existing session is locked before the grabber is touched; a new
     // one is made only once the camera and lightings are known good.
-    let existing = Session::open_existing(&parent, session.as_str())
-        .with_context(|| format!("cannot open the session {}", a.session.display()))?;
+    let existing = open_existing(&parent, &session, &a)?;
     let faults = match &a.sim_faults {
         Some(s) => Faults::parse(s)?,
         None => Faults::default(),
@@ -148,6 +154,49 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         })?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Opens the session if it exists, taking over a lock whose holder is gone
+/// (or on another host) with `--take-over` or when a person at a terminal
+/// says so — the same rule as the console and `vss session redo`.
+fn open_existing(
+    parent: &Path,
+    session: &SessionName,
+    a: &Args,
+) -> anyhow::Result<Option<Session>> {
+    let context = || format!("cannot open the session {}", a.session.display());
+    match Session::open_existing(parent, session.as_str()) {
+        Err(e @ SessionError::Locked { stale, foreign, .. }) if stale || foreign => {
+            if a.take_over || ask_take_over(&e)? {
+                let dir = parent.join(session.as_str());
+                let s = Session::open_take_over(&dir).with_context(context)?;
+                eprintln!("took over the lock of {}", dir.display());
+                Ok(Some(s))
+            } else {
+                Err(anyhow::Error::new(e).context(context()))
+            }
+        }
+        r => r.with_context(context),
+    }
+}
+
+/// Asks on the terminal whether to take a stale lock over; `false` without
+/// a terminal (the error then says `--take-over`).
+fn ask_take_over(e: &SessionError) -> anyhow::Result<bool> {
+    use std::io::IsTerminal;
+    if !std::io::stdin().is_terminal() || !std::io::stderr().is_terminal() {
+        return Ok(false);
+    }
+    let mut err = std::io::stderr();
+    write!(
+        err,
+        "{e}
+take the session over? [y/N] "
+    )?;
+    err.flush()?;
+    let mut answer = String::new();
+    std::io::stdin().read_line(&mut answer)?;
+    Ok(matches!(answer.trim(), "y" | "Y" | "yes" | "YES" | "Yes"))
 }
 
 fn capture_one(

@@ -33,7 +33,7 @@ pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                 out!("{text}");
             }
             Err(e) => {
-                eprintln!("vss: error: {e}");
+                errln!("vss: error: {e}");
                 failed += 1;
             }
         }
@@ -218,8 +218,10 @@ pub fn describe(path: &Path) -> anyhow::Result<String> {
             }
         }
         "toml" => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| anyhow::anyhow!("{shown}: cannot read: {e}"))?;
+            // A profile or a manifest: the larger bound of the two.
+            let text =
+                crate::fsutil::read_input_text(path, crate::session::manifest::MAX_LEN as u64)
+                    .map_err(|e| anyhow::anyhow!("{shown}: cannot read: {e}"))?;
             match Profile::from_toml(&text, path) {
                 Ok(p) => profile_lines(&mut s, &shown, &p)?,
                 // A session's manifest is TOML too; describe its shape.

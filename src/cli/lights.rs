@@ -1,5 +1,7 @@
 //! `vss lights on|off|set CONFIG|status`: quick checks at the cell. Switches
-//! the profile's relay board and reads it back.
+//! the profile's relay board and reads it back. An LCUS board cannot be
+//! read: `status` then says what vss last set on it (kept in its state
+//! file) and switches nothing.
 
 use std::process::ExitCode;
 
@@ -64,25 +66,45 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         }
         Action::Status => {}
     }
-    let mask = board.read_mask()?;
-    let on: Vec<String> = (0..32)
-        .filter(|b| mask & (1 << b) != 0)
-        .map(|b| {
-            profile
-                .lights
-                .iter()
-                .find(|l| l.relay == b)
-                .map_or_else(|| format!("relay {b}"), |l| l.name.clone())
-        })
-        .collect();
-    outln!(
-        "{}: relays {mask:04x}; on: {}",
-        board.port_name(),
+    let name_of = |mask: u32| -> String {
+        let on: Vec<String> = (0..32)
+            .filter(|b| mask & (1 << b) != 0)
+            .map(|b| {
+                profile
+                    .lights
+                    .iter()
+                    .find(|l| l.relay == b)
+                    .map_or_else(|| format!("relay {b}"), |l| l.name.clone())
+            })
+            .collect();
         if on.is_empty() {
             "none".to_string()
         } else {
             on.join(", ")
         }
+    };
+    if !board.reads_back() {
+        // An LCUS board: nothing to ask, only what vss remembers.
+        let last = match board.last_set() {
+            Some(l) => format!(
+                "relays {:04x} at {}; on: {}",
+                l.mask,
+                crate::formats::sanitize(&l.when),
+                name_of(l.mask)
+            ),
+            None => "nothing recorded (vss has not switched this board yet)".to_string(),
+        };
+        outln!(
+            "{}: LCUS boards cannot be read; last set by vss: {last}",
+            board.port_name()
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mask = board.read_mask()?;
+    outln!(
+        "{}: relays {mask:04x}; on: {}",
+        board.port_name(),
+        name_of(mask)
     );
     Ok(ExitCode::SUCCESS)
 }

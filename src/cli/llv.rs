@@ -169,7 +169,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             if super::is_broken_pipe(&e) {
                 return Err(e);
             }
-            eprintln!("vss: error: {}: {e:#}", grp.stem);
+            errln!("vss: error: {}: {e:#}", grp.stem);
             failed += 1;
         }
     }
@@ -200,7 +200,13 @@ fn run_group(
     let files: Vec<ImgFile> = grp
         .files
         .iter()
-        .map(|f| imageio::read_any(f))
+        .map(|f| {
+            // The size from the header, before the pixels are read.
+            imageio::read_any_sized(f, |w, h| {
+                crate::llv::image::check_stage_size(w, h).map_err(|e| e.to_string())
+            })
+            .map(|(f, _)| f)
+        })
         .collect::<Result<_, _>>()?;
     // Sizes first: a lens map is made for the size before the stages run.
     for (path, f) in grp.files.iter().zip(&files) {
@@ -232,6 +238,9 @@ fn run_group(
             .map(|i| grp.files[i].clone()),
     };
     let size = input.size();
+    if let (Some(m), Some(cdf_path)) = (camera.as_ref(), &a.cdf) {
+        cdf::check_camera_area(m, size.0, size.1, cdf_path)?;
+    }
     let proposal = match &a.auto {
         Some(t) => {
             let map = runner.lens_map(&input, p)?;

@@ -66,7 +66,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             match out {
                 Some(o) => {
                     write_par(&o, &f)?;
-                    eprintln!(
+                    errln!(
                         "vss: wrote {} ({} parameters, set \"{}\")",
                         o.display(),
                         f.entries.len(),
@@ -80,11 +80,12 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         Cmd::Import { file, out } => {
             let base_name = g.profile.as_deref().unwrap_or("default");
             let base_path = resolve(base_name)?;
-            let base_text = std::fs::read_to_string(&base_path)
-                .with_context(|| format!("cannot read profile {}", base_path.display()))?;
+            let base_text =
+                crate::fsutil::read_input_text(&base_path, crate::profile::MAX_LEN as u64)
+                    .with_context(|| format!("cannot read profile {}", base_path.display()))?;
             let base = Profile::from_toml(&base_text, &base_path)?;
-            let text =
-                std::fs::read(&file).with_context(|| format!("cannot read {}", file.display()))?;
+            let text = crate::fsutil::read_input(&file, crate::formats::max_len(&file))
+                .with_context(|| format!("cannot read {}", file.display()))?;
             let text = std::str::from_utf8(&text).map_err(|_| {
                 anyhow::anyhow!(
                     "{}: not UTF-8 text; expected a parameter file",
@@ -93,7 +94,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             })?;
             let (params, notes) = import_params(text, &file, &base.llv)?;
             for n in notes {
-                eprintln!("vss: note: {}: {n}", file.display());
+                errln!("vss: note: {}: {n}", file.display());
             }
             match out {
                 Some(o) => {
@@ -103,13 +104,13 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                     let moved = o.parent().map(|d| d.canonicalize().ok())
                         != base_path.parent().map(|d| d.canonicalize().ok());
                     if moved && base.survey.cdf.iter().any(|c| c.is_relative()) {
-                        eprintln!(
+                        errln!(
                             "vss: note: {} is in another folder than {}: its relative survey.cdf paths now point elsewhere",
                             o.display(),
                             base_path.display()
                         );
                     }
-                    eprintln!(
+                    errln!(
                         "vss: wrote {} ({} from {})",
                         o.display(),
                         changed_text(&base.llv, &params),

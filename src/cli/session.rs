@@ -148,7 +148,7 @@ fn new(g: &Global, name: &str, dir: Option<PathBuf>) -> anyhow::Result<ExitCode>
         if let Some(c) = &cdf
             && !c.is_file()
         {
-            eprintln!(
+            errln!(
                 "vss: warning: camera {cam}: {} not found; image {k} has no camera description",
                 c.display()
             );
@@ -157,7 +157,7 @@ fn new(g: &Global, name: &str, dir: Option<PathBuf>) -> anyhow::Result<ExitCode>
         s.set_image_info(k, cam, (k - 1) / cams + 1, cdf.as_deref())?;
     }
     if let Some(w) = s.name().dos_warning(s.manifest().session.planned_images) {
-        eprintln!("vss: note: {w}");
+        errln!("vss: note: {w}");
     }
     outln!("created session {}", s.dir().display());
     print_checklist(&s)?;
@@ -167,13 +167,16 @@ fn new(g: &Global, name: &str, dir: Option<PathBuf>) -> anyhow::Result<ExitCode>
 fn show(dir: &Path) -> anyhow::Result<ExitCode> {
     let s = Session::inspect(dir)?;
     let m = s.manifest();
-    outln!("session {} in {}", m.session.name, s.dir().display());
+    // Every text from the manifest is one line: a line break in a note must
+    // not make a line of its own that looks like the checklist's.
+    let t = crate::text::sanitize;
+    outln!("session {} in {}", t(&m.session.name), s.dir().display());
     outln!(
-        "  created {}, modified {} by vss {}, profile {:?}",
-        m.session.created,
-        m.session.modified,
-        m.session.version,
-        m.session.profile
+        "  created {}, modified {} by vss {}, profile \"{}\"",
+        t(&m.session.created),
+        t(&m.session.modified),
+        t(&m.session.version),
+        t(&m.session.profile)
     );
     match s.lock_holder() {
         Some(h) => outln!(
@@ -190,16 +193,16 @@ fn show(dir: &Path) -> anyhow::Result<ExitCode> {
     for l in &m.lighting {
         outln!(
             "  {}: {}{}",
-            l.letter,
+            t(&l.letter.to_string()),
             if l.on.is_empty() {
                 "no lights".to_string()
             } else {
-                l.on.join(", ")
+                t(&l.on.join(", "))
             },
             if l.note.is_empty() {
                 String::new()
             } else {
-                format!(" -- {}", l.note)
+                format!(" -- {}", t(&l.note))
             }
         );
     }
@@ -214,15 +217,15 @@ fn show(dir: &Path) -> anyhow::Result<ExitCode> {
                 c.edges_v,
                 c.lines_raw,
                 c.lines,
-                o.made
+                t(&o.made)
             );
         }
         for e in &r.edit {
             outln!(
                 "  image {}: edit {} at {} -> {} lines",
                 r.number,
-                e.op,
-                e.at,
+                t(&e.op),
+                t(&e.at),
                 e.lines
             );
         }
@@ -239,12 +242,18 @@ fn print_checklist(s: &Session) -> anyhow::Result<()> {
         let captured: String = p
             .letters
             .iter()
-            .map(|l| if i.captured.contains(l) { *l } else { '.' })
+            .map(|l| {
+                if i.captured.contains(l) && !l.is_control() {
+                    *l
+                } else {
+                    '.'
+                }
+            })
             .collect();
         let out = match &i.outputs {
             OutputState::Missing => "-".to_string(),
             OutputState::Done => "done".to_string(),
-            OutputState::Stale(why) => format!("STALE ({why})"),
+            OutputState::Stale(why) => format!("STALE ({})", crate::text::sanitize(why)),
         };
         let edits = if i.edits > 0 {
             format!(", {} manual edits", i.edits)

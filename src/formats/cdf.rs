@@ -297,6 +297,7 @@ pub fn parse_cdf(text: &str, path: &Path) -> Result<Cdf, FormatError> {
                 ));
             }
         }
+        check_value(&cur.name, cur.status, &row, path, n)?;
         cur.rows.push(row);
     }
     if let Some(prev) = cdf.params.last() {
@@ -311,6 +312,85 @@ pub fn parse_cdf(text: &str, path: &Path) -> Result<Cdf, FormatError> {
         ));
     }
     Ok(cdf)
+}
+
+/// The sense of a value line of a parameter the camera model uses: scale
+/// factors and the focal length are positive (a zero scale puts every pixel
+/// at infinity, which once made an all-black `.imc` and no lines, silently).
+/// Values of a parameter marked `N` are placeholders and not checked.
+fn check_value(
+    name: &str,
+    status: Status,
+    row: &[f64],
+    path: &Path,
+    line: usize,
+) -> Result<(), FormatError> {
+    if status == Status::NotAvailable {
+        return Ok(());
+    }
+    let what = match name {
+        "S" => "a scale factor (mm per pixel)",
+        "f" => "the focal length (mm)",
+        _ => return Ok(()),
+    };
+    match row.iter().find(|&&v| v <= 0.0) {
+        Some(v) => Err(FormatError::at_line(
+            path,
+            line,
+            K::Range,
+            format!("{name}: {what} must be greater than 0, found {v}"),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The share of a corrected image below which a camera model is refused.
+const MIN_VALID_SHARE: f64 = 0.1;
+
+/// Checks that lens correction with `m` leaves a picture: of a grid of
+/// points over a `width` × `height` corrected image, at least a tenth must
+/// come from inside the observed image. A model whose centre, scale or
+/// distortion sends (nearly) everything outside would give a black image
+/// and no lines; it is refused naming the file and the fields to check.
+pub fn check_camera_area(
+    m: &CameraModel,
+    width: usize,
+    height: usize,
+    path: &Path,
+) -> Result<(), FormatError> {
+    const N: usize = 24;
+    let (w, h) = (width.max(1) as f64, height.max(1) as f64);
+    let mut inside = 0usize;
+    for j in 0..N {
+        for i in 0..N {
+            let x = (i as f64 + 0.5) * w / N as f64 - 0.5;
+            let y = (j as f64 + 0.5) * h / N as f64 - 0.5;
+            let (xs, ys) = m.ideal_to_observed_converged(x, y);
+            if xs.is_finite()
+                && ys.is_finite()
+                && (-0.5..=w - 0.5).contains(&xs)
+                && (-0.5..=h - 0.5).contains(&ys)
+            {
+                inside += 1;
+            }
+        }
+    }
+    let share = inside as f64 / (N * N) as f64;
+    if share < MIN_VALID_SHARE {
+        return Err(FormatError::new(
+            path,
+            super::Location::None,
+            K::Range,
+            format!(
+                "C, S, D: lens correction of a {width} × {height} image with this camera model \
+                 leaves {:.0} % of it with pixels (at least {:.0} % are needed): check the \
+                 image centre, the scale factors and the distortion coefficients",
+                share * 100.0,
+                MIN_VALID_SHARE * 100.0
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn check_shape(p: &CdfParam, line: usize, path: &Path) -> Result<(), FormatError> {

@@ -204,6 +204,13 @@ pub fn parse_edges(bytes: &[u8], path: &Path) -> Result<EdgePoints, FormatError>
     })
 }
 
+/// The largest edge file read: a header line and two points for every pixel
+/// of the largest image the LLV stages take (a scan finds at most one edge
+/// point a pixel per direction; two leave room for hand-made files).
+pub fn max_file_len() -> u64 {
+    (MAX_HEADER + 2 * POINT_LEN * crate::llv::image::MAX_PIXELS) as u64
+}
+
 /// Reads a `.hpo`/`.vpo` file.
 pub fn read_edges(path: &Path) -> Result<EdgePoints, FormatError> {
     parse_edges(&read_bytes(path)?, path)

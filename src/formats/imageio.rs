@@ -70,12 +70,43 @@ pub fn read_any(path: &Path) -> Result<ImgFile, FormatError> {
 /// Reads a grey image and returns the notes a person should see (colour
 /// reduced to grey, 16 bits reduced to 8, alpha dropped).
 pub fn read_any_noted(path: &Path) -> Result<(ImgFile, Vec<String>), FormatError> {
+    read_any_sized(path, |_, _| Ok(()))
+}
+
+/// Reads a grey image whose size `accept(width, height)` takes, checking
+/// the size from the header before the pixels are read or decoded (an
+/// `.img` costs its 64-byte header, a PNG its compressed bytes, when the
+/// image is refused). Returns the notes as [`read_any_noted`].
+pub fn read_any_sized(
+    path: &Path,
+    accept: impl Fn(usize, usize) -> Result<(), String>,
+) -> Result<(ImgFile, Vec<String>), FormatError> {
     let kind = ImageKind::of_or_err(path)?;
     if kind == ImageKind::Img {
-        return super::img::read_img(path).map(|f| (f, Vec::new()));
+        return super::img::read_img_sized(path, accept).map(|f| (f, Vec::new()));
     }
     let bytes = read_bytes(path)?;
+    if let Some((w, h)) = foreign_size(&bytes, kind) {
+        accept(w, h).map_err(|m| FormatError::new(path, Location::None, K::Range, m))?;
+    }
     decode_any(&bytes, kind, path)
+}
+
+/// The width and height a PNG, PNM, TIFF or BMP header gives, without
+/// decoding the pixels; `None` when the header does not read (the decoder
+/// then says why).
+fn foreign_size(bytes: &[u8], kind: ImageKind) -> Option<(usize, usize)> {
+    let fmt = match kind {
+        ImageKind::Img => return None,
+        ImageKind::Png => image::ImageFormat::Png,
+        ImageKind::Pgm => image::ImageFormat::Pnm,
+        ImageKind::Tiff => image::ImageFormat::Tiff,
+        ImageKind::Bmp => image::ImageFormat::Bmp,
+    };
+    let (w, h) = image::ImageReader::with_format(Cursor::new(bytes), fmt)
+        .into_dimensions()
+        .ok()?;
+    Some((w as usize, h as usize))
 }
 
 /// Decodes image bytes of a given kind.

@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use super::{FormatError, FormatErrorKind as K, read_bytes, write_bytes};
+use super::{FormatError, FormatErrorKind as K, input_err, write_bytes};
 use crate::llv::GreyImage;
 
 /// Size of the ITEX header.
@@ -189,32 +189,55 @@ pub fn parse_img(bytes: &[u8], path: &Path) -> Result<ImgFile, FormatError> {
     })
 }
 
+/// The largest `.img` there can be: the header, a 200-byte comment and
+/// 65535 × 65535 pixels.
+pub fn max_file_len() -> u64 {
+    HEADER_LEN as u64 + MAX_COMMENT_LEN as u64 + u64::from(u16::MAX) * u64::from(u16::MAX)
+}
+
+/// Opens an `.img` (a regular file, not through a link) and checks its
+/// header against its real size; returns the header, the header's bytes and
+/// the file positioned after them.
+fn open_checked(path: &Path) -> Result<(ImgHeader, Vec<u8>, std::fs::File), FormatError> {
+    use std::io::Read;
+    let (mut f, len) =
+        crate::fsutil::open_input(path, max_file_len()).map_err(|e| input_err(path, &e))?;
+    let mut head = Vec::with_capacity(HEADER_LEN);
+    (&mut f)
+        .take(HEADER_LEN as u64)
+        .read_to_end(&mut head)
+        .map_err(|e| FormatError::io(path, "read", &e))?;
+    let h = parse_header(&head, len, path)?;
+    Ok((h, head, f))
+}
+
 /// Reads an `.img`/`.imc` file.
 pub fn read_img(path: &Path) -> Result<ImgFile, FormatError> {
-    // Check the header against the real size before reading the pixels.
-    let meta = std::fs::metadata(path).map_err(|e| FormatError::io(path, "read", &e))?;
-    let mut head = Vec::with_capacity(HEADER_LEN);
-    {
-        use std::io::Read;
-        let f = std::fs::File::open(path).map_err(|e| FormatError::io(path, "open", &e))?;
-        f.take(HEADER_LEN as u64)
-            .read_to_end(&mut head)
-            .map_err(|e| FormatError::io(path, "read", &e))?;
-    }
-    parse_header(&head, meta.len(), path)?;
-    parse_img(&read_bytes(path)?, path)
+    read_img_sized(path, |_, _| Ok(()))
+}
+
+/// Reads an `.img`/`.imc` file whose size `accept(width, height)` takes:
+/// the header is checked (against the file's size and by `accept`) before
+/// a pixel is read, so a refused image costs 64 bytes, not its size.
+pub fn read_img_sized(
+    path: &Path,
+    accept: impl Fn(usize, usize) -> Result<(), String>,
+) -> Result<ImgFile, FormatError> {
+    use std::io::Read;
+    let (h, mut bytes, f) = open_checked(path)?;
+    accept(usize::from(h.width), usize::from(h.height))
+        .map_err(|m| FormatError::at_byte(path, 4, K::Range, m))?;
+    let rest = h.file_len().saturating_sub(HEADER_LEN as u64);
+    bytes.reserve_exact(usize::try_from(rest).unwrap_or(0));
+    f.take(rest)
+        .read_to_end(&mut bytes)
+        .map_err(|e| FormatError::io(path, "read", &e))?;
+    parse_img(&bytes, path)
 }
 
 /// Reads only the header of an `.img` (for `vss info`).
 pub fn read_header(path: &Path) -> Result<ImgHeader, FormatError> {
-    use std::io::Read;
-    let meta = std::fs::metadata(path).map_err(|e| FormatError::io(path, "read", &e))?;
-    let f = std::fs::File::open(path).map_err(|e| FormatError::io(path, "open", &e))?;
-    let mut head = Vec::with_capacity(HEADER_LEN);
-    f.take(HEADER_LEN as u64)
-        .read_to_end(&mut head)
-        .map_err(|e| FormatError::io(path, "read", &e))?;
-    parse_header(&head, meta.len(), path)
+    open_checked(path).map(|(h, _, _)| h)
 }
 
 /// Encodes an image as `.img` bytes. Fails (kind `Range`/`Encoding`) when the

@@ -49,6 +49,19 @@ impl ParamSpec {
     }
 }
 
+/// A parameter value as an operator types it: integers without a
+/// fraction, others with at most four decimals, never `-0`.
+pub fn fmt_value(v: f64) -> String {
+    let v = if v == 0.0 { 0.0 } else { v };
+    if v == v.trunc() && v.abs() < 1e12 {
+        format!("{}", v as i64)
+    } else {
+        let s = format!("{v:.4}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        if s == "-0" { "0".into() } else { s.to_string() }
+    }
+}
+
 fn fmt_num(v: f64) -> String {
     if v == v.trunc() && v.abs() < 1e15 {
         format!("{}", v as i64)
@@ -375,6 +388,16 @@ pub enum ParamError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn values_read_as_typed() {
+        assert_eq!(fmt_value(4.0), "4");
+        assert_eq!(fmt_value(2.25), "2.25");
+        assert_eq!(fmt_value(1.0 / 3.0), "0.3333");
+        assert_eq!(fmt_value(-0.0), "0");
+        assert_eq!(fmt_value(-0.00001), "0");
+        assert_eq!(fmt_value(-1.5), "-1.5");
+    }
 
     #[test]
     fn table_and_accessors_agree() {

@@ -13,6 +13,7 @@
 //! the distance to it. Cast shadows are not rendered (every light reaches
 //! every surface that faces it), so every image edge is a polygon edge.
 
+pub mod compare;
 pub mod eval;
 mod geom;
 mod raster;
@@ -22,6 +23,7 @@ mod scenes;
 mod score;
 pub mod straight;
 mod truth;
+pub mod yard;
 
 pub use geom::{Face, Polyhedron, V3, look_at};
 pub use render::{finish, render_exact};

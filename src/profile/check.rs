@@ -229,6 +229,14 @@ fn check_params(p: &Profile, cx: &Ctx<'_, '_>) -> Result<(), ProfileError> {
 
 fn check_cell(p: &Profile, cx: &Ctx<'_, '_>) -> Result<(), ProfileError> {
     use Seg::{Index as I, Key as K};
+    if let Some(c) = p.relay.channels
+        && ![1, 2, 4, 8, 16, 32].contains(&c)
+    {
+        return Err(cx.at(
+            &[K("relay"), K("channels")],
+            format!("{c} relays: a board has 1, 2, 4, 8, 16 or 32"),
+        ));
+    }
     // Lights: named, unique, on distinct channels 0–15.
     for (i, l) in p.lights.iter().enumerate() {
         if l.name.trim().is_empty() || l.name.chars().any(char::is_control) {
@@ -237,12 +245,18 @@ fn check_cell(p: &Profile, cx: &Ctx<'_, '_>) -> Result<(), ProfileError> {
                 "a light needs a name without control characters".into(),
             ));
         }
-        if l.relay > MAX_RELAY {
+        let max_relay = p.relay.channels.map_or(MAX_RELAY, |c| c.saturating_sub(1));
+        if l.relay > max_relay {
             return Err(cx.at(
                 &[K("lights"), I(i), K("relay")],
                 format!(
-                    "relay channel {} is out of range: allowed 0 to {MAX_RELAY}",
-                    l.relay
+                    "relay channel {} is out of range: allowed 0 to {max_relay}{}",
+                    l.relay,
+                    if p.relay.channels.is_some() {
+                        " (the board's [relay] channels)"
+                    } else {
+                        " (set [relay] channels for a larger board)"
+                    }
                 ),
             ));
         }

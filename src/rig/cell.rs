@@ -50,25 +50,32 @@ pub fn open_lights(
     let r = &profile.relay;
     let timeout = Duration::from_millis(r.timeout_ms.max(1));
     Ok(match (r.kind, sim) {
-        (RelayKind::Simulated, Some(s)) => {
-            Box::new(NumatoBoard::open(s.relay_path(), r.baud, timeout)?)
-        }
+        (RelayKind::Simulated, Some(s)) => Box::new(NumatoBoard::open(
+            s.relay_path(),
+            r.baud,
+            timeout,
+            Some(s.scene().opts.relays),
+        )?),
         (RelayKind::Simulated, None) => {
             return Err(RigError::Config(
                 "the relay board is `simulated` but no simulated cell runs".into(),
             ));
         }
         (RelayKind::Lcus, _) => {
-            let channels = profile
-                .lights
-                .iter()
-                .map(|l| l.relay + 1)
-                .max()
-                .unwrap_or(0)
-                .max(LCUS_CHANNELS);
+            let channels = r.channels.unwrap_or_else(|| {
+                profile
+                    .lights
+                    .iter()
+                    .map(|l| l.relay + 1)
+                    .max()
+                    .unwrap_or(0)
+                    .max(LCUS_CHANNELS)
+            });
             Box::new(LcusBoard::open(&r.port, channels, timeout)?)
         }
-        (RelayKind::Numato, _) => Box::new(NumatoBoard::open(&r.port, r.baud, timeout)?),
+        (RelayKind::Numato, _) => {
+            Box::new(NumatoBoard::open(&r.port, r.baud, timeout, r.channels)?)
+        }
     })
 }
 

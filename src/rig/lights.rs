@@ -1,15 +1,32 @@
 //! The relay board that switches the lights: [`LightSwitch`], the Numato
-//! driver ([`NumatoBoard`]: echo, `\n\r`, `>` prompt, read-back after every
-//! switch) and the LCUS/CH340 driver ([`LcusBoard`]: binary frames, no
-//! replies, state tracked here). The board kind is a profile setting.
+//! driver ([`NumatoBoard`]) and the LCUS/CH340 driver ([`LcusBoard`], in
+//! `lights/lcus.rs`: binary frames, no replies, state remembered). The
+//! board kind is a profile setting.
+//!
+//! Numato: every command is sent, then the reply is read up to the `>`
+//! prompt that follows *this command's echo* — a prompt may come tens of
+//! milliseconds after the echo, and a late prompt of an earlier command is
+//! skipped rather than taken for this one's. A re-sync (after silence or a
+//! garbled answer) ends any half-typed line with a bare CR and waits for the
+//! board's prompt before the line goes quiet. The mask width of `readall`
+//! and `writeall` follows the board's size (relays / 4 hex digits, at least
+//! 2), from the profile's `channels` or learned from `readall`; every switch
+//! is read back and compared.
 
 use std::io::{self, ErrorKind};
 use std::time::{Duration, Instant};
 
 use super::protocol::{
-    NumatoCommand, lcus_frame, numato_parse_mask, numato_parse_state, numato_split,
+    NumatoCommand, numato_channels_of_digits, numato_mask_digits, numato_parse_mask,
+    numato_parse_state, numato_split,
 };
 use super::{Link, RigError, SerialLink, open_serial};
+
+mod lcus;
+#[cfg(test)]
+mod tests;
+
+pub use lcus::{LastSet, LcusBoard, lcus_state_file};
 
 /// A board of relays, numbered from 0.
 pub trait LightSwitch: Send {
@@ -17,15 +34,37 @@ pub trait LightSwitch: Send {
     fn set(&mut self, relay: u32, on: bool) -> Result<(), RigError>;
     /// Sets all relays at once: bit N = relay N.
     fn set_mask(&mut self, mask: u32) -> Result<(), RigError>;
-    /// The relays that are on.
+    /// The relays that are on: read from the board, or, for a board that
+    /// cannot be read ([`LightSwitch::reads_back`] false), what vss last set
+    /// (none when that is not known).
     fn read_mask(&mut self) -> Result<u32, RigError>;
+    /// Whether [`LightSwitch::read_mask`] asks the board.
+    fn reads_back(&self) -> bool {
+        true
+    }
+    /// For a board that cannot be read: what vss last set on it, and when.
+    fn last_set(&self) -> Option<LastSet> {
+        None
+    }
     fn port_name(&self) -> &str;
 }
 
-/// Repeats of a Numato command whose answer was garbled or missing.
-const RETRIES: u32 = 2;
+/// Attempts of a Numato command whose answer was garbled or missing.
+const ATTEMPTS: u32 = 3;
 /// Longest reply before the prompt; anything longer is garbage.
 const MAX_REPLY: usize = 256;
+/// Quiet time that ends a drain.
+const QUIET: Duration = Duration::from_millis(30);
+
+/// Why one try of a Numato command got no usable answer.
+enum Miss {
+    /// Nothing came back.
+    Silent,
+    /// The echo came, the prompt did not.
+    NoPrompt,
+    /// Something else came: what.
+    Garbled(String),
+}
 
 /// A Numato Lab USB relay module (or the simulated board).
 pub struct NumatoBoard<P: Link> {
@@ -33,34 +72,55 @@ pub struct NumatoBoard<P: Link> {
     name: String,
     timeout: Duration,
     rx: Vec<u8>,
+    /// The relay count the profile gives (`channels`), if it does.
+    channels: Option<u32>,
+    /// Hex digits of `readall`/`writeall`: from `channels`, else learned
+    /// from the first `readall`.
+    digits: Option<usize>,
 }
 
 impl NumatoBoard<SerialLink> {
-    /// Opens the board on a serial device and checks that it answers `ver`.
-    pub fn open(path: &str, baud: u32, timeout: Duration) -> Result<Self, RigError> {
+    /// Opens the board on a serial device, checks that it answers `ver` and
+    /// learns (or checks against `channels`) its size from `readall`.
+    pub fn open(
+        path: &str,
+        baud: u32,
+        timeout: Duration,
+        channels: Option<u32>,
+    ) -> Result<Self, RigError> {
         let port = open_serial(path, baud, timeout)?;
-        let mut b = NumatoBoard::new(port, path, timeout);
+        let mut b = NumatoBoard::new(port, path, timeout, channels);
         b.connect()?;
         Ok(b)
     }
 }
 
+/// Where `needle` first occurs in `hay`.
+fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
+    if needle.is_empty() {
+        return Some(0);
+    }
+    hay.windows(needle.len()).position(|w| w == needle)
+}
+
 impl<P: Link> NumatoBoard<P> {
-    pub fn new(port: P, name: &str, timeout: Duration) -> Self {
+    pub fn new(port: P, name: &str, timeout: Duration, channels: Option<u32>) -> Self {
         NumatoBoard {
             port,
             name: name.to_string(),
             timeout,
             rx: Vec::new(),
+            channels,
+            digits: channels.map(numato_mask_digits),
         }
     }
 
-    /// Clears a half-typed command with a bare `\r`, discards the answer,
-    /// and asks the firmware version.
+    /// Re-syncs, asks the firmware version and learns the board's size.
     pub fn connect(&mut self) -> Result<String, RigError> {
-        self.write(b"\r")?;
-        self.drain()?;
-        self.version()
+        self.sync()?;
+        let v = self.version()?;
+        self.read_mask()?;
+        Ok(v)
     }
 
     /// The firmware version (`ver`).
@@ -70,6 +130,12 @@ impl<P: Link> NumatoBoard<P> {
             [v] => Ok(v.clone()),
             _ => Err(self.board_err(format!("unexpected reply to `ver`: {lines:?}"))),
         }
+    }
+
+    /// The relays of the board, as the profile gives them or `readall`
+    /// showed (`None` before the first `readall` without `channels`).
+    pub fn channels(&self) -> Option<u32> {
+        self.channels.or(self.digits.map(numato_channels_of_digits))
     }
 
     fn board_err(&self, detail: String) -> RigError {
@@ -95,85 +161,155 @@ impl<P: Link> NumatoBoard<P> {
         r.map_err(|e| self.vanished(e))
     }
 
-    /// Discards input until the line is quiet.
-    fn drain(&mut self) -> Result<(), RigError> {
-        let give_up = Instant::now() + self.timeout.max(Duration::from_millis(500));
+    /// Reads what arrives within `wait` into `rx`; `false` on silence.
+    fn fill(&mut self, wait: Duration) -> Result<bool, RigError> {
         let mut buf = [0u8; 256];
-        self.rx.clear();
-        while Instant::now() < give_up {
-            self.port
-                .set_timeout(Duration::from_millis(30))
-                .map_err(|e| self.vanished(e))?;
+        self.port
+            .set_timeout(wait.max(Duration::from_millis(1)))
+            .map_err(|e| self.vanished(e))?;
+        loop {
             match self.port.read(&mut buf) {
                 Ok(0) => return Err(self.vanished(ErrorKind::UnexpectedEof.into())),
-                Ok(_) => {}
+                Ok(n) => {
+                    self.rx.extend_from_slice(buf.get(..n).unwrap_or_default());
+                    return Ok(true);
+                }
                 Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock) => {
-                    return Ok(());
+                    return Ok(false);
                 }
                 Err(e) if e.kind() == ErrorKind::Interrupted => {}
                 Err(e) => return Err(self.vanished(e)),
             }
         }
+    }
+
+    /// Discards input until the line is quiet.
+    fn drain(&mut self) -> Result<(), RigError> {
+        let give_up = Instant::now() + self.timeout.max(Duration::from_millis(500));
+        while Instant::now() < give_up {
+            self.rx.clear();
+            if !self.fill(QUIET)? {
+                break;
+            }
+        }
+        self.rx.clear();
         Ok(())
+    }
+
+    /// Ends a half-typed line with a bare CR, waits (up to the reply
+    /// timeout) for the prompt that answers it, then for quiet.
+    fn sync(&mut self) -> Result<(), RigError> {
+        self.write(b"\r")?;
+        self.rx.clear();
+        let deadline = Instant::now() + self.timeout;
+        while !self.rx.contains(&b'>') {
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                break;
+            }
+            self.fill(left)?;
+        }
+        self.drain()
     }
 
     /// Sends a command and returns the reply lines between the echo and the
     /// `>` prompt. Every Numato command is safe to repeat (switching a relay
     /// to a state twice leaves it there), so a garbled or missing answer is
-    /// retried after clearing the line.
+    /// tried again after a re-sync.
     fn command(&mut self, cmd: &NumatoCommand) -> Result<Vec<String>, RigError> {
         let text = cmd
             .text()
-            .ok_or_else(|| self.board_err(format!("{cmd:?}: no such relay on a Numato board")))?;
-        let mut attempt = 0;
-        loop {
-            attempt += 1;
-            match self.command_once(&text) {
-                Err(RigError::Timeout { .. } | RigError::Board { .. }) if attempt <= RETRIES => {
-                    // A bare CR ends any half-typed line; then drop the noise.
-                    self.write(b"\r")?;
-                    self.drain()?;
+            .ok_or_else(|| self.board_err(format!("{cmd:?}: not a command this board takes")))?;
+        let mut last = Miss::Silent;
+        let mut echoed = false;
+        for attempt in 1..=ATTEMPTS {
+            if attempt > 1 {
+                self.sync()?;
+            }
+            match self.command_once(&text)? {
+                Ok(lines) => return Ok(lines),
+                Err(m) => {
+                    echoed |= matches!(m, Miss::NoPrompt);
+                    last = m;
                 }
-                r => return r,
             }
         }
+        // A board that echoed the command in any try but never prompted in
+        // time is slow, not silent: say that, not "no reply".
+        if echoed && matches!(last, Miss::Silent) {
+            last = Miss::NoPrompt;
+        }
+        let (port, timeout_ms) = (self.name.clone(), self.timeout.as_millis() as u64);
+        Err(match last {
+            Miss::Silent => RigError::Timeout {
+                port,
+                command: text,
+                timeout_ms,
+                attempts: ATTEMPTS,
+            },
+            Miss::NoPrompt => RigError::NoPrompt {
+                port,
+                command: text,
+                timeout_ms,
+                attempts: ATTEMPTS,
+            },
+            Miss::Garbled(detail) => RigError::Garbled {
+                port,
+                command: text,
+                detail,
+                attempts: ATTEMPTS,
+            },
+        })
     }
 
-    fn command_once(&mut self, text: &str) -> Result<Vec<String>, RigError> {
-        let text = text.to_string();
+    /// One try: the reply is what lies between this command's echo and the
+    /// next prompt; whatever came before the echo (a late answer to an
+    /// earlier command) is skipped.
+    fn command_once(&mut self, text: &str) -> Result<Result<Vec<String>, Miss>, RigError> {
         self.rx.clear();
         self.write(format!("{text}\r").as_bytes())?;
         let deadline = Instant::now() + self.timeout;
-        let mut buf = [0u8; 256];
+        let echo = text.as_bytes();
         loop {
-            if let Some(i) = self.rx.iter().position(|&b| b == b'>') {
-                let raw: Vec<u8> = self.rx.drain(..=i).collect();
-                let body = raw.get(..i).unwrap_or_default();
-                return numato_split(&text, body)
-                    .map_err(|e| self.board_err(format!("`{text}`: {e}")));
+            if let Some(p) = find(&self.rx, echo) {
+                let after = self.rx.get(p..).unwrap_or_default();
+                if let Some(q) = after.iter().position(|&b| b == b'>') {
+                    let body = after.get(..q).unwrap_or_default().to_vec();
+                    self.rx.drain(..p + q + 1);
+                    return Ok(numato_split(text, &body).map_err(|e| Miss::Garbled(e.to_string())));
+                }
             }
             if self.rx.len() > MAX_REPLY {
                 let got = String::from_utf8_lossy(&self.rx).into_owned();
                 self.drain()?;
-                return Err(self.board_err(format!("`{text}`: no prompt in {got:?}")));
+                return Ok(Err(Miss::Garbled(format!("no prompt in {got:?}"))));
             }
             let left = deadline.saturating_duration_since(Instant::now());
             if left.is_zero() {
-                return Err(RigError::Timeout {
-                    port: self.name.clone(),
-                    command: text,
-                    timeout_ms: self.timeout.as_millis() as u64,
-                    attempts: 1,
-                });
+                return Ok(Err(self.miss(text)));
             }
-            self.port.set_timeout(left).map_err(|e| self.vanished(e))?;
-            match self.port.read(&mut buf) {
-                Ok(0) => return Err(self.vanished(ErrorKind::UnexpectedEof.into())),
-                Ok(n) => self.rx.extend_from_slice(buf.get(..n).unwrap_or_default()),
-                Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock) => {}
-                Err(e) if e.kind() == ErrorKind::Interrupted => {}
-                Err(e) => return Err(self.vanished(e)),
-            }
+            self.fill(left)?;
+        }
+    }
+
+    /// What a try that timed out got.
+    fn miss(&self, text: &str) -> Miss {
+        if find(&self.rx, text.as_bytes()).is_some() {
+            return Miss::NoPrompt;
+        }
+        if self.rx.is_empty() {
+            return Miss::Silent;
+        }
+        let got = || format!("{:?} without a prompt", String::from_utf8_lossy(&self.rx));
+        // A prompt after something else than the echo: the echo was wrong.
+        let Some(last) = self.rx.iter().rposition(|&b| b == b'>') else {
+            return Miss::Garbled(got());
+        };
+        let upto = self.rx.get(..last).unwrap_or_default();
+        let start = upto.iter().rposition(|&b| b == b'>').map_or(0, |j| j + 1);
+        match numato_split(text, upto.get(start..).unwrap_or_default()) {
+            Err(e) => Miss::Garbled(e.to_string()),
+            Ok(_) => Miss::Garbled(got()),
         }
     }
 
@@ -190,10 +326,27 @@ impl<P: Link> NumatoBoard<P> {
         let lines = self.command(&NumatoCommand::Read(relay))?;
         numato_parse_state(&lines).map_err(|e| self.board_err(format!("relay read {relay}: {e}")))
     }
+
+    /// The width of the board's masks: known, or learned now.
+    fn digits(&mut self) -> Result<usize, RigError> {
+        match self.digits {
+            Some(d) => Ok(d),
+            None => {
+                self.read_mask()?;
+                self.digits
+                    .ok_or_else(|| self.board_err("`relay readall` gave no mask width".into()))
+            }
+        }
+    }
 }
 
 impl<P: Link> LightSwitch for NumatoBoard<P> {
     fn set(&mut self, relay: u32, on: bool) -> Result<(), RigError> {
+        if let Some(c) = self.channels().filter(|&c| relay >= c) {
+            return Err(self.board_err(format!(
+                "relay {relay} does not exist on this {c}-relay board"
+            )));
+        }
         let cmd = if on {
             NumatoCommand::On(relay)
         } else {
@@ -215,7 +368,14 @@ impl<P: Link> LightSwitch for NumatoBoard<P> {
     }
 
     fn set_mask(&mut self, mask: u32) -> Result<(), RigError> {
-        let cmd = NumatoCommand::WriteAll(mask);
+        let digits = self.digits()?;
+        let cmd = NumatoCommand::WriteAll { mask, digits };
+        if cmd.text().is_none() {
+            return Err(self.board_err(format!(
+                "relay mask {mask:x} names relays beyond this {}-relay board",
+                numato_channels_of_digits(digits)
+            )));
+        }
         let lines = self.command(&cmd)?;
         self.expect_empty(&cmd, &lines)?;
         let got = self.read_mask()?;
@@ -223,8 +383,8 @@ impl<P: Link> LightSwitch for NumatoBoard<P> {
             return Err(RigError::RelayMismatch {
                 port: self.name.clone(),
                 relay: "mask".into(),
-                expected: format!("{mask:04x}"),
-                got: format!("{got:04x}"),
+                expected: format!("{mask:0digits$x}"),
+                got: format!("{got:0digits$x}"),
             });
         }
         Ok(())
@@ -232,186 +392,24 @@ impl<P: Link> LightSwitch for NumatoBoard<P> {
 
     fn read_mask(&mut self) -> Result<u32, RigError> {
         let lines = self.command(&NumatoCommand::ReadAll)?;
-        numato_parse_mask(&lines).map_err(|e| self.board_err(format!("relay readall: {e}")))
-    }
-
-    fn port_name(&self) -> &str {
-        &self.name
-    }
-}
-
-/// An LCUS/CH340 board: it answers nothing, so the driver remembers what it
-/// switched. Every relay is switched off on connect so that memory is true.
-pub struct LcusBoard<P: Link> {
-    port: P,
-    name: String,
-    timeout: Duration,
-    channels: u32,
-    mask: u32,
-}
-
-impl LcusBoard<SerialLink> {
-    /// Opens an LCUS board (9600 8N1) with `channels` relays.
-    pub fn open(path: &str, channels: u32, timeout: Duration) -> Result<Self, RigError> {
-        let port = open_serial(path, 9600, timeout)?;
-        let mut b = LcusBoard::new(port, path, channels, timeout);
-        b.set_mask(0)?;
-        Ok(b)
-    }
-}
-
-impl<P: Link> LcusBoard<P> {
-    pub fn new(port: P, name: &str, channels: u32, timeout: Duration) -> Self {
-        LcusBoard {
-            port,
-            name: name.to_string(),
-            timeout,
-            channels: channels.clamp(1, 32),
-            mask: 0,
-        }
-    }
-
-    /// The stream (tests inspect what was sent).
-    pub fn port_mut(&mut self) -> &mut P {
-        &mut self.port
-    }
-}
-
-impl<P: Link> LightSwitch for LcusBoard<P> {
-    fn set(&mut self, relay: u32, on: bool) -> Result<(), RigError> {
-        let frame = match lcus_frame(relay, on) {
-            Some(f) if relay < self.channels => f,
-            _ => {
-                return Err(RigError::Board {
-                    port: self.name.clone(),
-                    detail: format!(
-                        "relay {relay} does not exist on this {}-channel LCUS board",
-                        self.channels
-                    ),
-                });
+        let (mask, digits) =
+            numato_parse_mask(&lines).map_err(|e| self.board_err(format!("relay readall: {e}")))?;
+        match self.channels {
+            Some(c) if digits != numato_mask_digits(c) => {
+                return Err(self.board_err(format!(
+                    "the profile gives channels = {c}, but `relay readall` answers {} hex digits, \
+                     as a {}-relay board does: set [relay] channels to the board's relay count",
+                    digits,
+                    numato_channels_of_digits(digits)
+                )));
             }
-        };
-        let r = self
-            .port
-            .set_timeout(self.timeout)
-            .and_then(|()| self.port.write_all(&frame))
-            .and_then(|()| self.port.flush());
-        r.map_err(|source| RigError::Vanished {
-            port: self.name.clone(),
-            source,
-        })?;
-        if on {
-            self.mask |= 1 << relay;
-        } else {
-            self.mask &= !(1 << relay);
+            Some(_) => {}
+            None => self.digits = Some(digits),
         }
-        Ok(())
-    }
-
-    fn set_mask(&mut self, mask: u32) -> Result<(), RigError> {
-        if self.channels < 32 && mask >> self.channels != 0 {
-            return Err(RigError::Board {
-                port: self.name.clone(),
-                detail: format!(
-                    "relay mask {mask:04x} names relays beyond this {}-channel LCUS board",
-                    self.channels
-                ),
-            });
-        }
-        for relay in 0..self.channels {
-            self.set(relay, mask & (1 << relay) != 0)?;
-        }
-        Ok(())
-    }
-
-    fn read_mask(&mut self) -> Result<u32, RigError> {
-        Ok(self.mask)
+        Ok(mask)
     }
 
     fn port_name(&self) -> &str {
         &self.name
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::rig::script::Script;
-
-    fn board(answers: &[&str]) -> NumatoBoard<Script> {
-        let a = answers.iter().map(|s| s.as_bytes().to_vec()).collect();
-        NumatoBoard::new(
-            Script::new(b'\r', a),
-            "/dev/relay0",
-            Duration::from_millis(50),
-        )
-    }
-
-    #[test]
-    fn switch_checks_echo_and_reads_back() {
-        let mut b = board(&["relay on 2\r\n\r>", "relay read 2\r\n\ron\n\r>"]);
-        assert!(b.set(2, true).is_ok());
-        assert_eq!(b.port.sent_text(), "relay on 2\rrelay read 2\r");
-    }
-
-    #[test]
-    fn a_relay_that_did_not_switch_is_reported() {
-        let mut b = board(&["relay on 2\r\n\r>", "relay read 2\r\n\roff\n\r>"]);
-        let e = b.set(2, true);
-        assert!(
-            matches!(&e, Err(RigError::RelayMismatch { port, expected, got, .. })
-                if port == "/dev/relay0" && expected == "on" && got == "off"),
-            "{e:?}"
-        );
-    }
-
-    #[test]
-    fn a_garbled_answer_is_retried_and_a_wrong_echo_is_an_error() {
-        let mut b = board(&[
-            "\x13\x00relay on 2\n\r>",
-            "relay on 2\r\n\r>",
-            "relay read 2\r\n\ron\n\r>",
-        ]);
-        assert!(b.set(2, true).is_ok());
-        let mut b = board(&["relay on 3\n\r>", "relay on 3\n\r>", "relay on 3\n\r>"]);
-        let e = b.set(2, true);
-        assert!(
-            matches!(&e, Err(RigError::Board { detail, .. }) if detail.contains("echoed")),
-            "{e:?}"
-        );
-        assert_eq!(b.port.sent_text().matches("relay on 2\r").count(), 3);
-    }
-
-    #[test]
-    fn mask_round_trip_and_version() {
-        let mut b = board(&[
-            "relay writeall 0005\n\r>",
-            "relay readall\n\r0005\n\r>",
-            "ver\n\r00000008\n\r>",
-        ]);
-        assert!(b.set_mask(5).is_ok());
-        assert_eq!(b.version().ok().as_deref(), Some("00000008"));
-    }
-
-    #[test]
-    fn no_prompt_is_a_timeout() {
-        let mut b = board(&["relay readall\n\r0005\n\r"]);
-        assert!(matches!(b.read_mask(), Err(RigError::Timeout { .. })));
-    }
-
-    #[test]
-    fn lcus_sends_frames_and_remembers() {
-        let s = Script::new(b'\n', vec![]);
-        let mut b = LcusBoard::new(s, "/dev/lcus", 4, Duration::from_millis(50));
-        assert!(b.set(0, true).is_ok());
-        assert!(b.set(3, true).is_ok());
-        assert!(b.set(0, false).is_ok());
-        assert_eq!(b.read_mask().ok(), Some(0b1000));
-        assert_eq!(
-            b.port.sent,
-            vec![0xA0, 1, 1, 0xA2, 0xA0, 4, 1, 0xA5, 0xA0, 1, 0, 0xA1]
-        );
-        assert!(matches!(b.set(4, true), Err(RigError::Board { .. })));
-        assert!(matches!(b.set_mask(1 << 6), Err(RigError::Board { .. })));
     }
 }

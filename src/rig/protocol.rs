@@ -7,6 +7,8 @@
 
 use std::fmt;
 
+mod relay;
+
 /// The XOR of all bytes of `text` (NMEA 0183 convention).
 pub fn checksum(text: &[u8]) -> u8 {
     text.iter().fold(0, |acc, b| acc ^ b)
@@ -376,142 +378,7 @@ impl GrabberStatus {
     }
 }
 
-// ---------------------------------------------------------------- Numato
-
-/// The character naming relay `n` on a Numato board: `0`–`9`, then `A`…`V`.
-pub fn numato_relay_char(n: u32) -> Option<char> {
-    match n {
-        0..=9 => char::from_digit(n, 10),
-        10..=31 => char::from_u32('A' as u32 + n - 10),
-        _ => None,
-    }
-}
-
-/// The inverse of [`numato_relay_char`] (either case).
-pub fn numato_relay_index(c: &str) -> Option<u32> {
-    let mut chars = c.chars();
-    let ch = chars.next()?.to_ascii_uppercase();
-    if chars.next().is_some() {
-        return None;
-    }
-    match ch {
-        '0'..='9' => ch.to_digit(10),
-        'A'..='V' => Some(ch as u32 - 'A' as u32 + 10),
-        _ => None,
-    }
-}
-
-/// A Numato command.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum NumatoCommand {
-    Ver,
-    On(u32),
-    Off(u32),
-    Read(u32),
-    ReadAll,
-    WriteAll(u32),
-}
-
-impl NumatoCommand {
-    /// The text typed to the board (without the trailing `\r`); `None` if
-    /// the relay number has no Numato character.
-    pub fn text(&self) -> Option<String> {
-        Some(match self {
-            NumatoCommand::Ver => "ver".to_string(),
-            NumatoCommand::On(n) => format!("relay on {}", numato_relay_char(*n)?),
-            NumatoCommand::Off(n) => format!("relay off {}", numato_relay_char(*n)?),
-            NumatoCommand::Read(n) => format!("relay read {}", numato_relay_char(*n)?),
-            NumatoCommand::ReadAll => "relay readall".to_string(),
-            NumatoCommand::WriteAll(m) => format!("relay writeall {m:04x}"),
-        })
-    }
-
-    pub fn parse(text: &str) -> Option<NumatoCommand> {
-        let w: Vec<&str> = text.split_whitespace().collect();
-        Some(match w.as_slice() {
-            ["ver"] => NumatoCommand::Ver,
-            ["relay", "on", n] => NumatoCommand::On(numato_relay_index(n)?),
-            ["relay", "off", n] => NumatoCommand::Off(numato_relay_index(n)?),
-            ["relay", "read", n] => NumatoCommand::Read(numato_relay_index(n)?),
-            ["relay", "readall"] => NumatoCommand::ReadAll,
-            ["relay", "writeall", m] if m.len() <= 8 => {
-                NumatoCommand::WriteAll(u32::from_str_radix(m, 16).ok()?)
-            }
-            _ => return None,
-        })
-    }
-}
-
-/// Why a Numato reply is not what the command expects.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-pub enum NumatoReplyError {
-    #[error("the board echoed {echo:?} instead of {sent:?}")]
-    Echo { sent: String, echo: String },
-    #[error("unexpected reply {0:?}")]
-    Unexpected(String),
-}
-
-/// Splits what the board sent up to (not including) the `>` prompt into the
-/// echo check and the reply lines. The board echoes the command as typed,
-/// possibly with its `\r`, then sends `\n\r`-separated lines.
-pub fn numato_split(sent: &str, raw: &[u8]) -> Result<Vec<String>, NumatoReplyError> {
-    let text = String::from_utf8_lossy(raw);
-    // The echo ends at the first line break the board adds after it.
-    let end = text.find(['\r', '\n']).unwrap_or(text.len());
-    let (echo, rest) = text.split_at(end);
-    if echo != sent {
-        return Err(NumatoReplyError::Echo {
-            sent: sent.to_string(),
-            echo: echo.to_string(),
-        });
-    }
-    Ok(rest
-        .split(['\r', '\n'])
-        .filter(|s| !s.trim().is_empty())
-        .map(|s| s.trim().to_string())
-        .collect())
-}
-
-/// The state `relay read N` reports.
-pub fn numato_parse_state(lines: &[String]) -> Result<bool, NumatoReplyError> {
-    match lines {
-        [s] if s == "on" => Ok(true),
-        [s] if s == "off" => Ok(false),
-        _ => Err(NumatoReplyError::Unexpected(lines.join("|"))),
-    }
-}
-
-/// The mask `relay readall` reports.
-pub fn numato_parse_mask(lines: &[String]) -> Result<u32, NumatoReplyError> {
-    match lines {
-        [s] if !s.is_empty() && s.len() <= 8 => {
-            u32::from_str_radix(s, 16).map_err(|_| NumatoReplyError::Unexpected(s.clone()))
-        }
-        _ => Err(NumatoReplyError::Unexpected(lines.join("|"))),
-    }
-}
-
-// ---------------------------------------------------------------- LCUS
-
-/// The LCUS frame switching `relay` (0-based; channel `relay + 1` on the
-/// wire) on or off: `A0 ch state sum`.
-pub fn lcus_frame(relay: u32, on: bool) -> Option<[u8; 4]> {
-    let ch = u8::try_from(relay.checked_add(1)?).ok()?;
-    let state = u8::from(on);
-    Some([0xA0, ch, state, 0xA0u8.wrapping_add(ch).wrapping_add(state)])
-}
-
-/// Decodes an LCUS frame into (relay, on); `None` if it is malformed.
-pub fn lcus_parse(frame: &[u8]) -> Option<(u32, bool)> {
-    match *frame {
-        [0xA0, ch, state @ (0 | 1), sum]
-            if ch >= 1 && sum == 0xA0u8.wrapping_add(ch).wrapping_add(state) =>
-        {
-            Some((u32::from(ch) - 1, state == 1))
-        }
-        _ => None,
-    }
-}
+pub use relay::*;
 
 #[cfg(test)]
 mod tests {
@@ -628,40 +495,5 @@ mod tests {
     #[test]
     fn crc_is_zlib_crc32() {
         assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
-    }
-
-    #[test]
-    fn numato_commands_and_replies() {
-        assert_eq!(NumatoCommand::On(10).text().as_deref(), Some("relay on A"));
-        assert_eq!(
-            NumatoCommand::parse("relay off a"),
-            Some(NumatoCommand::Off(10))
-        );
-        assert_eq!(NumatoCommand::Read(32).text(), None);
-        assert_eq!(
-            NumatoCommand::parse("relay writeall 00ff"),
-            Some(NumatoCommand::WriteAll(0xff))
-        );
-        let lines = numato_split("relay read 3", b"relay read 3\r\n\ron\n\r");
-        assert_eq!(lines.as_deref().map(numato_parse_state), Ok(Ok(true)));
-        let lines = numato_split("relay readall", b"relay readall\n\r0005\n\r");
-        assert_eq!(lines.as_deref().map(numato_parse_mask), Ok(Ok(5)));
-        assert!(matches!(
-            numato_split("relay on 1", b"relay on 2\n\r"),
-            Err(NumatoReplyError::Echo { .. })
-        ));
-        assert_eq!(
-            numato_split("ver", b"ver\r\n\r00000008\n\r"),
-            Ok(vec!["00000008".to_string()])
-        );
-    }
-
-    #[test]
-    fn lcus_frames_match_the_spec_examples() {
-        assert_eq!(lcus_frame(0, true), Some([0xA0, 0x01, 0x01, 0xA2]));
-        assert_eq!(lcus_frame(0, false), Some([0xA0, 0x01, 0x00, 0xA1]));
-        assert_eq!(lcus_parse(&[0xA0, 0x02, 0x01, 0xA3]), Some((1, true)));
-        assert_eq!(lcus_parse(&[0xA0, 0x02, 0x01, 0xA4]), None);
-        assert_eq!(lcus_frame(255, true), None);
     }
 }

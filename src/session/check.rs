@@ -88,7 +88,7 @@ pub fn check(s: &Session) -> CheckReport {
 }
 
 fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) {
-    let bytes = match std::fs::read(path) {
+    let bytes = match crate::fsutil::read_input(path, formats::max_len(path)) {
         Ok(b) => b,
         Err(e) => {
             r.problems.push(format!("{}: {e}", path.display()));

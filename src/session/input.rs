@@ -150,8 +150,9 @@ impl PipelineInput {
 pub struct Runner {
     ws: Workspace,
     lens: Option<(CameraModel, (usize, usize), Arc<LensMap>)>,
-    /// The caller's key of the input of the last run ([`Runner::run_changed`]).
-    last: Option<u64>,
+    /// The caller's key and the camera of the last complete run of
+    /// [`Runner::run_changed`].
+    last: Option<(u64, Option<CameraModel>)>,
 }
 
 impl Runner {
@@ -200,24 +201,31 @@ impl Runner {
     }
 
     /// Runs what `p` changed since the last run when `key` names the same
-    /// input as the last run (the caller promises: same frames, same
-    /// camera), else every stage; with nothing changed the last outputs
-    /// stand. This is how the console re-runs a parameter tweak.
+    /// frames as the last run (the caller's promise: a new capture gets a
+    /// new key) and the camera is the same, else every stage; with nothing
+    /// changed the last outputs stand. A failed run leaves nothing to run
+    /// from: the next is a full run. This is how the console re-runs a
+    /// parameter tweak.
     pub fn run_changed(
         &mut self,
         key: u64,
         input: &PipelineInput,
         p: &Params,
     ) -> Result<&StageOutputs, LlvError> {
-        let from = match self.last {
-            Some(k) if k == key => match self.ws.outputs().params.first_changed_stage(p) {
-                None => return Ok(self.ws.outputs()),
-                Some(stage) => stage,
-            },
+        let from = match self.last.take() {
+            Some(last) if last == (key, input.camera) => {
+                match self.ws.outputs().params.first_changed_stage(p) {
+                    None => {
+                        self.last = Some(last);
+                        return Ok(self.ws.outputs());
+                    }
+                    Some(stage) => stage,
+                }
+            }
             _ => Stage::Lens,
         };
         self.run(input, from, p)?;
-        self.last = Some(key);
+        self.last = Some((key, input.camera));
         Ok(self.ws.outputs())
     }
 
@@ -263,7 +271,15 @@ impl Session {
         if input.images.is_empty() {
             return Err(self.missing(k, "no grey image captured yet: capture it first".into()));
         }
-        Ok(input.with_camera(self.camera_model(k)?))
+        let camera = self.camera_model(k)?;
+        if let (Some(m), Some(cdf)) = (&camera, self.manifest.image(k).and_then(|r| r.cdf.as_ref()))
+        {
+            // A camera that leaves (almost) nothing of the image is the
+            // .cdf's fault: say so before a lens map is made.
+            let (w, h) = input.size();
+            formats::cdf::check_camera_area(m, w, h, &self.path(&cdf.file))?;
+        }
+        Ok(input.with_camera(camera))
     }
 
     /// Runs image `k`'s stages from `from` with `params` through `runner`,
@@ -373,5 +389,42 @@ mod tests {
             r.split([('c', img(1)), ('a', img(2))]).letters,
             vec!['a', 'c']
         );
+    }
+
+    /// A bright square on a dark ground.
+    fn square() -> GreyImage {
+        let mut g = GreyImage::filled(128, 128, 40).unwrap();
+        for y in 30..90 {
+            for x in 35..95 {
+                g.data_mut()[y * 128 + x] = 200;
+            }
+        }
+        g
+    }
+
+    #[test]
+    fn run_changed_reruns_what_changed_as_a_full_run_would() {
+        let input = FrameRule::default().split([('a', square())]);
+        let p = Params::default();
+        let mut r = Runner::new();
+        let first = r.run_changed(1, &input, &p).unwrap().clone();
+        assert!(first.lines.len() >= 4 && first.timings.edges_us > 0);
+        let mut q = p.clone();
+        q.connect.corner_radius = 0.0;
+        let again = r.run_changed(1, &input, &q).unwrap().clone();
+        assert_eq!(again.timings.edges_us, 0, "only CONNECT re-ran");
+        let full = Runner::new().run(&input, Stage::Lens, &q).unwrap().clone();
+        assert_eq!(again.lines, full.lines);
+        assert_eq!(again.edges_h, full.edges_h);
+        // A failed run leaves nothing to re-run from.
+        let mut bad = q.clone();
+        bad.edges.half_width = 99;
+        assert!(r.run_changed(1, &input, &bad).is_err());
+        let after = r.run_changed(1, &input, &q).unwrap();
+        assert!(after.timings.edges_us > 0, "a full run after a failure");
+        assert_eq!(after.lines, full.lines);
+        // Another key: a full run.
+        let other = r.run_changed(2, &input, &q).unwrap();
+        assert!(other.timings.edges_us > 0);
     }
 }

@@ -10,12 +10,15 @@
 //! host, can be taken over on request; a live holder on this host never.
 
 use std::fs;
-use std::io;
+use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
 use super::{SessionError, stamp};
+
+/// The largest lock file read (a real one is about 150 bytes).
+const MAX_LOCK_LEN: u64 = 64 << 10;
 
 /// Who holds a lock.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -94,13 +97,23 @@ impl Lock {
             path: path.to_path_buf(),
             source,
         };
-        let tmp = path.with_file_name(format!(
-            ".{}.tmp.{}",
-            path.file_name()
-                .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
-            info.pid
-        ));
-        fs::write(&tmp, text.as_bytes()).map_err(io_err)?;
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        let name = path.file_name().unwrap_or_default();
+        // Created exclusively under a random name: a link planted in the
+        // folder is never written through. (No sweep of stale temporary
+        // files here: the session's first write does it, and a lock is
+        // taken again quickly when a console closes and reopens.)
+        let (mut file, tmp) = crate::fsutil::create_temp(dir, name).map_err(io_err)?;
+        // No fsync: a lock torn by a crash reads as an unknown holder, which
+        // can be taken over.
+        if let Err(e) = file.write_all(text.as_bytes()) {
+            let _ = fs::remove_file(&tmp);
+            return Err(io_err(e));
+        }
+        drop(file);
         let linked = fs::hard_link(&tmp, path);
         let result = match linked {
             Ok(()) => Ok(()),
@@ -158,7 +171,7 @@ impl Drop for Lock {
 
 /// The holder named in a lock file, if it can be read.
 pub fn read_holder(path: &Path) -> Option<LockInfo> {
-    let text = fs::read_to_string(path).ok()?;
+    let text = crate::fsutil::read_input_text(path, MAX_LOCK_LEN).ok()?;
     toml::from_str(&text).ok()
 }
 

@@ -22,6 +22,12 @@ use crate::llv::{Params, Segment};
 /// Version of the manifest schema this console writes.
 pub const FORMAT: u32 = 1;
 
+/// The largest manifest read: 16 MiB. TOML parsing costs 25–50 times the
+/// text in memory, so a 98 MB file once took 2.5 GB; a real manifest takes
+/// a few KiB an image (see docs/reliability.md), so this bound holds
+/// thousands of fully processed images. Larger files are refused unread.
+pub const MAX_LEN: usize = 16 << 20;
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Manifest {
@@ -238,6 +244,16 @@ impl Manifest {
 
     /// Parses manifest text; errors name `path` and the line.
     pub fn parse(text: &str, path: &Path) -> Result<Manifest, SessionError> {
+        if text.len() > MAX_LEN {
+            return Err(SessionError::Manifest {
+                path: path.to_path_buf(),
+                line: 0,
+                message: format!(
+                    "the manifest has {} bytes, more than the {MAX_LEN} a manifest may have",
+                    text.len()
+                ),
+            });
+        }
         let m: Manifest = toml::from_str(text).map_err(|e| {
             let line = e
                 .span()

@@ -57,15 +57,23 @@ fn cdf_param(name: String) -> BoxedStrategy<CdfParam> {
             proptest::collection::vec(proptest::collection::vec(finite(), cols), rows),
             any::<bool>(),
         )
-            .prop_map(move |(status, rows, empty)| CdfParam {
-                name: name.clone(),
-                status,
-                // Status N may also come without values.
-                rows: if status == Status::NotAvailable && empty {
-                    Vec::new()
-                } else {
-                    rows
-                },
+            .prop_map(move |(status, mut rows, empty)| {
+                // Scale factors and focal length are positive unless marked N.
+                if status != Status::NotAvailable && (name == "S" || name == "f") {
+                    for v in rows.iter_mut().flatten() {
+                        *v = v.abs().max(1e-6);
+                    }
+                }
+                CdfParam {
+                    name: name.clone(),
+                    status,
+                    // Status N may also come without values.
+                    rows: if status == Status::NotAvailable && empty {
+                        Vec::new()
+                    } else {
+                        rows
+                    },
+                }
             })
             .boxed(),
         None => (

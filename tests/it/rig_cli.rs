@@ -460,3 +460,148 @@ fn a_grabber_pulled_and_plugged_back_is_found_under_its_name() {
     assert_eq!(imgs(&session), ["plug1a.img", "plug1b.img"]);
     sim.stop();
 }
+
+/// Starts `vss grab` with a long stall, waits until its transfer has begun
+/// (progress on stderr) and SIGKILLs it: the session's lock stays behind.
+fn kill_mid_grab(prof: &Path, session: &Path) {
+    use std::io::Read;
+    let mut child = vss()
+        .arg("--profile")
+        .arg(prof)
+        .args(["grab", "--camera", "1", "--lighting", "a", "--image", "1"])
+        .args(["--yes", "--sim-faults", "stall=60s", "--session"])
+        .arg(session)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start grab");
+    let mut err = child.stderr.take().expect("stderr");
+    let mut seen = Vec::new();
+    let mut buf = [0u8; 256];
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !String::from_utf8_lossy(&seen).contains("bytes (") {
+        assert!(Instant::now() < deadline, "no progress from grab");
+        match err.read(&mut buf) {
+            Ok(0) | Err(_) => panic!("grab ended early: {}", String::from_utf8_lossy(&seen)),
+            Ok(n) => seen.extend_from_slice(&buf[..n]),
+        }
+    }
+    child.kill().expect("SIGKILL");
+    child.wait().expect("wait");
+    let name = session.file_name().expect("name").to_string_lossy();
+    assert!(
+        session.join(format!("{name}.lock")).exists(),
+        "the lock stayed"
+    );
+}
+
+fn grab_one(prof: &Path, session: &Path, extra: &[&str]) -> std::process::Output {
+    vss()
+        .arg("--profile")
+        .arg(prof)
+        .args([
+            "grab",
+            "--camera",
+            "1",
+            "--lighting",
+            "a",
+            "--image",
+            "1",
+            "--yes",
+        ])
+        .args(extra)
+        .arg("--session")
+        .arg(session)
+        .stdin(Stdio::null())
+        .output()
+        .expect("run grab")
+}
+
+#[test]
+fn a_killed_grab_leaves_a_lock_the_next_grab_can_take_over() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let prof = write_profile(tmp.path(), "p.toml", &base());
+    let session = tmp.path().join("s/kill");
+    kill_mid_grab(&prof, &session);
+    // Without a terminal and without the flag: refused, saying what to do.
+    let out = grab_one(&prof, &session, &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "a stale lock was ignored");
+    assert!(err.contains("gone") && err.contains("--take-over"), "{err}");
+    // With it: taken over and captured.
+    let out = grab_one(&prof, &session, &["--take-over"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(imgs(&session), ["kill1a.img"]);
+    assert!(
+        !session.join("kill.lock").exists(),
+        "released after the grab"
+    );
+}
+
+#[test]
+fn a_terminal_is_asked_before_a_stale_lock_is_taken_over() {
+    use portable_pty::{CommandBuilder, PtySize, native_pty_system};
+    use std::io::{Read, Write};
+    let tmp = tempfile::tempdir().expect("tmp");
+    let prof = write_profile(tmp.path(), "p.toml", &base());
+    let session = tmp.path().join("s/ask");
+    kill_mid_grab(&prof, &session);
+    let pair = native_pty_system()
+        .openpty(PtySize {
+            rows: 24,
+            cols: 80,
+            pixel_width: 0,
+            pixel_height: 0,
+        })
+        .expect("pty");
+    let mut cmd = CommandBuilder::new(cargo_bin("vss"));
+    cmd.arg("--profile");
+    cmd.arg(&prof);
+    cmd.args(["grab", "--camera", "1", "--lighting", "a", "--image", "1"]);
+    cmd.args(["--yes", "--session"]);
+    cmd.arg(&session);
+    let mut child = pair.slave.spawn_command(cmd).expect("spawn");
+    drop(pair.slave);
+    let mut reader = pair.master.try_clone_reader().expect("reader");
+    let mut writer = pair.master.take_writer().expect("writer");
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut buf = [0u8; 1024];
+        while let Ok(n) = reader.read(&mut buf) {
+            if n == 0 || tx.send(buf[..n].to_vec()).is_err() {
+                break;
+            }
+        }
+    });
+    let mut screen = Vec::new();
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !String::from_utf8_lossy(&screen).contains("[y/N]") {
+        assert!(
+            Instant::now() < deadline,
+            "no question: {}",
+            String::from_utf8_lossy(&screen)
+        );
+        if let Ok(b) = rx.recv_timeout(Duration::from_millis(100)) {
+            screen.extend_from_slice(&b);
+        }
+    }
+    writer.write_all(b"y\r").expect("answer");
+    let status = loop {
+        if let Ok(Some(st)) = child.try_wait() {
+            break st;
+        }
+        assert!(Instant::now() < deadline, "grab did not finish");
+        while let Ok(b) = rx.try_recv() {
+            screen.extend_from_slice(&b);
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let text = String::from_utf8_lossy(&screen).into_owned();
+    assert!(status.success(), "{text}");
+    assert!(text.contains("took over"), "{text}");
+    assert_eq!(imgs(&session), ["ask1a.img"]);
+}

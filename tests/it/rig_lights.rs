@@ -49,7 +49,7 @@ fn raw_numato_commands_on_the_simulated_board() {
 fn numato_driver_switches_and_reads_back() {
     let sim = SimCell::start(SimOptions::new(32, 32)).expect("sim");
     let mut b =
-        NumatoBoard::open(sim.relay_path(), 19200, Duration::from_millis(300)).expect("open");
+        NumatoBoard::open(sim.relay_path(), 19200, Duration::from_millis(300), None).expect("open");
     b.set(2, true).expect("on");
     b.set(10, true).expect("on A");
     assert_eq!(b.read_mask().expect("mask"), (1 << 2) | (1 << 10));
@@ -66,6 +66,152 @@ fn numato_driver_switches_and_reads_back() {
 }
 
 #[test]
+fn writeall_sends_as_many_digits_as_the_board_has_relays_over_four() {
+    for (relays, mask, typed) in [
+        (8, 0x81, "relay writeall 81"),
+        (16, 0x8001, "relay writeall 8001"),
+        (32, 0x8000_0001, "relay writeall 80000001"),
+    ] {
+        let mut o = SimOptions::new(32, 32);
+        o.relays = relays;
+        let sim = SimCell::start(o).expect("sim");
+        // The width learned from the board itself, and given by the profile.
+        for channels in [None, Some(relays)] {
+            let mut b = NumatoBoard::open(
+                sim.relay_path(),
+                19200,
+                Duration::from_millis(300),
+                channels,
+            )
+            .expect("open");
+            b.set_mask(0).expect("off");
+            b.set_mask(mask).expect(typed);
+            assert_eq!(sim.scene().relays(), mask, "{typed}");
+            assert_eq!(b.channels(), Some(relays));
+        }
+        if relays == 32 {
+            let mut b =
+                NumatoBoard::open(sim.relay_path(), 19200, Duration::from_millis(300), None)
+                    .expect("open");
+            b.set(31, false).expect("relay V");
+            assert_eq!(sim.scene().relays(), 1);
+        }
+    }
+    // What a Numato board types back, raw: 8 relays, 2 digits.
+    let mut o = SimOptions::new(32, 32);
+    o.relays = 8;
+    let sim = SimCell::start(o).expect("sim");
+    let mut p = open_serial(sim.relay_path(), 19200, Duration::from_millis(50)).expect("open");
+    p.write_all(b"relay readall\r").expect("write");
+    let got = String::from_utf8(read_until(&mut p, b'>', 16)).expect("ascii");
+    assert_eq!(got, "relay readall\r\n\r00\n\r>");
+}
+
+#[test]
+fn a_prompt_long_after_the_echo_keeps_the_numato_driver_in_step() {
+    for delay_ms in [40, 60, 120] {
+        let mut o = SimOptions::new(32, 32);
+        o.prompt_delay = Duration::from_millis(delay_ms);
+        let sim = SimCell::start(o).expect("sim");
+        let mut b = NumatoBoard::open(sim.relay_path(), 19200, Duration::from_millis(500), None)
+            .unwrap_or_else(|e| panic!("{delay_ms} ms: {e}"));
+        b.set(2, true)
+            .unwrap_or_else(|e| panic!("{delay_ms} ms: {e}"));
+        b.set_mask(0b1001)
+            .unwrap_or_else(|e| panic!("{delay_ms} ms: {e}"));
+        assert_eq!(b.read_mask().expect("mask"), 0b1001, "{delay_ms} ms");
+        assert_eq!(sim.scene().relays(), 0b1001);
+    }
+    // A prompt later than the reply timeout: the error says so, and counts
+    // its attempts.
+    let mut o = SimOptions::new(32, 32);
+    o.prompt_delay = Duration::from_millis(400);
+    let sim = SimCell::start(o).expect("sim");
+    let e = match NumatoBoard::open(sim.relay_path(), 19200, Duration::from_millis(100), None) {
+        Ok(_) => panic!("a 400 ms prompt within 100 ms"),
+        Err(e) => e,
+    };
+    let msg = e.to_string();
+    assert!(matches!(e, RigError::NoPrompt { attempts: 3, .. }), "{msg}");
+    assert!(
+        msg.contains("prompt") && msg.contains("3 attempts"),
+        "{msg}"
+    );
+    assert!(
+        !msg.contains("instead of") && !msg.contains("1 attempts"),
+        "{msg}"
+    );
+}
+
+/// Reads LCUS frames from the device side of a pty for `wait`.
+fn frames(peer: &mut TTYPort, wait: Duration) -> Vec<u8> {
+    let deadline = Instant::now() + wait;
+    let mut got = Vec::new();
+    let mut buf = [0u8; 64];
+    while Instant::now() < deadline {
+        if let Ok(n) = peer.read(&mut buf) {
+            got.extend_from_slice(&buf[..n]);
+        }
+    }
+    got
+}
+
+#[test]
+fn lcus_status_switches_nothing_and_set_sends_only_what_changes() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let (mut peer, dev) = TTYPort::pair().expect("pty");
+    peer.set_timeout(Duration::from_millis(20))
+        .expect("timeout");
+    let port = dev.name().expect("pty name");
+    let mut p = cell_profile(32, 32);
+    p.relay.kind = vss::profile::RelayKind::Lcus;
+    p.relay.port = port.clone();
+    p.relay.settle_ms = 0;
+    let prof = tmp.path().join("lcus.toml");
+    std::fs::write(&prof, toml::to_string(&p).expect("toml")).expect("profile");
+    let lights = |action: &[&str]| {
+        let o = std::process::Command::new(assert_cmd::cargo::cargo_bin("vss"))
+            .arg("--profile")
+            .arg(&prof)
+            .arg("lights")
+            .args(action)
+            .env("XDG_STATE_HOME", tmp.path().join("state"))
+            .output()
+            .expect("vss lights");
+        let text =
+            String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{action:?}: {text}");
+        text
+    };
+    let out = lights(&["status"]);
+    assert!(out.contains("LCUS boards cannot be read"), "{out}");
+    assert!(out.contains("nothing recorded"), "{out}");
+    assert!(
+        frames(&mut peer, Duration::from_millis(300)).is_empty(),
+        "status switched relays"
+    );
+    // a: relay 0 on. Nothing was known, so all 8 channels go once.
+    lights(&["set", "a"]);
+    let got = frames(&mut peer, Duration::from_millis(300));
+    assert_eq!(got.len(), 8 * 4, "{got:02x?}");
+    assert_eq!(&got[..4], &[0xA0, 1, 1, 0xA2]);
+    // b: relay 0 off, relay 1 on; the rest stays as it is, unsent.
+    lights(&["set", "b"]);
+    let got = frames(&mut peer, Duration::from_millis(300));
+    assert_eq!(got, [0xA0, 1, 0, 0xA1, 0xA0, 2, 1, 0xA3]);
+    let out = lights(&["status"]);
+    assert!(
+        out.contains("last set by vss: relays 0002") && out.contains("right-front"),
+        "{out}"
+    );
+    assert!(
+        frames(&mut peer, Duration::from_millis(300)).is_empty(),
+        "status switched relays"
+    );
+    drop(dev);
+}
+
+#[test]
 fn lcus_frames_over_a_pty() {
     let (mut peer, mut dev) = TTYPort::pair().expect("pty");
     dev.set_timeout(Duration::from_millis(200))
@@ -74,19 +220,20 @@ fn lcus_frames_over_a_pty() {
         .expect("timeout");
     let name = dev.name().unwrap_or_default();
     let mut b = LcusBoard::new(dev, &name, 4, Duration::from_millis(200));
+    b.set_mask(0).expect("all off");
     b.set(0, true).expect("on");
     b.set(2, true).expect("on");
     b.set(0, false).expect("off");
     let mut got = Vec::new();
     let deadline = Instant::now() + Duration::from_secs(3);
     let mut buf = [0u8; 64];
-    while got.len() < 12 && Instant::now() < deadline {
+    while got.len() < 28 && Instant::now() < deadline {
         if let Ok(n) = peer.read(&mut buf) {
             got.extend_from_slice(&buf[..n]);
         }
     }
     assert_eq!(
-        got,
+        got[16..],
         [0xA0, 1, 1, 0xA2, 0xA0, 3, 1, 0xA4, 0xA0, 1, 0, 0xA1],
         "A0 ch state sum"
     );

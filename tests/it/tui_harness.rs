@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
 use ratatui::crossterm::event::KeyCode;
-use vss::tui::keymap::{Action, KEYMAP, Key, Scope, ScreenId};
+use vss::tui::keymap::{Action, KEYMAP, Key, ModalAction, Scope, ScreenId, SurveyAction};
 
 /// A small, quick simulated cell: 128 × 128 images, short settle, three
 /// lightings (c ambient), four cameras.
@@ -243,6 +243,11 @@ impl Console {
         self.send(&bytes(&k));
     }
 
+    /// Answers the open question with yes.
+    pub fn yes(&mut self) {
+        self.press(Scope::Confirm, Action::Modal(ModalAction::Yes));
+    }
+
     /// Waits until the screen satisfies `f`, or fails showing the screen.
     pub fn wait(&self, what: &str, secs: u64, f: impl Fn(&str) -> bool) -> String {
         let end = Instant::now() + Duration::from_secs(secs);
@@ -287,7 +292,7 @@ impl Console {
     /// Creates session `name` by keys.
     pub fn create_session(&mut self, name: &str) {
         self.wait_text("choose a session", 10);
-        self.press(SURVEY, Action::NewSession);
+        self.press(SURVEY, Action::Survey(SurveyAction::NewSession));
         self.wait_text("new session name", 5);
         self.send(name);
         self.send("\r");
@@ -298,7 +303,7 @@ impl Console {
     /// waits for its review.
     pub fn capture_current(&mut self, k: u32) {
         self.wait_text(&format!("Image {k}: camera"), 20);
-        self.press(SURVEY, Action::NextStep);
+        self.press(SURVEY, Action::Survey(SurveyAction::Enter));
         self.wait(&format!("image {k} reviewed"), 60, |s| {
             s.contains(&format!("Image {k}: ")) && s.contains("before CONNECT")
         });
@@ -309,7 +314,7 @@ impl Console {
         self.create_session("cube");
         for k in 1..=n {
             self.capture_current(k);
-            self.press(SURVEY, Action::Accept);
+            self.press(SURVEY, Action::Survey(SurveyAction::Accept));
             self.wait_text(&format!("Image {}: camera", k + 1), 20);
         }
     }
@@ -378,12 +383,15 @@ pub fn bytes(k: &Key) -> String {
 /// The value the parameter panel shows for `key` (`None` when the row is
 /// not on screen).
 pub fn panel_value(screen: &str, key: &str) -> Option<String> {
+    // Rows of the panel start at its border; the log also names keys.
     screen.lines().find_map(|l| {
-        let at = l.find(&format!("{key} "))?;
+        let at = ["│", "|"]
+            .iter()
+            .find_map(|b| l.starts_with(&format!("{b}{key} ")).then_some(b.len()))?;
         let rest = l[at + key.len()..].trim_start();
         let v: String = rest
             .chars()
-            .take_while(|c| !c.is_whitespace() && *c != '│' && *c != '|')
+            .take_while(|c| !c.is_whitespace() && !matches!(c, '│' | '|' | '*'))
             .collect();
         (!v.is_empty()).then_some(v)
     })
