@@ -46,6 +46,8 @@ mod tui_device;
 mod tui_flow;
 mod tui_harness;
 mod tui_pty;
+mod tui_pty_review;
+mod tui_pty_trouble;
 mod tui_pty_tuning;
 mod tui_screens;
 mod tui_truth;
