@@ -57,9 +57,7 @@ fn ldr_file_prints_with_its_image_size() {
     );
     let tree = svg_parses(&dir.path().join("test1.svg"));
     assert_eq!(tree.size().width(), 300.0);
-    if !gs::have_gs() {
-        return;
-    }
+    gs::require_gs();
     let page = &gs::render(&dir.path().join("test1.ps"), "a4", 72)[0];
     let bx = gs::long_run_box(page, 150).expect("frame");
     let (fw, fh) = ((bx.2 - bx.0) as f64, (bx.3 - bx.1) as f64);
@@ -96,9 +94,7 @@ fn img_files_print_six_per_page() {
         dir.path().join("cube1a.ps").is_file(),
         "default output beside the input"
     );
-    if !gs::have_gs() {
-        return;
-    }
+    gs::require_gs();
     assert_eq!(
         gs::render(&dir.path().join("cube1.ps"), "letter", 36).len(),
         2
@@ -172,9 +168,7 @@ fn session_report_has_every_image() {
     let text = std::fs::read_to_string(dir.path().join("all.ps")).unwrap();
     assert!(text.contains("%%Pages: 4"), "two pages per image");
     assert!(text.contains("edges.half_width = 4"), "parameters printed");
-    if !gs::have_gs() {
-        return;
-    }
+    gs::require_gs();
     assert_eq!(gs::render(&dir.path().join("all.ps"), "a4", 36).len(), 4);
     assert_eq!(
         gs::render(&dir.path().join("cube.ps"), "letter", 36).len(),
