@@ -26,6 +26,22 @@ fn vss(args: &[&str], cwd: &Path) -> std::process::Output {
     out
 }
 
+/// Thirty edge points down column 20 of a 64 × 48 picture.
+fn edge_column() -> EdgePoints {
+    EdgePoints {
+        dir: Some(ScanDir::Horizontal),
+        width: 64,
+        height: 48,
+        points: (0..30)
+            .map(|i| EdgePoint {
+                x: 20.0,
+                y: i as f32 + 5.0,
+                response: 25.0,
+            })
+            .collect(),
+    }
+}
+
 fn svg_parses(p: &Path) -> resvg::usvg::Tree {
     let text = std::fs::read_to_string(p).unwrap();
     resvg::usvg::Tree::from_str(&text, &resvg::usvg::Options::default())
@@ -110,18 +126,7 @@ fn session_report_has_every_image() {
     let mut p = Profile::default();
     p.survey.cameras = 2;
     let mut s = Session::create(dir.path(), "cube", &p).unwrap();
-    let e = EdgePoints {
-        dir: Some(ScanDir::Horizontal),
-        width: 64,
-        height: 48,
-        points: (0..30)
-            .map(|i| EdgePoint {
-                x: 20.0,
-                y: i as f32 + 5.0,
-                response: 25.0,
-            })
-            .collect(),
-    };
+    let e = edge_column();
     let l = [Segment::new(Point::new(20.0, 5.0), Point::new(20.0, 35.0))];
     for k in 1..=2 {
         s.save_image(
@@ -184,18 +189,7 @@ fn the_console_s_export_and_vss_report_write_the_same_pages() {
     use vss::report::survey::{self, Targets};
     let dir = tempfile::tempdir().unwrap();
     let mut s = Session::create(dir.path(), "cube", &Profile::default()).unwrap();
-    let e = EdgePoints {
-        dir: Some(ScanDir::Horizontal),
-        width: 64,
-        height: 48,
-        points: (0..30)
-            .map(|i| EdgePoint {
-                x: 20.0,
-                y: i as f32 + 5.0,
-                response: 25.0,
-            })
-            .collect(),
-    };
+    let e = edge_column();
     let l = [
         Segment::new(Point::new(20.0, 5.0), Point::new(20.0, 35.0)),
         Segment::new(Point::new(30.0, 5.0), Point::new(30.0, 35.0)),
