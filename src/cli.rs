@@ -7,11 +7,19 @@ use clap::{Parser, Subcommand};
 
 /// `println!` that hands a failed write back (`?`, as a [`StdoutError`])
 /// instead of panicking: a reader that goes away (`vss info FILE | head
-/// -2`) ends the command quietly (see [`main`]).
+/// -2`) ends the command quietly (see [`main`]). What it prints goes
+/// through the one sanitiser ([`crate::text::sanitize_lines`]): text from
+/// files (a note, a light name, a comment) never reaches the terminal with
+/// an escape sequence in it.
 macro_rules! outln {
+    () => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout()).map_err($crate::cli::StdoutError)?
+    }};
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        writeln!(std::io::stdout(), $($arg)*).map_err($crate::cli::StdoutError)?
+        let text = $crate::text::sanitize_lines(&format!($($arg)*));
+        writeln!(std::io::stdout(), "{text}").map_err($crate::cli::StdoutError)?
     }};
 }
 
@@ -19,10 +27,20 @@ macro_rules! outln {
 macro_rules! out {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        write!(std::io::stdout(), $($arg)*).map_err($crate::cli::StdoutError)?
+        let text = $crate::text::sanitize_lines(&format!($($arg)*));
+        write!(std::io::stdout(), "{text}").map_err($crate::cli::StdoutError)?
     }};
 }
 
+/// `eprintln!` through the one sanitiser: notes and errors name files and
+/// quote what they hold.
+macro_rules! errln {
+    ($($arg:tt)*) => {{
+        eprintln!("{}", $crate::text::sanitize_lines(&format!($($arg)*)))
+    }};
+}
+
+pub mod calibrate;
 pub mod convert;
 pub mod grab;
 pub mod info;
@@ -37,7 +55,9 @@ pub mod sim;
 /// Options every subcommand shares.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Global {
-    /// Profile: a path to a .toml file, or a name from profiles/ (default: "default").
+    /// Profile: a path to a .toml file, or a NAME looked up as NAME.toml in
+    /// ./profiles, then ~/.config/vss/profiles (default: "default", built in
+    /// unless a default.toml is there).
     #[arg(long, global = true, value_name = "P")]
     pub profile: Option<String>,
 }
@@ -64,10 +84,32 @@ pub struct Cli {
     #[command(flatten)]
     pub global: Global,
     /// Preview mode of the console (default: picked from TERM and NO_COLOR).
-    #[arg(long, value_name = "MODE", value_parser = ["ascii", "braille", "blocks"])]
-    pub preview: Option<String>,
+    #[arg(long, value_name = "MODE", value_enum)]
+    pub preview: Option<Preview>,
     #[command(subcommand)]
     pub command: Option<Command>,
+}
+
+/// How the console draws its previews (`--preview`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Preview {
+    /// Plain ASCII: a character ramp for grey, `- | / \\` strokes for lines.
+    Ascii,
+    /// Braille dots (2 × 4 a cell) for everything.
+    Braille,
+    /// Half-blocks in 256-colour greys for images, Braille for lines.
+    Blocks,
+}
+
+impl Preview {
+    /// The mode's name, as typed after `--preview`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preview::Ascii => "ascii",
+            Preview::Braille => "braille",
+            Preview::Blocks => "blocks",
+        }
+    }
 }
 
 #[derive(Debug, Subcommand)]
@@ -88,6 +130,8 @@ pub enum Command {
     Grab(grab::Args),
     /// Switch and read the lights.
     Lights(lights::Args),
+    /// Calibrate a camera from images of a calibration plate (writes its .cdf).
+    Calibrate(calibrate::Args),
     /// Create, show, check and redo survey sessions.
     Session(session::Args),
     /// Write PostScript and SVG reports.
@@ -98,7 +142,12 @@ pub enum Command {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => crate::tui::run(&cli.global, cli.preview.as_deref()),
+        None => cli.global.load_profile().and_then(|p| {
+            crate::tui::run(
+                p,
+                crate::tui::mode::from_env(cli.preview.map(Preview::name)),
+            )
+        }),
         Some(cmd) => run(&cli.global, cmd),
     };
     match result {
@@ -107,7 +156,7 @@ pub fn main() -> ExitCode {
         // wanted, so stop quietly, as a pipeline expects.
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("vss: error: {e:#}");
+            errln!("vss: error: {e:#}");
             ExitCode::FAILURE
         }
     }
@@ -139,6 +188,7 @@ fn run(g: &Global, cmd: Command) -> anyhow::Result<ExitCode> {
         Command::Sim(a) => sim::run(g, a),
         Command::Grab(a) => grab::run(g, a),
         Command::Lights(a) => lights::run(g, a),
+        Command::Calibrate(a) => calibrate::run(g, a),
         Command::Session(a) => session::run(g, a),
         Command::Report(a) => report::run(g, a),
     }

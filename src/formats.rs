@@ -265,11 +265,9 @@ pub(crate) fn shorten(s: &str) -> String {
     out
 }
 
-/// A comment or name made safe to show to the operator: control characters
-/// removed (formats.md §2).
-pub fn sanitize(s: &str) -> String {
-    s.chars().filter(|c| !c.is_control()).collect()
-}
+/// A comment or name made safe to show to the operator (formats.md §2):
+/// the crate's one sanitiser.
+pub use crate::text::sanitize;
 
 #[cfg(test)]
 mod tests {

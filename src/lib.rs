@@ -9,7 +9,9 @@
 //! - [`rig`]: the frame grabber and relay-board drivers, and the simulated cell.
 //! - [`session`]: a survey on disk; [`report`]: PostScript and SVG.
 //! - [`cli`]: headless subcommands; [`tui`]: the operator console.
+//! - [`text`]: the one sanitiser of text shown to a person.
 
+pub mod calib;
 pub mod cli;
 pub mod formats;
 pub mod fsutil;
@@ -18,4 +20,5 @@ pub mod profile;
 pub mod report;
 pub mod rig;
 pub mod session;
+pub mod text;
 pub mod tui;

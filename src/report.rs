@@ -2,12 +2,15 @@
 //! page of the original `img2ps`, the line page of `ldr2ps`, and a multi-page
 //! survey report per image (grey images, edge images, raw and connected
 //! lines, parameters, counts, timings). The writers build text in memory from
-//! plain data ([`GreyImage`], [`Segment`], [`EdgePoints`]); saving goes
-//! through [`crate::fsutil::write_atomic`].
+//! plain data ([`GreyImage`], [`Segment`], [`EdgePoints`]); [`survey`]
+//! gathers that data from a session and is the one writer of a session's
+//! report, for the command line and the console alike; saving goes through
+//! [`crate::fsutil::write_atomic`].
 
 pub mod clip;
 pub mod encode;
 pub mod ps;
+pub mod survey;
 pub mod svg;
 
 use crate::formats::edgefile::MAX_SIDE;
@@ -110,10 +113,13 @@ pub fn edge_image(
     Ok(img)
 }
 
-/// Text safe for a PostScript string or an XML attribute: printable ASCII
-/// only (the comment of an `.img` may hold anything).
+/// Text safe for a PostScript string or an XML attribute: the crate's one
+/// sanitiser ([`crate::text::sanitize`]) first, then printable ASCII only,
+/// the standard fonts' characters (the comment of an `.img` may hold
+/// anything).
 pub(crate) fn printable(s: &str) -> String {
-    s.chars()
+    crate::text::sanitize(s)
+        .chars()
         .map(|c| {
             if c.is_ascii_graphic() || c == ' ' {
                 c
@@ -185,6 +191,6 @@ mod tests {
 
     #[test]
     fn printable_strips_control_and_unicode() {
-        assert_eq!(printable("a\u{1b}[2Jb µ"), "a?[2Jb ?");
+        assert_eq!(printable("a\u{1b}[2Jb µ"), "a[2Jb ?");
     }
 }

@@ -34,7 +34,7 @@ pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     let (mut f, notes) = read_any_noted(&a.input)?;
     let in_kind = ImageKind::of(&a.input);
     for n in notes {
-        eprintln!("vss: note: {}: {n}", a.input.display());
+        errln!("vss: note: {}: {n}", a.input.display());
     }
     if let Some(c) = a.comment {
         f.comment = c;
@@ -53,7 +53,7 @@ pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             .unwrap_or_default();
     }
     if !out_kind.keeps_header() && (!f.comment.is_empty() || f.x0 != 0 || f.y0 != 0) {
-        eprintln!(
+        errln!(
             "vss: note: {}: this format keeps only the pixels (comment and upper-left corner dropped)",
             a.output.display()
         );

@@ -33,7 +33,7 @@ pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                 out!("{text}");
             }
             Err(e) => {
-                eprintln!("vss: error: {e}");
+                errln!("vss: error: {e}");
                 failed += 1;
             }
         }

@@ -6,7 +6,10 @@
 //! Images of one view under several lightings (`cube1a.img cube1b.img`: the
 //! same stem but for the lighting letter, formats.md §1) are ONE input to the
 //! photometric pipeline and give `cube1.hpo` etc.; other images are
-//! processed one by one. A failing input is reported on stderr and the
+//! processed one by one. Which of them is the ambient frame is the profile's
+//! rule (`session::FrameRule`, as for the console and `vss session redo`),
+//! unless `--ambient IMG` names one; the stages run through the same
+//! `session::Runner`. A failing input is reported on stderr and the
 //! others still run; the exit code is 1 if any failed.
 //!
 //! `--auto lines=200` (or `--auto clean`) first searches the parameters for
@@ -24,9 +27,12 @@ use super::Global;
 use crate::formats::names::VssFile;
 use crate::formats::{cdf, edgefile, imageio, img::ImgFile, lines as linefile};
 use crate::llv::auto::{self, AutoResult, Target};
-use crate::llv::lens::{CameraModel, LensMap};
-use crate::llv::pipeline::{Input, StageOutputs, Workspace, lines_from_edges};
+use crate::llv::lens::CameraModel;
+use crate::llv::params::Stage;
+use crate::llv::pipeline::{Saved, StageOutputs};
 use crate::llv::{GreyImage, Params};
+use crate::profile::Profile;
+use crate::session::{FrameRule, Runner};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -65,6 +71,8 @@ struct Group {
     stem: String,
     dir: PathBuf,
     files: Vec<PathBuf>,
+    /// The lighting letter of each file (VSS names), or none (one file).
+    letters: Vec<Option<char>>,
 }
 
 /// Groups image paths into views, in order of first appearance.
@@ -85,8 +93,12 @@ fn group(paths: &[PathBuf]) -> Vec<Group> {
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_else(|| "image".to_string()),
         };
+        let letter = parsed.as_ref().and_then(|f| f.lighting);
         match (parsed.is_some(), index.get(&(dir.clone(), stem.clone()))) {
-            (true, Some(&k)) => groups[k].files.push(p.clone()),
+            (true, Some(&k)) => {
+                groups[k].files.push(p.clone());
+                groups[k].letters.push(letter);
+            }
             _ => {
                 if parsed.is_some() {
                     index.insert((dir.clone(), stem.clone()), groups.len());
@@ -95,19 +107,22 @@ fn group(paths: &[PathBuf]) -> Vec<Group> {
                     stem,
                     dir,
                     files: vec![p.clone()],
+                    letters: vec![letter],
                 });
             }
         }
     }
     for g in &mut groups {
-        g.files
-            .sort_by_key(|f| f.file_name().map(|n| n.to_os_string()));
+        let mut both: Vec<(PathBuf, Option<char>)> =
+            g.files.drain(..).zip(g.letters.drain(..)).collect();
+        both.sort_by_key(|(f, _)| f.file_name().map(|n| n.to_os_string()));
+        (g.files, g.letters) = both.into_iter().unzip();
     }
     groups
 }
 
-fn params(g: &Global, a: &Args) -> anyhow::Result<Params> {
-    let mut p = g.load_profile()?.llv;
+fn params(profile: &Profile, a: &Args) -> anyhow::Result<Params> {
+    let mut p = profile.llv.clone();
     for s in &a.set {
         p.set_str(s).with_context(|| format!("--set {s}"))?;
     }
@@ -116,7 +131,8 @@ fn params(g: &Global, a: &Args) -> anyhow::Result<Params> {
 }
 
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
-    let p = params(g, &a)?;
+    let profile = g.load_profile()?;
+    let p = params(&profile, &a)?;
     if let Some(out) = &a.out {
         std::fs::create_dir_all(out)
             .with_context(|| format!("{}: cannot create the output directory", out.display()))?;
@@ -137,27 +153,23 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         })?),
         None => None,
     };
-    let ambient = match &a.ambient {
-        Some(path) => Some(imageio::read_any(path)?.image),
-        None => None,
+    // An ambient image given by name is subtracted from every image given;
+    // else the profile's rule picks it among the lightings of one view.
+    let (rule, ambient) = match &a.ambient {
+        Some(path) => (
+            FrameRule::default(),
+            Some((path.clone(), imageio::read_any(path)?.image)),
+        ),
+        None => (FrameRule::of_profile(&profile), None),
     };
-    let mut maps: HashMap<(usize, usize), LensMap> = HashMap::new();
-    let mut ws = Workspace::new();
+    let mut runner = Runner::new();
     let mut failed = 0;
     for grp in group(&a.images) {
-        if let Err(e) = run_group(
-            &grp,
-            &a,
-            &p,
-            camera.as_ref(),
-            ambient.as_ref(),
-            &mut maps,
-            &mut ws,
-        ) {
+        if let Err(e) = run_group(&grp, &a, &p, camera, &rule, ambient.as_ref(), &mut runner) {
             if super::is_broken_pipe(&e) {
                 return Err(e);
             }
-            eprintln!("vss: error: {}: {e:#}", grp.stem);
+            errln!("vss: error: {}: {e:#}", grp.stem);
             failed += 1;
         }
     }
@@ -176,15 +188,14 @@ fn out_path(a: &Args, dir: &Path, name: &str) -> PathBuf {
     a.out.as_deref().unwrap_or(dir).join(name)
 }
 
-#[allow(clippy::too_many_arguments)]
 fn run_group(
     grp: &Group,
     a: &Args,
     p: &Params,
-    camera: Option<&CameraModel>,
-    ambient: Option<&GreyImage>,
-    maps: &mut HashMap<(usize, usize), LensMap>,
-    ws: &mut Workspace,
+    camera: Option<CameraModel>,
+    rule: &FrameRule,
+    ambient: Option<&(PathBuf, GreyImage)>,
+    runner: &mut Runner,
 ) -> anyhow::Result<()> {
     let files: Vec<ImgFile> = grp
         .files
@@ -203,33 +214,50 @@ fn run_group(
             .check_stage_size()
             .with_context(|| path.display().to_string())?;
     }
-    let images: Vec<GreyImage> = files.iter().map(|f| f.image.clone()).collect();
-    let size = images.first().map(GreyImage::size).unwrap_or_default();
-    if let (Some(m), Some(cdf_path)) = (camera, &a.cdf) {
-        if !maps.contains_key(&size) {
-            cdf::check_camera_area(m, size.0, size.1, cdf_path)?;
-        }
+    // Files without a lighting letter come one to a group: any key will do.
+    let keys: Vec<char> = grp.letters.iter().map(|l| l.unwrap_or('a')).collect();
+    let mut input = rule
+        .split(
+            keys.iter()
+                .copied()
+                .zip(files.iter().map(|f| f.image.clone())),
+        )
+        .with_camera(camera);
+    if let Some((_, img)) = ambient {
+        input.ambient = Some(('-', img.clone()));
     }
-    let map = camera.map(|m| {
-        &*maps
-            .entry(size)
-            .or_insert_with(|| LensMap::new(m, size.0, size.1))
-    });
-    let input = Input {
-        images: &images,
-        ambient,
-        lens: map,
+    // Which file each lit image came from, and the ambient one's.
+    let file_of = |key: char| keys.iter().position(|k| *k == key);
+    let lit: Vec<usize> = input.letters.iter().filter_map(|l| file_of(*l)).collect();
+    let ambient_file = match ambient {
+        Some((path, _)) => Some(path.clone()),
+        None => input
+            .ambient
+            .as_ref()
+            .and_then(|(l, _)| file_of(*l))
+            .map(|i| grp.files[i].clone()),
     };
+    let size = input.size();
+    if let (Some(m), Some(cdf_path)) = (camera.as_ref(), &a.cdf) {
+        cdf::check_camera_area(m, size.0, size.1, cdf_path)?;
+    }
     let proposal = match &a.auto {
-        Some(t) => Some(auto::search(&input, p, t)?),
+        Some(t) => {
+            let map = runner.lens_map(&input, p)?;
+            Some(auto::search(&input.input(map.as_deref()), p, t)?)
+        }
         None => None,
     };
-    let out = ws.run(&input, proposal.as_ref().map_or(p, |r| &r.params))?;
+    let out = runner.run(
+        &input,
+        Stage::Lens,
+        proposal.as_ref().map_or(p, |r| &r.params),
+    )?;
     let mut written = Vec::new();
     if camera.is_some() {
-        // The corrected images (the inputs themselves when the map is the
-        // identity or correction is switched off).
-        for (k, (path, f)) in grp.files.iter().zip(&files).enumerate() {
+        // The corrected images of the lit frames (the inputs themselves when
+        // the map is the identity or correction is switched off).
+        for (k, (path, f)) in lit.iter().map(|&i| (&grp.files[i], &files[i])).enumerate() {
             let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
             let target = out_path(a, &grp.dir, &format!("{}.imc", stem.unwrap_or_default()));
             let image = out.corrected.get(k).unwrap_or(&f.image).clone();
@@ -253,6 +281,7 @@ fn run_group(
         a,
         &grp.stem,
         &grp.files,
+        ambient_file.as_deref(),
         size,
         out,
         &written,
@@ -286,22 +315,26 @@ fn write_outputs(
 }
 
 fn from_edges(hpo: &Path, vpo: &Path, a: &Args, p: &Params) -> anyhow::Result<()> {
-    let eh = edgefile::read_edges(hpo)?;
-    let ev = edgefile::read_edges(vpo)?;
-    let out = lines_from_edges(eh, ev, p);
+    let saved = Saved::Edges {
+        h: edgefile::read_edges(hpo)?,
+        v: edgefile::read_edges(vpo)?,
+    };
+    let mut runner = Runner::new();
+    let out = runner.run_saved(saved, p);
     let stem = hpo
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "edges".to_string());
     let dir = hpo.parent().map(Path::to_path_buf).unwrap_or_default();
-    let written = write_outputs(a, &dir, &stem, &out, false)?;
+    let written = write_outputs(a, &dir, &stem, out, false)?;
     let size = (out.edges_h.width, out.edges_h.height);
     report(
         a,
         &stem,
         &[hpo.to_path_buf(), vpo.to_path_buf()],
+        None,
         size,
-        &out,
+        out,
         &written,
         None,
     )?;
@@ -337,10 +370,12 @@ fn auto_json(r: &AutoResult) -> serde_json::Value {
 }
 
 /// Prints what one input gave: text, or one JSON object per line.
+#[allow(clippy::too_many_arguments)]
 fn report(
     a: &Args,
     stem: &str,
     files: &[PathBuf],
+    ambient: Option<&Path>,
     size: (usize, usize),
     out: &StageOutputs,
     written: &[PathBuf],
@@ -366,6 +401,7 @@ fn report(
             "timings_us": {"lens": t.lens_us, "edges": t.edges_us, "lines": t.lines_us, "connect": t.connect_us},
             "line_attributes": attrs,
             "written": written.iter().map(shown).collect::<Vec<_>>(),
+            "ambient": ambient.map(|p| shown(&p.to_path_buf())),
         });
         if let (Some(r), Some(obj)) = (proposal, v.as_object_mut()) {
             obj.insert("auto".to_string(), auto_json(r));
@@ -380,6 +416,12 @@ fn report(
         size.0,
         size.1
     );
+    if let Some(amb) = ambient {
+        outln!(
+            "  ambient      {} (subtracted from the others)",
+            shown(&amb.to_path_buf())
+        );
+    }
     outln!(
         "  edge points  H {:>6}   V {:>6}",
         out.edges_h.points.len(),

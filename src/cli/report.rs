@@ -11,7 +11,7 @@ use super::Global;
 use crate::formats;
 use crate::fsutil::write_atomic;
 use crate::llv::GreyImage;
-use crate::report::{ImageReport, ps, svg};
+use crate::report::{ps, survey, svg};
 use crate::session::Session;
 
 #[derive(Debug, clap::Args)]
@@ -143,7 +143,7 @@ fn grey_report(a: &Args) -> anyhow::Result<ExitCode> {
             let path = if images.len() == 1 {
                 p.clone()
             } else {
-                numbered(p, i as u32 + 1)
+                survey::numbered(p, i as u32 + 1)
             };
             write(&path, &svg::grey_svg(name, img))?;
         }
@@ -151,54 +151,21 @@ fn grey_report(a: &Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// `out.svg` → `out3.svg`.
-fn numbered(p: &Path, k: u32) -> PathBuf {
-    let stem = p
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let ext = p
-        .extension()
-        .map(|e| e.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "svg".into());
-    p.with_file_name(format!("{stem}{k}.{ext}"))
-}
-
 fn session_report(dir: &Path, a: &Args) -> anyhow::Result<ExitCode> {
     let s = Session::inspect(dir)?;
-    let reports: Vec<ImageReport> = match a.image {
-        Some(k) => vec![s.image_report(k)?],
-        None => s.reports()?,
-    };
-    if reports.is_empty() {
-        eprintln!("vss: note: session {} has no images yet", s.name());
+    if s.manifest().image.is_empty() {
+        errln!("vss: note: session {} has no images yet", s.name());
     }
-    let title = match a.image {
-        Some(k) => format!("survey {} image {k}", s.name()),
-        None => format!("survey {}", s.name()),
+    let targets = survey::Targets {
+        ps: a.ps.clone().or_else(|| {
+            a.svg
+                .is_none()
+                .then(|| PathBuf::from(format!("{}.ps", s.name())))
+        }),
+        svg: a.svg.clone(),
     };
-    let ps_path = a.ps.clone().or_else(|| {
-        a.svg
-            .is_none()
-            .then(|| PathBuf::from(format!("{}.ps", s.name())))
-    });
-    if let Some(p) = ps_path {
-        write(&p, &ps::survey_report(&title, &reports))?;
-    }
-    if let Some(p) = &a.svg {
-        for r in &reports {
-            let path = if reports.len() == 1 {
-                p.clone()
-            } else {
-                let k = r
-                    .title
-                    .trim_start_matches(s.name().as_str())
-                    .parse()
-                    .unwrap_or(0);
-                numbered(p, k)
-            };
-            write(&path, &svg::image_svg(r))?;
-        }
+    for p in survey::write(&s, a.image, &targets)? {
+        outln!("wrote {}", p.display());
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -212,13 +179,5 @@ mod tests {
         assert_eq!(parse_size("640x480").unwrap(), (640, 480));
         assert!(parse_size("640").unwrap_err().to_string().contains("WxH"));
         assert!(parse_size("0x5").is_err());
-    }
-
-    #[test]
-    fn numbered_inserts_the_image_number() {
-        assert_eq!(
-            numbered(Path::new("/t/out.svg"), 3),
-            Path::new("/t/out3.svg")
-        );
     }
 }

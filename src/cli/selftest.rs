@@ -1,20 +1,46 @@
-//! `vss selftest`: renders synthetic scenes with known edges, runs the LLV
-//! pipeline with the profile's parameters and prints, per noise level,
-//! recall, precision, endpoint distances and angle error — with subpixel edge
-//! positions and with whole-pixel ones — and a lens-correction check.
+//! `vss selftest`: renders the two families of synthetic scenes with known
+//! edges (cubes: polyhedra under point lights; yard: layered welding-yard
+//! parts, `llv::synth::yard`), runs the LLV pipeline with the profile's
+//! parameters and prints, per family and noise level, recall, precision, F,
+//! endpoint distances, angle error and the breakdowns of the scorer — for
+//! the cubes also with whole-pixel positions — and a lens check per family.
+//!
+//! `--export DIR` writes the same images, their truth and vss's segments
+//! and times for other detectors to run on; `--score DIR` scores every
+//! detector found there with the same scorer (`llv::synth::compare`).
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
 
 use super::Global;
+use crate::llv::synth::compare::{self, ExportConfig};
+use crate::llv::synth::eval::yard::{Level, YardConfig, YardReport, evaluate_yard};
 use crate::llv::synth::eval::{EvalConfig, EvalReport, evaluate};
+
+mod tables;
+
+pub use tables::{compare_table, table, yard_table};
+
+/// Which family of scenes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Family {
+    Cubes,
+    Yard,
+    All,
+}
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Noise levels σ (grey levels), comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "2,5,10")]
-    pub noise: Vec<f64>,
+    /// Family of scenes: cubes (polyhedra), yard (welding-yard parts) or all.
+    #[arg(long, value_enum, default_value = "all")]
+    pub family: Family,
+    /// Noise levels σ (grey levels), comma-separated; `sd` is the yard's
+    /// signal-dependent noise. Default: 2,5,10 for the cubes, 0,2,5,10,sd
+    /// for the yard.
+    #[arg(long, value_delimiter = ',')]
+    pub noise: Option<Vec<Level>>,
     /// Seed of the scenes and the noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -24,12 +50,66 @@ pub struct Args {
     /// Image width and height (px).
     #[arg(long, default_value_t = 512)]
     pub size: usize,
+    /// Write the images, truth and vss's segments and times to DIR instead
+    /// of printing scores (for benches/opencv_lines.py).
+    #[arg(long, value_name = "DIR", conflicts_with = "score")]
+    pub export: Option<PathBuf>,
+    /// Timed runs of vss per image with --export.
+    #[arg(long, default_value_t = 20)]
+    pub runs: usize,
+    /// Score every detector's segments in DIR (made by --export) instead of
+    /// running the pipeline.
+    #[arg(long, value_name = "DIR")]
+    pub score: Option<PathBuf>,
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
 }
 
+fn configs(a: &Args) -> (Option<EvalConfig>, Option<YardConfig>) {
+    let cubes = matches!(a.family, Family::Cubes | Family::All).then(|| {
+        let noise = match &a.noise {
+            Some(levels) => levels
+                .iter()
+                .filter_map(|l| match l {
+                    Level::Sigma(s) => Some(*s),
+                    Level::Signal => None,
+                })
+                .collect(),
+            None => EvalConfig::default().noise,
+        };
+        EvalConfig {
+            noise,
+            scenes: a.scenes,
+            size: a.size,
+            seed: a.seed,
+            ..Default::default()
+        }
+    });
+    let yard = matches!(a.family, Family::Yard | Family::All).then(|| {
+        let d = YardConfig::default();
+        YardConfig {
+            noise: a.noise.clone().unwrap_or(d.noise),
+            scenes: a.scenes,
+            size: a.size,
+            seed: a.seed,
+            ..d
+        }
+    });
+    // A cube run left with no level (only `sd` asked for) is no run.
+    (cubes.filter(|c| !c.noise.is_empty()), yard)
+}
+
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
+    if let Some(dir) = &a.score {
+        let scores = compare::score_dir(dir)?;
+        if a.json {
+            outln!("{}", serde_json::to_string(&scores)?);
+        } else {
+            out!("{}", compare_table(&scores));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
     if a.size < 64 {
         anyhow::bail!(
             "--size {} is too small: the scenes need at least 64 px",
@@ -39,110 +119,57 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     if a.scenes == 0 {
         anyhow::bail!("--scenes must be at least 1");
     }
-    if let Some(n) = a.noise.iter().find(|n| !(n.is_finite() && **n >= 0.0)) {
-        anyhow::bail!("--noise {n} is not a noise level (σ ≥ 0 grey levels)");
-    }
     let profile = g.load_profile()?;
-    let cfg = EvalConfig {
-        noise: a.noise,
-        scenes: a.scenes,
-        size: a.size,
-        seed: a.seed,
-        ..Default::default()
-    };
-    let report = evaluate(&cfg, &profile.llv).context("running the pipeline on the scenes")?;
-    if a.json {
-        outln!("{}", serde_json::to_string(&report)?);
-    } else {
-        out!(
-            "{}",
-            table(&report, g.profile.as_deref().unwrap_or("default"))
-        );
-    }
-    Ok(ExitCode::SUCCESS)
-}
-
-/// The report as a table for people.
-pub fn table(r: &EvalReport, profile: &str) -> String {
-    use std::fmt::Write;
-    let c = &r.config;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "{} scenes of {}×{} px, blur σ = {}, seed {}, profile {profile}; true edges: contrast ≥ {} grey levels",
-        c.scenes, c.size, c.size, c.blur, c.seed, c.min_contrast
-    );
-    let _ = writeln!(
-        s,
-        "{:>6}  {:<11} {:>6} {:>9} {:>6}  {:>13}  {:>9}  {:>6} {:>6}",
-        "noise",
-        "positions",
-        "recall",
-        "precision",
-        "F",
-        "endpoint px",
-        "angle °",
-        "points",
-        "lines"
-    );
-    for l in &r.levels {
-        for (name, m) in [("subpixel", &l.subpixel), ("whole-pixel", &l.whole_pixel)] {
-            let _ = writeln!(
-                s,
-                "{:>6}  {:<11} {:>6.3} {:>9.3} {:>6.3}  {:>6.3} / {:<5.3}  {:>9.3}  {:>6.0} {:>6.1}",
-                l.noise,
-                name,
-                m.recall,
-                m.precision,
-                m.f_score(),
-                m.endpoint_mean,
-                m.endpoint_p95,
-                m.angle_mean_deg,
-                l.edge_points,
-                l.lines
+    let (cubes, yard) = configs(&a);
+    let name = g.profile.as_deref().unwrap_or("default");
+    if let Some(dir) = &a.export {
+        let cfg = ExportConfig {
+            cubes,
+            yard,
+            runs: a.runs,
+        };
+        let m = compare::export(dir, &cfg, &profile.llv)
+            .with_context(|| format!("exporting the scenes to {}", dir.display()))?;
+        for f in &m.families {
+            outln!(
+                "{}: {} scenes of {}×{} px at noise {} written to {}",
+                f.name,
+                f.scenes,
+                f.size,
+                f.size,
+                f.levels.join(", "),
+                dir.join(&f.name).display()
             );
         }
+        return Ok(ExitCode::SUCCESS);
     }
-    for l in &r.levels {
-        let _ = writeln!(
-            s,
-            "noise {}: edge points lie {:.3} px (RMS) from their true edges with subpixel positions, {:.3} px with whole pixels",
-            l.noise, l.point_rms_subpixel, l.point_rms_whole_pixel
-        );
+    let cube_report: Option<EvalReport> = cubes
+        .map(|c| evaluate(&c, &profile.llv))
+        .transpose()
+        .context("running the pipeline on the cube scenes")?;
+    let yard_report: Option<YardReport> = yard
+        .map(|y| evaluate_yard(&y, &profile.llv))
+        .transpose()
+        .context("running the pipeline on the yard scenes")?;
+    if a.json {
+        let mut v = match &cube_report {
+            Some(r) => serde_json::to_value(r)?,
+            None => serde_json::json!({}),
+        };
+        if let (Some(y), Some(obj)) = (&yard_report, v.as_object_mut()) {
+            obj.insert("yard".into(), serde_json::to_value(y)?);
+        }
+        outln!("{}", serde_json::to_string(&v)?);
+    } else {
+        if let Some(r) = &cube_report {
+            out!("{}", table(r, name));
+        }
+        if let Some(y) = &yard_report {
+            if cube_report.is_some() {
+                outln!();
+            }
+            out!("{}", yard_table(y, name));
+        }
     }
-    let lr = &r.lens;
-    let rel = if lr.residual_undistorted > 0.0 {
-        100.0 * (lr.residual_corrected / lr.residual_undistorted - 1.0)
-    } else {
-        0.0
-    };
-    let _ = writeln!(
-        s,
-        "lens (noise σ = {}): mean line-fit residual {:.4} px undistorted, {:.4} px distorted, {:.4} px corrected ({:+.1} %)",
-        c.lens_noise, lr.residual_undistorted, lr.residual_distorted, lr.residual_corrected, rel
-    );
-    let srel = if lr.straightness_undistorted > 0.0 {
-        100.0 * (lr.straightness_corrected / lr.straightness_undistorted - 1.0)
-    } else {
-        0.0
-    };
-    let _ = writeln!(
-        s,
-        "lens (distortion ×{}): edge-point straightness {:.4} px undistorted, {:.4} px distorted, {:.4} px corrected ({:+.1} %, {} edges)",
-        c.lens_scale,
-        lr.straightness_undistorted,
-        lr.straightness_distorted,
-        lr.straightness_corrected,
-        srel,
-        lr.straightness_edges
-    );
-    let _ = writeln!(
-        s,
-        "lens: endpoint mean {:.3} px and angle {:.3}° corrected, {:.3} px and {:.3}° uncorrected",
-        lr.corrected.endpoint_mean,
-        lr.corrected.angle_mean_deg,
-        lr.uncorrected.endpoint_mean,
-        lr.uncorrected.angle_mean_deg
-    );
-    s
+    Ok(ExitCode::SUCCESS)
 }

@@ -28,6 +28,14 @@ pub struct Args {
     /// seconds (on a new pseudo-terminal; `--link` follows it).
     #[arg(long, value_name = "SECONDS")]
     pub replug_after: Option<f64>,
+    /// What the cameras see: the cell (`scene`), a calibration plate held at
+    /// a new pose for every freeze (`plate`), or lying at its place in the
+    /// cell (`plate-placed`).
+    #[arg(long, value_name = "TARGET", default_value = "scene", value_parser = ["scene", "plate", "plate-placed"])]
+    pub target: String,
+    /// The calibration plate for --target (a name from profiles/plates/ or a file).
+    #[arg(long, value_name = "PLATE", default_value = "squares")]
+    pub plate: String,
 }
 
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
@@ -42,6 +50,22 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             .context("cannot install the Ctrl-C handler")?;
     }
     let mut sim = SimCell::from_profile(&profile, faults)?;
+    let mode = match a.target.as_str() {
+        "plate" => Some(crate::rig::sim::plate::Mode::Held),
+        "plate-placed" => Some(crate::rig::sim::plate::Mode::Placed),
+        _ => None,
+    };
+    if let Some(mode) = mode {
+        let plate = crate::calib::Plate::load(&a.plate)?;
+        if mode == crate::rig::sim::plate::Mode::Placed && plate.place.is_none() {
+            anyhow::bail!(
+                "plate {}: no [place] in its file, so it cannot lie at its place",
+                plate.name
+            );
+        }
+        sim.scene()
+            .set_target(Some(crate::rig::sim::plate::PlateTarget { plate, mode }));
+    }
     if let Some(link) = &a.link {
         sim.link_grabber(link)?;
     }

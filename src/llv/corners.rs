@@ -24,7 +24,7 @@
 //!    distance the two endpoints move (then by index, so the result is
 //!    deterministic); each endpoint moves at most once.
 //!
-//! Measured on twelve noisy synthetic scenes (`tests/issue6_corners.rs`,
+//! Measured on twelve noisy synthetic scenes (`tests/it/llv_corners.rs`,
 //! with a stray-point check in the line extractor): with a radius of 5 px
 //! the mean distance of endpoints near corners from the true corner falls
 //! from 2.63 px to 2.19 px while precision and recall rise slightly; 8 px

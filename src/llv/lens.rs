@@ -56,6 +56,29 @@ impl CameraModel {
         (du, dv)
     }
 
+    /// The derivatives of [`delta`](Self::delta) at `(u, v)`: by `(u, v)`
+    /// (`[[∂δu/∂u, ∂δu/∂v], [∂δv/∂u, ∂δv/∂v]]`) and by the coefficients
+    /// `(k1, g1, g2, g3, g4)`, for the calibration's solver (`crate::calib`).
+    pub fn delta_derivatives(&self, u: f64, v: f64) -> ([[f64; 2]; 2], [[f64; 5]; 2]) {
+        let [k1, g1, g2, g3, g4] = self.distortion.unwrap_or([0.0; 5]);
+        let r2 = u * u + v * v;
+        let by_uv = [
+            [
+                2.0 * (g1 + g3) * u + g4 * v + k1 * (r2 + 2.0 * u * u),
+                g4 * u + 2.0 * g1 * v + 2.0 * k1 * u * v,
+            ],
+            [
+                2.0 * g2 * u + g3 * v + 2.0 * k1 * u * v,
+                g3 * u + 2.0 * (g2 + g4) * v + k1 * (r2 + 2.0 * v * v),
+            ],
+        ];
+        let by_d = [
+            [u * r2, r2, 0.0, u * u, u * v],
+            [v * r2, 0.0, r2, u * v, v * v],
+        ];
+        (by_uv, by_d)
+    }
+
     /// Where an ideal (undistorted) pixel position was observed: three
     /// fixed-point steps of `ud = u + δu(ud, vd)` (lens.md, Resampling).
     pub fn ideal_to_observed(&self, x: f64, y: f64) -> (f64, f64) {

@@ -14,10 +14,12 @@ use serde::Serialize;
 
 use super::connect::{ConnectScratch, connect_into};
 use super::corners::{CornerScratch, close_corners_with};
-use super::edges::{PeakScratch, Response, ResponseScratch, exact_response_into, peaks_into};
+use super::edges::{
+    NoiseMap, PeakMap, PeakScratch, Response, ResponseScratch, detect_into, exact_response_into,
+};
 use super::image::GreyImage;
 use super::lens::{LensMap, correct_into};
-use super::lines::{LineScratch, extract_into};
+use super::lines::{LineScratch, extract_into, track_into};
 use super::params::{Params, Stage};
 use super::photometric::{PhotoScratch, combined_response_into};
 use super::{EdgePoints, LlvError, ScanDir, Segment};
@@ -47,6 +49,9 @@ pub struct StageOutputs {
     pub corrected: Vec<GreyImage>,
     pub response_h: Response,
     pub response_v: Response,
+    /// The noise scale of each response, per tile (`edges/noise.rs`).
+    pub noise_h: NoiseMap,
+    pub noise_v: NoiseMap,
     pub edges_h: EdgePoints,
     pub edges_v: EdgePoints,
     /// Extracted lines: those of `edges_h` first, then those of `edges_v`.
@@ -78,15 +83,24 @@ impl<'a> Input<'a> {
     }
 }
 
+/// A saved stage result to run the later stages from ([`Workspace::run_saved`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Saved {
+    /// Edge points of both scan directions: line extraction and CONNECT run.
+    Edges { h: EdgePoints, v: EdgePoints },
+    /// Extracted lines (a `.lex`): CONNECT runs.
+    Lines(Vec<Segment>),
+}
+
 /// Reusable buffers for the whole pipeline, and the outputs of the last run.
 #[derive(Clone, Debug, Default)]
 pub struct Workspace {
     out: StageOutputs,
     ambient_corrected: GreyImage,
-    response: ResponseScratch,
-    /// Buffers of the several-lightings combination (llv.md §2.6).
-    photo: PhotoScratch,
-    peaks: PeakScratch,
+    /// Each scan direction's buffers.
+    dir_h: DirScratch,
+    dir_v: DirScratch,
+    /// Line extraction from edge points alone.
     lines: LineScratch,
     connect: ConnectScratch,
     tmp: Vec<Segment>,
@@ -143,9 +157,14 @@ impl Workspace {
         p: &Params,
     ) -> Result<&StageOutputs, LlvError> {
         let size = check_input(input)?;
-        // The kernel checks the half-width (`edges::check_half_width`).
-        let a = p.edges.half_width as usize;
+        // The responses of a lens-corrected run with an ambient image are made
+        // from the corrected ambient, which a workspace built from earlier
+        // outputs alone (`with_outputs`) does not have: it corrects again.
+        let ambient_ready = input.ambient.is_none()
+            || self.out.corrected.is_empty()
+            || self.ambient_corrected.size() == size;
         let prev_fits = self.valid
+            && ambient_ready
             && self.out.edges_h.width == size.0
             && self.out.edges_h.height == size.1
             && self.out.response_h.covers(size.0, size.1);
@@ -159,59 +178,141 @@ impl Workspace {
             self.lens(input, p)?;
             self.out.timings.lens_us = micros(t);
         }
-        if from <= Stage::Edges {
-            let t = Instant::now();
-            let same_response = from == Stage::Edges
+        if from <= Stage::Lines {
+            let same_response = from >= Stage::Edges
                 && prev_params.edges.half_width == p.edges.half_width
                 && prev_params.edges.noise_factor == p.edges.noise_factor;
-            if !same_response {
-                self.responses(input, a)?;
+            let job = Job {
+                from,
+                response: !same_response,
+                params: p,
+            };
+            let StageOutputs {
+                corrected,
+                response_h,
+                response_v,
+                noise_h,
+                noise_v,
+                edges_h,
+                edges_v,
+                lines_raw,
+                timings,
+                ..
+            } = &mut self.out;
+            let lensed = !corrected.is_empty();
+            let images: &[GreyImage] = if lensed { corrected } else { input.images };
+            let ambient = if lensed {
+                input.ambient.map(|_| &self.ambient_corrected)
+            } else {
+                input.ambient
+            };
+            let h = DirOut {
+                dir: ScanDir::Horizontal,
+                response: response_h,
+                noise: noise_h,
+                edges: edges_h,
+                s: &mut self.dir_h,
+            };
+            let v = DirOut {
+                dir: ScanDir::Vertical,
+                response: response_v,
+                noise: noise_v,
+                edges: edges_v,
+                s: &mut self.dir_v,
+            };
+            let (th, tv) = if p.edges.threads >= 2 {
+                std::thread::scope(|sc| {
+                    let other = sc.spawn(|| job.run(images, ambient, v));
+                    let here = job.run(images, ambient, h);
+                    let there = other
+                        .join()
+                        .unwrap_or_else(|e| std::panic::resume_unwind(e));
+                    Ok::<_, LlvError>((here?, there?))
+                })?
+            } else {
+                (job.run(images, ambient, h)?, job.run(images, ambient, v)?)
+            };
+            // With two threads a stage takes as long as its slower direction.
+            let both = |a: u64, b: u64| {
+                if p.edges.threads >= 2 {
+                    a.max(b)
+                } else {
+                    a + b
+                }
+            };
+            if from <= Stage::Edges {
+                timings.edges_us = both(th.0, tv.0);
             }
-            peaks_into(
-                &self.out.response_h,
-                &p.edges,
-                &mut self.out.edges_h,
-                &mut self.peaks,
-            );
-            peaks_into(
-                &self.out.response_v,
-                &p.edges,
-                &mut self.out.edges_v,
-                &mut self.peaks,
-            );
-            self.out.timings.edges_us = micros(t);
+            timings.lines_us = both(th.1, tv.1);
+            lines_raw.clear();
+            lines_raw.extend_from_slice(&self.dir_h.segs);
+            lines_raw.extend_from_slice(&self.dir_v.segs);
         }
-        if from <= Stage::Lines {
-            let t = Instant::now();
-            extract_into(
-                &self.out.edges_h,
-                &p.lines,
-                &mut self.out.lines_raw,
-                &mut self.lines,
-            );
-            extract_into(&self.out.edges_v, &p.lines, &mut self.tmp, &mut self.lines);
-            self.out.lines_raw.extend_from_slice(&self.tmp);
-            self.out.timings.lines_us = micros(t);
-        }
-        {
-            let t = Instant::now();
-            connect_into(
-                &self.out.lines_raw,
-                &p.connect,
-                &mut self.out.lines,
-                &mut self.connect,
-            );
-            if p.connect.corner_radius > 0.0 {
-                close_corners_with(
-                    &mut self.out.lines,
-                    p.connect.corner_radius,
-                    &mut self.corners,
-                );
-            }
-            self.out.timings.connect_us = micros(t);
-        }
+        self.connect_lines(p);
         self.valid = true;
         Ok(&self.out)
+    }
+
+    /// Runs the stages after a saved result (`vss llv --from-edges`, `vss
+    /// session redo --from lines|connect`): line extraction and CONNECT from
+    /// edge points, or CONNECT alone from extracted lines. The outputs have no
+    /// images or responses (nor edge points, from lines), so a later
+    /// [`Workspace::rerun`] runs every stage.
+    pub fn run_saved(&mut self, saved: Saved, p: &Params) -> &StageOutputs {
+        self.valid = false;
+        self.out.corrected.clear();
+        self.out.response_h = Response::default();
+        self.out.response_v = Response::default();
+        self.out.noise_h = NoiseMap::default();
+        self.out.noise_v = NoiseMap::default();
+        self.out.params = p.clone();
+        self.out.timings = Timings::default();
+        match saved {
+            Saved::Edges { h, v } => {
+                self.out.edges_h = h;
+                self.out.edges_v = v;
+                self.extract_lines(p);
+            }
+            Saved::Lines(raw) => {
+                self.out.edges_h = EdgePoints::default();
+                self.out.edges_v = EdgePoints::default();
+                self.out.lines_raw = raw;
+            }
+        }
+        self.connect_lines(p);
+        &self.out
+    }
+
+    /// Line extraction from edge points alone.
+    fn extract_lines(&mut self, p: &Params) {
+        let t = Instant::now();
+        extract_into(
+            &self.out.edges_h,
+            &p.lines,
+            &mut self.out.lines_raw,
+            &mut self.lines,
+        );
+        extract_into(&self.out.edges_v, &p.lines, &mut self.tmp, &mut self.lines);
+        self.out.lines_raw.extend_from_slice(&self.tmp);
+        self.out.timings.lines_us = micros(t);
+    }
+
+    fn connect_lines(&mut self, p: &Params) {
+        let t = Instant::now();
+        connect_into(
+            &self.out.lines_raw,
+            &p.connect,
+            &mut self.out.lines,
+            &mut self.connect,
+        );
+        if p.connect.corner_radius > 0.0 {
+            close_corners_with(
+                &mut self.out.lines,
+                p.connect.corner_radius,
+                &mut self.corners,
+            );
+        }
+        self.out.timings.connect_us = micros(t);
     }
 
     fn lens(&mut self, input: &Input, p: &Params) -> Result<(), LlvError> {
@@ -231,45 +332,94 @@ impl Workspace {
         }
         Ok(())
     }
+}
 
-    fn responses(&mut self, input: &Input, a: usize) -> Result<(), LlvError> {
-        let lensed = !self.out.corrected.is_empty();
-        let images: &[GreyImage] = if lensed {
-            &self.out.corrected
-        } else {
-            input.images
-        };
-        let ambient = if lensed {
-            input.ambient.map(|_| &self.ambient_corrected)
-        } else {
-            input.ambient
-        };
-        if images.len() == 1 && ambient.is_none() {
-            let img = &images[0];
-            exact_response_into(
-                img,
-                ScanDir::Horizontal,
-                a,
-                &mut self.out.response_h,
-                &mut self.response,
-            )?;
-            exact_response_into(
-                img,
-                ScanDir::Vertical,
-                a,
-                &mut self.out.response_v,
-                &mut self.response,
-            )?;
-        } else {
-            let ep = &self.out.params.edges;
-            for (dir, out) in [
-                (ScanDir::Horizontal, &mut self.out.response_h),
-                (ScanDir::Vertical, &mut self.out.response_v),
-            ] {
-                combined_response_into(images, ambient, dir, ep, out, &mut self.photo)?;
+/// One scan direction's buffers: the response, the several-lightings
+/// combination, the edge points and the line extractor each keep theirs,
+/// so that the two directions can run on two threads.
+#[derive(Clone, Debug, Default)]
+struct DirScratch {
+    response: ResponseScratch,
+    photo: PhotoScratch,
+    peaks: PeakScratch,
+    /// The peaks the edge points and the line extractor are taken from.
+    map: PeakMap,
+    lines: LineScratch,
+    /// The direction's extracted lines.
+    segs: Vec<Segment>,
+}
+
+/// One scan direction's outputs and buffers.
+struct DirOut<'a> {
+    dir: ScanDir,
+    response: &'a mut Response,
+    noise: &'a mut NoiseMap,
+    edges: &'a mut EdgePoints,
+    s: &'a mut DirScratch,
+}
+
+/// What a run does in each scan direction: from the edges (the response
+/// too, unless it can be kept) or from the lines on.
+#[derive(Clone, Copy)]
+struct Job<'p> {
+    from: Stage,
+    response: bool,
+    params: &'p Params,
+}
+
+impl Job<'_> {
+    /// Runs one direction; returns the microseconds of its edge stage and
+    /// of its line extraction.
+    fn run(
+        &self,
+        images: &[GreyImage],
+        ambient: Option<&GreyImage>,
+        o: DirOut,
+    ) -> Result<(u64, u64), LlvError> {
+        let p = self.params;
+        let mut edges_us = 0;
+        if self.from <= Stage::Edges {
+            let t = Instant::now();
+            if self.response {
+                let a = p.edges.half_width as usize;
+                match (images, ambient) {
+                    ([img], None) => {
+                        exact_response_into(img, o.dir, a, o.response, &mut o.s.response)?
+                    }
+                    _ => combined_response_into(
+                        images,
+                        ambient,
+                        o.dir,
+                        &p.edges,
+                        o.response,
+                        &mut o.s.photo,
+                    )?,
+                }
             }
+            detect_into(
+                o.response,
+                &p.edges,
+                p.lines.track_sigmas,
+                o.noise,
+                &mut o.s.map,
+                o.edges,
+                &mut o.s.peaks,
+            );
+            edges_us = micros(t);
         }
-        Ok(())
+        let t = Instant::now();
+        track_into(
+            o.response,
+            o.noise,
+            &o.s.map,
+            o.edges,
+            p.edges.floor,
+            p.edges.half_width as usize,
+            &p.lines,
+            &mut o.s.segs,
+            &mut o.s.lines,
+        );
+        Ok((edges_us, micros(t)))
     }
 }
 
@@ -320,30 +470,13 @@ fn check_input(input: &Input) -> Result<(usize, usize), LlvError> {
 /// --from-edges`): the outputs have no images or responses.
 pub fn lines_from_edges(edges_h: EdgePoints, edges_v: EdgePoints, p: &Params) -> StageOutputs {
     let mut ws = Workspace::new();
-    ws.out.edges_h = edges_h;
-    ws.out.edges_v = edges_v;
-    ws.out.params = p.clone();
-    let t = Instant::now();
-    extract_into(
-        &ws.out.edges_h,
-        &p.lines,
-        &mut ws.out.lines_raw,
-        &mut ws.lines,
+    ws.run_saved(
+        Saved::Edges {
+            h: edges_h,
+            v: edges_v,
+        },
+        p,
     );
-    extract_into(&ws.out.edges_v, &p.lines, &mut ws.tmp, &mut ws.lines);
-    ws.out.lines_raw.extend_from_slice(&ws.tmp);
-    ws.out.timings.lines_us = micros(t);
-    let t = Instant::now();
-    connect_into(
-        &ws.out.lines_raw,
-        &p.connect,
-        &mut ws.out.lines,
-        &mut ws.connect,
-    );
-    if p.connect.corner_radius > 0.0 {
-        close_corners_with(&mut ws.out.lines, p.connect.corner_radius, &mut ws.corners);
-    }
-    ws.out.timings.connect_us = micros(t);
     ws.take_outputs()
 }
 
@@ -423,6 +556,50 @@ mod tests {
         q.edges.per_region = 3;
         let again = rerun(first, Stage::Edges, &input, &q).unwrap();
         assert_eq!(again.edges_h, run(&input, &q).unwrap().edges_h);
+    }
+
+    /// Several lightings with an ambient image and lens correction: a
+    /// rerun from the edges (a new half-width) on earlier outputs once
+    /// failed on the missing corrected ambient ("image sizes differ: (96,
+    /// 80) and (0, 0)"); it now matches a full run, on fresh outputs and in
+    /// a workspace kept between runs.
+    #[test]
+    fn rerun_with_lens_and_ambient_matches_a_full_run() {
+        let imgs = [square(96, 80), square(96, 80)];
+        let ambient = GreyImage::filled(96, 80, 30).unwrap();
+        let model = crate::llv::lens::CameraModel {
+            cx: 48.0,
+            cy: 40.0,
+            sx: 0.01,
+            sy: 0.01,
+            f: 8.0,
+            distortion: Some([-0.02, 0.0, 0.0, 0.0, 0.0]),
+        };
+        let map = LensMap::new(&model, 96, 80);
+        let input = Input {
+            images: &imgs,
+            ambient: Some(&ambient),
+            lens: Some(&map),
+        };
+        let p = Params::default();
+        let first = run(&input, &p).unwrap();
+        assert!(!first.corrected.is_empty());
+        for change in [
+            |q: &mut Params| q.edges.half_width = 5,
+            |q: &mut Params| q.edges.noise_factor = 6.0,
+            |q: &mut Params| q.edges.per_region = 3,
+        ] {
+            let mut q = p.clone();
+            change(&mut q);
+            let full = run(&input, &q).unwrap();
+            let again = rerun(first.clone(), Stage::Edges, &input, &q).unwrap();
+            assert_eq!(again.lines, full.lines);
+            let mut ws = Workspace::new();
+            ws.run(&input, &p).unwrap();
+            let kept = ws.rerun(Stage::Edges, &input, &q).unwrap();
+            assert_eq!(kept.edges_h, full.edges_h);
+            assert_eq!(kept.lines, full.lines);
+        }
     }
 
     #[test]

@@ -1,10 +1,10 @@
-//! Synthetic scenes with known edges (issue 3): polyhedra (cube, box,
+//! Synthetic scenes with known edges: polyhedra (cube, box,
 //! L-bracket) on a floor plate, Lambertian faces under point lights plus
 //! ambient light, seen by pinhole cameras with Weng lens distortion; rendered
 //! with area sampling, blur and seeded noise; plus the true visible edges, the
 //! visible corners, and the scoring of detected lines against them.
 //!
-//! The simulated cell (issue 4), the accuracy tests and `vss selftest` all
+//! The simulated cell, the accuracy tests and `vss selftest` all
 //! draw their images from here. Everything is deterministic for a seed.
 //!
 //! Brightness model (grey levels, before blur, noise and clamping to 0–255):
@@ -13,6 +13,7 @@
 //! the distance to it. Cast shadows are not rendered (every light reaches
 //! every surface that faces it), so every image edge is a polygon edge.
 
+pub mod compare;
 pub mod eval;
 mod geom;
 mod raster;
@@ -22,6 +23,7 @@ mod scenes;
 mod score;
 pub mod straight;
 mod truth;
+pub mod yard;
 
 pub use geom::{Face, Polyhedron, V3, look_at};
 pub use render::{finish, render_exact};

@@ -1,13 +1,14 @@
 //! Changing a profile's LLV parameters in its own text, so the comments and
 //! layout a person wrote survive `vss params import … --out`: each changed
-//! value is replaced where it stands; a key the file lacks is added under its
-//! `[llv.<group>]` header (or in a new such table at the end). The result is
-//! parsed back and must load with exactly the asked parameters.
+//! value is replaced where it stands, with the comment beside it; a key the
+//! file lacks is added to its `[llv.<group>]` table (or to a new such table
+//! at the end). `toml_edit` keeps everything it does not touch as it was.
+//! The result is parsed back and must load with exactly the asked
+//! parameters.
 
-use std::ops::Range;
 use std::path::Path;
 
-use toml::de::{DeTable, DeValue};
+use toml_edit::{DocumentMut, Item, Table, Value};
 
 use super::{Profile, ProfileError};
 use crate::llv::Params;
@@ -15,95 +16,76 @@ use crate::llv::params::{Kind, PARAMS};
 
 /// The TOML text of a parameter value.
 pub fn toml_value(kind: Kind, v: f64) -> String {
-    match kind {
-        Kind::Bool => (v != 0.0).to_string(),
-        Kind::Int => format!("{}", v as i64),
-        // Debug keeps a `.0` or an exponent, so TOML reads a float.
-        Kind::Float => format!("{v:?}"),
-    }
+    value_of(kind, v).to_string().trim().to_string()
 }
 
-fn value_span(doc: &DeTable<'_>, group: &str, name: &str) -> Option<Range<usize>> {
-    let llv = doc.iter().find(|(k, _)| k.get_ref().as_ref() == "llv")?.1;
-    let DeValue::Table(llv) = llv.get_ref() else {
-        return None;
-    };
-    let g = llv.iter().find(|(k, _)| k.get_ref().as_ref() == group)?.1;
-    let DeValue::Table(g) = g.get_ref() else {
-        return None;
-    };
-    g.iter()
-        .find(|(k, _)| k.get_ref().as_ref() == name)
-        .map(|(_, v)| v.span())
+/// A parameter value as a TOML value of its kind.
+fn value_of(kind: Kind, v: f64) -> Value {
+    match kind {
+        Kind::Bool => Value::from(v != 0.0),
+        Kind::Int => Value::from(v as i64),
+        Kind::Float => Value::from(v),
+    }
 }
 
 /// `text` (a profile) with its `[llv.*]` values replaced by `params`.
 pub fn set_llv(text: &str, path: &Path, params: &Params) -> Result<String, ProfileError> {
-    let invalid = |line: usize, message: String| ProfileError::Invalid {
+    let invalid = |message: String| ProfileError::Invalid {
         path: path.to_path_buf(),
-        line,
+        line: 1,
         message,
     };
     let current = Profile::from_toml(text, path)?;
-    let doc = DeTable::parse(text)
-        .map_err(|e| invalid(1, format!("not valid TOML: {}", e.message().trim())))?;
-    let mut replace: Vec<(Range<usize>, String)> = Vec::new();
-    let mut missing: Vec<(&str, &str, String)> = Vec::new();
+    let mut doc: DocumentMut = text.parse().map_err(|e: toml_edit::TomlError| {
+        invalid(format!("not valid TOML: {}", e.message().trim()))
+    })?;
+    let cannot = || {
+        invalid(
+            "cannot place the new [llv] values in this file's layout; write the parameters to a new profile instead"
+                .into(),
+        )
+    };
     for sp in PARAMS {
         let (Some(old), Some(new)) = (current.llv.get(sp.key), params.get(sp.key)) else {
             continue;
         };
+        if old == new {
+            continue;
+        }
         let (group, name) = sp.key.split_once('.').unwrap_or(("", sp.key));
-        match value_span(doc.get_ref(), group, name) {
-            Some(r) if old != new => replace.push((r, toml_value(sp.kind, new))),
-            Some(_) => {}
-            None if old != new => missing.push((group, name, toml_value(sp.kind, new))),
-            None => {}
-        }
-    }
-    let mut out = text.to_string();
-    replace.sort_by_key(|(r, _)| std::cmp::Reverse(r.start));
-    for (r, v) in replace {
-        if out.get(r.clone()).is_some() {
-            out.replace_range(r, &v);
-        }
-    }
-    for (group, name, v) in missing {
-        let header = format!("[llv.{group}]");
-        let at = find_header_end(&out, &header);
-        match at {
-            Some(i) => out.insert_str(i, &format!("{name} = {v}\n")),
+        let llv = table_in(doc.as_table_mut(), "llv").ok_or_else(cannot)?;
+        let g = table_in(llv, group).ok_or_else(cannot)?;
+        let mut v = value_of(sp.kind, new);
+        match g.get_mut(name).and_then(Item::as_value_mut) {
+            Some(old) => {
+                // The new value takes the old one's spacing and comment.
+                *v.decor_mut() = old.decor().clone();
+                *old = v;
+            }
             None => {
-                if !out.ends_with('\n') && !out.is_empty() {
-                    out.push('\n');
-                }
-                out.push_str(&format!("\n{header}\n{name} = {v}\n"));
+                g.insert(name, Item::Value(v));
             }
         }
     }
+    let out = doc.to_string();
     let check = Profile::from_toml(&out, path)?;
     if check.llv != *params {
-        return Err(invalid(
-            1,
-            "cannot place the new [llv] values in this file's layout; write the parameters to a new profile instead".into(),
-        ));
+        return Err(cannot());
     }
     Ok(out)
 }
 
-/// Byte offset just after the line `header` (its trimmed text), if present.
-fn find_header_end(text: &str, header: &str) -> Option<usize> {
-    let mut off = 0;
-    for line in text.split_inclusive('\n') {
-        off += line.len();
-        if line.trim() == header {
-            if !line.ends_with('\n') {
-                return None;
-            }
-            return Some(off);
-        }
-    }
-    None
+/// The table `key` of `parent`, made (as a `[header]` table, implicit when
+/// it only holds tables) when the file lacks it; `None` when `key` holds
+/// something else.
+fn table_in<'a>(parent: &'a mut Table, key: &str) -> Option<&'a mut Table> {
+    let implicit = key == "llv";
+    let item = parent.entry(key).or_insert_with(|| {
+        let mut t = Table::new();
+        t.set_implicit(implicit);
+        Item::Table(t)
+    });
+    item.as_table_mut()
 }
 
 #[cfg(test)]
@@ -124,7 +106,8 @@ mod tests {
         assert!(out.contains("half_width = 5 # A\n"), "{out}");
         assert!(out.contains("# edges, tuned by hand"));
         assert!(out.contains("per_region = 12"));
-        assert!(out.contains("[llv.connect]\nwl = 7.25"));
+        assert!(out.contains("[llv.connect]\nwl = 7.25"), "{out}");
+        assert!(!out.contains("[llv]\n"), "no empty [llv] header: {out}");
         assert_eq!(
             Profile::from_toml(&out, Path::new("t.toml")).unwrap().llv,
             p

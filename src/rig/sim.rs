@@ -22,6 +22,7 @@ use crate::profile::Profile;
 
 mod board;
 pub mod faults;
+pub mod plate;
 pub mod render;
 mod vsg;
 
@@ -113,6 +114,8 @@ pub struct Scene {
     /// Noise-free frames per (camera, relay mask): rendering is costly,
     /// noise is cheap and drawn anew at every FREEZE.
     cache: Mutex<FrameCache>,
+    /// A calibration plate shown instead of the bare cell (`None`: the cell).
+    target: Mutex<Option<Arc<plate::PlateTarget>>>,
 }
 
 impl Scene {
@@ -121,6 +124,7 @@ impl Scene {
             opts,
             relays: Mutex::new(0),
             cache: Mutex::new(HashMap::new()),
+            target: Mutex::new(None),
         }
     }
 
@@ -160,9 +164,25 @@ impl Scene {
             .fold(0, |m, l| m | (1 << l.relay))
     }
 
+    /// Shows a calibration plate from the next freeze on (`None`: the cell).
+    pub fn set_target(&self, target: Option<plate::PlateTarget>) {
+        *self.target.lock().unwrap_or_else(PoisonError::into_inner) = target.map(Arc::new);
+    }
+
+    /// The calibration plate being shown, if any.
+    pub fn target(&self) -> Option<Arc<plate::PlateTarget>> {
+        self.target
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    }
+
     /// A digitised frame: the clean image plus seeded noise, as 8 bits.
     pub fn frame(&self, cam: u32, mask: u32, shot: u64) -> Vec<u8> {
-        let clean = self.clean(cam, mask);
+        let mut clean = self.clean(cam, mask);
+        if let Some(t) = self.target() {
+            clean = Arc::new(t.render(&self.opts, cam, shot, &clean));
+        }
         let mut rng = SplitMix64::new(
             self.opts.seed ^ shot.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ u64::from(cam) << 56,
         );

@@ -12,8 +12,9 @@ use crate::formats;
 use crate::formats::img::ImgFile;
 use crate::llv::{EdgePoints, GreyImage, Params, Segment};
 
-/// The outputs to save. `corrected[i]` belongs to the i-th captured
-/// lighting in letter order (the order of [`Session::load_images`]).
+/// The outputs to save. `corrected[i]` belongs to the i-th lit frame of
+/// the image, in the order of [`super::FrameRule::lit_letters`] (that of
+/// [`super::PipelineInput::images`]): the ambient frame has no `.imc`.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct OutputSet<'a> {
     pub corrected: &'a [GreyImage],
@@ -36,11 +37,12 @@ impl Session {
     ) -> Result<(), SessionError> {
         self.writable()?;
         super::check_image_number(k)?;
-        let letters: Vec<char> = self
+        let captured: Vec<char> = self
             .manifest
             .image(k)
             .map(|r| r.grey.iter().map(|g| g.letter).collect())
             .unwrap_or_default();
+        let letters = self.frame_rule().lit_letters(captured);
         let mut written: Vec<FileRecord> = Vec::new();
         for (i, img) in set.corrected.iter().enumerate() {
             let letter = letters.get(i).copied();

@@ -1,17 +1,10 @@
 //! Making text from files and devices safe to draw: control characters
 //! (which could move the cursor or change the terminal's state) are removed.
 
-/// Removes control characters (C0, DEL, C1) and escapes; tabs become spaces.
+/// Removes control characters (C0, DEL, C1) and escapes; tabs become spaces:
+/// the crate's one sanitiser, [`crate::text::sanitize`].
 pub fn clean(s: &str) -> String {
-    s.chars()
-        .filter_map(|c| match c {
-            '\t' => Some(' '),
-            c if c.is_control() => None,
-            // Bidi overrides can reorder what the operator reads.
-            '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}' => None,
-            c => Some(c),
-        })
-        .collect()
+    crate::text::sanitize(s)
 }
 
 #[cfg(test)]

@@ -1,6 +1,6 @@
-//! `vss selftest` as a user runs it: the table, the JSON for scripts, and a
-//! clear refusal of bad arguments. Small scenes keep it quick; the floors
-//! themselves are in `accuracy.rs`.
+//! `vss selftest` as a user runs it: the tables of both families, the JSON
+//! for scripts, and a clear refusal of bad arguments. Small scenes keep it
+//! quick; the floors themselves are in `accuracy.rs` and `accuracy_yard.rs`.
 
 use assert_cmd::Command;
 
@@ -86,6 +86,8 @@ fn selftest_refuses_bad_arguments() {
         &["selftest", "--size", "8"],
         &["selftest", "--scenes", "0"],
         &["selftest", "--noise", "two"],
+        &["selftest", "--family", "spheres"],
+        &["selftest", "--export", "/tmp/x", "--score", "/tmp/y"],
     ] {
         let out = vss().args(args).output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -93,4 +95,72 @@ fn selftest_refuses_bad_arguments() {
         assert!(!stderr.trim().is_empty(), "{args:?}: no reason given");
         assert!(out.stdout.is_empty(), "{args:?}: printed results anyway");
     }
+}
+
+#[test]
+fn selftest_reports_the_yard_family_with_its_breakdowns_and_lens_check() {
+    let out = vss()
+        .args([
+            "selftest", "--family", "yard", "--scenes", "2", "--size", "192", "--noise", "0,sd",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.starts_with("yard: 2 scenes of 192×192 px"),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("cubes:"), "{stdout}");
+    assert!(stdout.contains("strong R close R off-angle"), "{stdout}");
+    for noise in ["0", "sd"] {
+        let row = stdout
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(noise))
+            .unwrap_or_else(|| panic!("no row for noise {noise}:\n{stdout}"));
+        // recall, precision and F are fractions.
+        for v in row.split_whitespace().skip(1).take(3) {
+            let x: f64 = v.parse().unwrap();
+            assert!((0.0..=1.0).contains(&x), "{row}");
+        }
+    }
+    assert_eq!(stdout.matches("lens (noise").count(), 2, "{stdout}");
+}
+
+#[test]
+fn selftest_json_holds_both_families() {
+    let out = vss()
+        .args([
+            "selftest", "--scenes", "1", "--size", "128", "--noise", "2,sd", "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // The cube family keeps its keys at the top; sd is the yard's alone.
+    assert_eq!(v["levels"].as_array().unwrap().len(), 1);
+    assert_eq!(v["levels"][0]["noise"], 2.0);
+    let yard = &v["yard"];
+    assert_eq!(yard["config"]["size"], 128);
+    assert_eq!(yard["levels"][0]["noise"], 2.0);
+    assert_eq!(yard["levels"][1]["noise"], "sd");
+    for key in [
+        "recall",
+        "precision",
+        "recall_strong",
+        "recall_close",
+        "off_angle",
+    ] {
+        let x = yard["levels"][1]["metrics"][key].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&x), "{key} = {x}");
+    }
+    assert!(yard["lens"][0]["f_difference"].as_f64().is_some());
 }

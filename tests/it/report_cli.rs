@@ -181,3 +181,84 @@ fn session_report_has_every_image() {
         4
     );
 }
+
+/// The console's export and `vss report` call the same writer: the same
+/// pages, with the edit log, the stale mark and a note for each file that
+/// cannot be shown.
+#[test]
+fn the_console_s_export_and_vss_report_write_the_same_pages() {
+    use vss::report::survey::{self, Targets};
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Session::create(dir.path(), "cube", &Profile::default()).unwrap();
+    let e = EdgePoints {
+        dir: Some(ScanDir::Horizontal),
+        width: 64,
+        height: 48,
+        points: (0..30)
+            .map(|i| EdgePoint {
+                x: 20.0,
+                y: i as f32 + 5.0,
+                response: 25.0,
+            })
+            .collect(),
+    };
+    let l = [
+        Segment::new(Point::new(20.0, 5.0), Point::new(20.0, 35.0)),
+        Segment::new(Point::new(30.0, 5.0), Point::new(30.0, 35.0)),
+    ];
+    let grey = |v| ImgFile::new(GreyImage::filled(64, 48, v).unwrap());
+    for k in 1..=2 {
+        s.save_image(k, 'a', &grey(60)).unwrap();
+        let set = OutputSet {
+            edges_h: Some(&e),
+            edges_v: Some(&e),
+            lines_raw: Some(&l),
+            lines: Some(&l),
+            ..Default::default()
+        };
+        s.save_output_set(k, &set, &Params::default()).unwrap();
+    }
+    s.record_edit(1, "delete 1", &l[..1]).unwrap();
+    s.save_image(2, 'a', &grey(70)).unwrap(); // image 2's outputs are stale
+    let sdir = s.dir().to_path_buf();
+    drop(s);
+    std::fs::remove_file(sdir.join("cube1.vpo")).unwrap();
+    std::fs::write(sdir.join("cube2.lex"), "1 2 3\nnot a line file\n").unwrap();
+
+    let d = sdir.to_str().unwrap();
+    vss(
+        &["report", d, "--ps", "cli.ps", "--svg", "cli.svg"],
+        dir.path(),
+    );
+    // What the console's `e` calls.
+    let s = Session::inspect(&sdir).unwrap();
+    let written = survey::write(&s, None, &Targets::in_session(&s)).unwrap();
+    let names: Vec<String> = written
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["cube.ps", "cube1.svg", "cube2.svg"]);
+
+    let read = |p: &Path| std::fs::read_to_string(p).unwrap();
+    let ps = read(&sdir.join("cube.ps"));
+    assert!(
+        ps == read(&dir.path().join("cli.ps")),
+        "the same PostScript"
+    );
+    for k in 1..=2 {
+        assert!(
+            read(&sdir.join(format!("cube{k}.svg")))
+                == read(&dir.path().join(format!("cli{k}.svg"))),
+            "the same SVG of image {k}"
+        );
+    }
+    for want in [
+        "manual edits \\(1\\):",
+        "delete 1 -> 1 lines",
+        "STALE: ",
+        "cannot show cube1.vpo: the manifest records it, but it is missing",
+        "cannot show cube2.lex: ",
+    ] {
+        assert!(ps.contains(want), "{want:?} not in the report");
+    }
+}

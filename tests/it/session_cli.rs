@@ -71,7 +71,12 @@ fn new_show_check_and_bad_names() {
         "camera 1's cdf copied for image 1"
     );
     assert!(!d.join("cube/cube2.cdf").exists());
-    assert!(text(&o).contains("cam2.cdf not found"), "{}", text(&o));
+    assert!(
+        text(&o).contains("camera 2: ./cam2.cdf: cannot read")
+            && text(&o).contains("image 2 has no camera description"),
+        "{}",
+        text(&o)
+    );
     assert_eq!(
         std::fs::read_to_string(d.join("cube/cube.ses")).unwrap(),
         "2\n2\n2\n"
@@ -214,10 +219,20 @@ fn lock_names_a_live_holder_and_yields_only_when_it_is_gone() {
         .spawn()
         .unwrap();
     let mut out = BufReader::new(child.stdout.take().unwrap());
+    // Killed however the test ends: a failed assertion must not leave it
+    // saving (and holding the test's output open) for a million rounds.
+    struct Reap(std::process::Child);
+    impl Drop for Reap {
+        fn drop(&mut self) {
+            let _ = self.0.kill();
+            let _ = self.0.wait();
+        }
+    }
+    let mut child = Reap(child);
     let mut line = String::new();
     out.read_line(&mut line).unwrap();
     assert_eq!(line.trim(), "ready");
-    let pid = child.id();
+    let pid = child.0.id();
     for args in [
         &["session", "redo", "held", "--image", "1"][..],
         &["session", "redo", "held", "--image", "1", "--take-over"][..],
@@ -234,8 +249,8 @@ fn lock_names_a_live_holder_and_yields_only_when_it_is_gone() {
     // show works read-only and names the holder.
     let t = text(&vss(&["session", "show", "held"], d));
     assert!(t.contains(&format!("in use by process {pid}")), "{t}");
-    child.kill().unwrap();
-    child.wait().unwrap();
+    child.0.kill().unwrap();
+    child.0.wait().unwrap();
     let o = vss(&["session", "redo", "held", "--image", "1"], d);
     assert!(!o.status.success());
     assert!(text(&o).contains("--take-over"), "{}", text(&o));
@@ -248,4 +263,133 @@ fn lock_names_a_live_holder_and_yields_only_when_it_is_gone() {
     );
     assert!(!text(&o).contains("in use"), "{}", text(&o));
     assert!(vss(&["session", "check", "held"], d).status.success());
+}
+
+/// Bytes that change a terminal's state: ESC, BEL, CR, and the 8-bit CSI
+/// (U+009B, C2 9B in UTF-8).
+fn terminal_controls(bytes: &[u8]) -> Vec<String> {
+    let mut found = Vec::new();
+    for (i, w) in bytes.windows(2).enumerate() {
+        if matches!(w[0], 0x1b | 0x07 | b'\r') || w == [0xc2, 0x9b] {
+            found.push(format!("byte {i}: {:02x}", w[0]));
+        }
+    }
+    if bytes
+        .last()
+        .is_some_and(|b| matches!(b, 0x1b | 0x07 | b'\r'))
+    {
+        found.push("last byte".into());
+    }
+    found
+}
+
+/// A manifest written by someone hostile: escape sequences in a lighting's
+/// note, a light's name, "made", the profile's name and an edit, and a line
+/// break that would forge a line of output. No output path passes them on.
+#[test]
+fn hostile_manifest_text_never_reaches_the_terminal() {
+    use vss::formats::img::ImgFile;
+    use vss::llv::{GreyImage, Params, Point, Segment};
+    use vss::session::{OutputSet, Session};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut s = Session::create(d, "cube", &vss::profile::Profile::default()).unwrap();
+    s.save_image(
+        1,
+        'a',
+        &ImgFile::new(GreyImage::filled(32, 32, 60).unwrap()),
+    )
+    .unwrap();
+    let l = [Segment::new(Point::new(2.0, 2.0), Point::new(20.0, 2.0))];
+    let set = OutputSet {
+        lines_raw: Some(&l),
+        lines: Some(&l),
+        ..Default::default()
+    };
+    s.save_output_set(1, &set, &Params::default()).unwrap();
+    s.record_edit(1, "delete 0", &l).unwrap();
+    drop(s);
+    let manifest = d.join("cube/cube.toml");
+    let text_of = std::fs::read_to_string(&manifest).unwrap();
+    let hostile: String = text_of
+        .lines()
+        .map(|line| {
+            let esc = |v: &str| format!("{} = \"{v}\"", line.split(" = ").next().unwrap());
+            match line.split(" = ").next().unwrap() {
+                "note" => esc(r"\u001B[2J\u001B]0;pwned\u0007 note"),
+                "made" => esc(r"\u001B[31mred\u009B2J"),
+                "profile" => esc(r"\u001B]0;title\u0007cell"),
+                "op" => esc(r"\u001B[2Jdelete\n  image 9: forged line\r"),
+                "on" => r#"on = ["\u009B2Jleft-front"]"#.to_string(),
+                _ => line.to_string(),
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    assert!(hostile.contains("pwned") && hostile.contains("forged"));
+    std::fs::write(&manifest, &hostile).unwrap();
+
+    let show = vss(&["session", "show", "cube"], d);
+    assert!(show.status.success(), "{}", text(&show));
+    let out = String::from_utf8_lossy(&show.stdout);
+    assert!(out.contains("[2J]0;pwned note"), "{out}");
+    assert!(out.contains("2Jleft-front"), "{out}");
+    assert!(
+        !out.lines().any(|l| l.starts_with("  image 9")),
+        "a line break in the manifest made a line of its own:\n{out}"
+    );
+    let runs = [
+        show,
+        vss(&["session", "check", "cube"], d),
+        vss(&["report", "cube", "--ps", "r.ps", "--svg", "r.svg"], d),
+        vss(&["info", "cube/cube.toml"], d),
+        // An error that quotes the file: an unknown key full of escapes.
+        {
+            std::fs::write(
+                &manifest,
+                format!("\"\\u001B[2Jkey\\u0007\" = 1\n{hostile}"),
+            )
+            .unwrap();
+            vss(&["session", "show", "cube"], d)
+        },
+        vss(&["info", "no\x1b[2Jsuch\x07.img"], d),
+    ];
+    for (i, o) in runs.iter().enumerate() {
+        for (what, bytes) in [("stdout", &o.stdout), ("stderr", &o.stderr)] {
+            let found = terminal_controls(bytes);
+            assert!(found.is_empty(), "run {i} {what}: {found:?}\n{}", text(o));
+        }
+    }
+    for i in [0, 2, 3] {
+        assert!(runs[i].status.success(), "run {i}: {}", text(&runs[i]));
+    }
+    assert!(!runs[4].status.success() && text(&runs[4]).contains("cube.toml"));
+    for f in ["r.ps", "r1.svg"] {
+        let found = terminal_controls(&std::fs::read(d.join(f)).unwrap());
+        assert!(found.is_empty(), "{f}: {found:?}");
+    }
+}
+
+/// The choice arguments refuse what they do not know, listing what they do.
+#[test]
+fn choice_arguments_list_their_values() {
+    let d = tempfile::tempdir().unwrap();
+    for (args, values) in [
+        (
+            &["session", "redo", "x", "--image", "1", "--from", "sideways"][..],
+            "[possible values: lens, edges, lines, connect]",
+        ),
+        (
+            &["--preview", "sideways"][..],
+            "[possible values: ascii, braille, blocks]",
+        ),
+        (
+            &["params", "export", "default", "--set", "sideways"][..],
+            "[possible values: lens, edges, lines, connect, all]",
+        ),
+    ] {
+        let o = vss(args, d.path());
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(text(&o).contains(values), "{args:?}: {}", text(&o));
+    }
 }

@@ -1,7 +1,8 @@
 //! Running the LLV stages on a session: save_outputs of a pipeline run,
 //! redo from edges, lines and connect (only the later stages change), lens
-//! correction from the image's .cdf, edits cleared by a new .ldr, and the
-//! `vss session redo` command.
+//! correction from the image's .cdf, edits cleared by a new .ldr, the
+//! `vss session redo` command, and one captured image giving the same lines
+//! whether `vss session redo` or the console's way of running runs it.
 
 use std::process::Command;
 
@@ -11,7 +12,7 @@ use vss::llv::params::Stage;
 use vss::llv::pipeline::{self, Input};
 use vss::llv::{GreyImage, Params};
 use vss::profile::{Lighting, Profile};
-use vss::session::{OutputState, Session};
+use vss::session::{FrameRule, OutputState, Runner, Session};
 
 /// A bright rectangle on a dark ground, anti-aliased edges by 4×4 sampling.
 fn rectangle(level: f64) -> GreyImage {
@@ -199,4 +200,145 @@ fn redo_command_uses_the_profile_and_explains_missing_inputs() {
     let o = vss(&["session", "redo", "--image", "2", "--from", "edges"]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("no grey image captured yet"));
+}
+
+/// The default profile's simulated cell, smaller and quicker: 256², lights
+/// settled in 5 ms, the cameras' `.cdf` files by absolute path.
+fn quick_cell(dir: &std::path::Path) -> (Profile, std::path::PathBuf) {
+    let mut p = Profile::load(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/profiles/default.toml"
+    ))
+    .unwrap();
+    p.sim.width = 256;
+    p.sim.height = 256;
+    p.relay.settle_ms = 5;
+    p.survey.cdf = (1..=p.survey.cameras)
+        .map(|c| p.cdf_path(c).unwrap())
+        .collect();
+    let path = dir.join("cell.toml");
+    std::fs::write(&path, p.to_toml().unwrap()).unwrap();
+    (Profile::load(path.to_str().unwrap()).unwrap(), path)
+}
+
+#[test]
+fn redo_and_the_console_s_way_write_the_same_ldr() {
+    let dir = tempfile::tempdir().unwrap();
+    let (profile, prof_path) = quick_cell(dir.path());
+    let sdir = dir.path().join("cube");
+    let vss = |args: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_vss"))
+            .arg("--profile")
+            .arg(&prof_path)
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        o
+    };
+    let s = sdir.to_str().unwrap();
+    vss(&[
+        "grab",
+        "--camera",
+        "2",
+        "--lighting",
+        "a,b,c,d,e",
+        "--image",
+        "1",
+        "--session",
+        s,
+    ]);
+    vss(&["session", "redo", s, "--image", "1", "--from", "edges"]);
+    let ldr = sdir.join("cube1.ldr");
+    let by_redo = std::fs::read(&ldr).unwrap();
+
+    // The console's way: the captured frames in memory, split by the
+    // profile's rule, the camera's model from the profile's .cdf, run by a
+    // runner as its pipeline worker does, saved through the session.
+    let frames: Vec<(char, GreyImage)> = "abcde"
+        .chars()
+        .map(|l| {
+            let f = vss::formats::img::read_img(&sdir.join(format!("cube1{l}.img"))).unwrap();
+            (l, f.image)
+        })
+        .collect();
+    let camera = vss::formats::cdf::read_cdf(&profile.cdf_path(2).unwrap())
+        .unwrap()
+        .camera_model();
+    assert!(camera.is_some());
+    let input = FrameRule::of_profile(&profile)
+        .split(frames.clone())
+        .with_camera(camera);
+    assert_eq!(input.letters, vec!['a', 'b', 'c', 'd']);
+    assert_eq!(input.ambient.as_ref().map(|a| a.0), Some('e'));
+    let mut runner = Runner::new();
+    let out = runner.run_changed(1, &input, &profile.llv).unwrap().clone();
+    std::fs::remove_file(&ldr).unwrap();
+    let mut sess = Session::open(&sdir).unwrap();
+    sess.save_outputs(1, &out, &profile.llv).unwrap();
+    assert!(
+        std::fs::read(&ldr).unwrap() == by_redo,
+        "the console's way wrote another .ldr than vss session redo"
+    );
+    assert_eq!(out.corrected.len(), 4, "the four lit frames lens-corrected");
+
+    // `vss llv` on the five files and the camera's .cdf: the same rule, the
+    // same runner, the same lines.
+    let out_dir = dir.path().join("llv");
+    let mut args: Vec<String> = vec!["llv".into(), "--out".into(), out_dir.display().to_string()];
+    args.push("--cdf".into());
+    args.push(profile.cdf_path(2).unwrap().display().to_string());
+    args.extend(
+        "abcde"
+            .chars()
+            .map(|l| sdir.join(format!("cube1{l}.img")).display().to_string()),
+    );
+    let o = vss(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("cube1e.img (subtracted"),
+        "{o:?}"
+    );
+    assert!(
+        std::fs::read(out_dir.join("cube1.ldr")).unwrap() == by_redo,
+        "vss llv wrote another .ldr than vss session redo"
+    );
+
+    // The ambient frame is subtracted, not a fifth lighting: taken as lit
+    // it gives other lines (the redo of old did that).
+    let all_lit = FrameRule::default().split(frames).with_camera(camera);
+    assert_eq!(all_lit.images.len(), 5);
+    let other = Runner::new()
+        .run(&all_lit, Stage::Lens, &profile.llv)
+        .unwrap()
+        .clone();
+    assert_ne!(
+        (other.edges_h.points.len(), other.lines.len()),
+        (out.edges_h.points.len(), out.lines.len())
+    );
+
+    // From the saved edge files (exact f32), with the same parameters, the
+    // same lines again; from the saved .lex, whose six decimals round the
+    // extracted lines, the same lines to within that rounding.
+    drop(sess);
+    vss(&["session", "redo", s, "--image", "1", "--from", "lines"]);
+    assert!(
+        std::fs::read(&ldr).unwrap() == by_redo,
+        "--from lines: another .ldr"
+    );
+    vss(&["session", "redo", s, "--image", "1", "--from", "connect"]);
+    let again = vss::formats::lines::read_lines(&ldr).unwrap();
+    assert_eq!(again.len(), out.lines.len());
+    for (a, b) in again.iter().zip(&out.lines) {
+        let d = (a.a.x - b.a.x).abs()
+            + (a.a.y - b.a.y).abs()
+            + (a.b.x - b.b.x).abs()
+            + (a.b.y - b.b.y).abs();
+        assert!(d < 1e-4, "--from connect: {a:?} against {b:?}");
+    }
+    let o = vss(&["session", "check", s]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("ok"), "{o:?}");
 }

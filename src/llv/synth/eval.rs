@@ -4,9 +4,14 @@
 //! and through lens distortion and correction.
 //!
 //! Every scene is rendered noise-free once; each noise level adds its own
-//! seeded noise to that render, so levels differ only in noise.
+//! seeded noise to that render, so levels differ only in noise. Edges with
+//! some contrast (≥ 1 grey level) but less than `min_contrast` are
+//! don't-care (`score`): finding them neither helps nor costs. The yard
+//! family's evaluation is in [`yard`].
 
 use serde::Serialize;
+
+pub mod yard;
 
 use super::rng::mix;
 use super::score::{Metrics, Tally};
@@ -17,6 +22,10 @@ use crate::llv::pipeline::{self, Input};
 use crate::llv::{
     EdgePoints, GreyImage, LlvError, Params, Point, Segment, connect, corners, lines,
 };
+
+/// Contrast (grey levels) below which an edge is no edge at all, not even
+/// a don't-care one.
+pub const FAINT: f64 = 1.0;
 
 /// What to evaluate.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -101,12 +110,16 @@ pub struct EvalReport {
     pub lens: LensResult,
 }
 
-struct Case {
-    scene: Scene,
-    cam: Camera,
-    lights: Vec<PointLight>,
-    exact: Vec<f64>,
-    truth: Vec<Segment>,
+/// One cube-family scene ready for noise: its noise-free render and truth.
+pub struct Case {
+    pub scene: Scene,
+    pub cam: Camera,
+    pub lights: Vec<PointLight>,
+    pub exact: Vec<f64>,
+    pub truth: Vec<Segment>,
+    /// Every visible edge with some contrast; those of `truth` among them
+    /// count as true (support is checked first).
+    pub dont_care: Vec<Segment>,
 }
 
 fn options(cfg: &EvalConfig, noise: f64, seed: u64, distort: bool) -> RenderOptions {
@@ -119,42 +132,54 @@ fn options(cfg: &EvalConfig, noise: f64, seed: u64, distort: bool) -> RenderOpti
     }
 }
 
-/// Runs the evaluation with the given LLV parameters.
-pub fn evaluate(cfg: &EvalConfig, params: &Params) -> Result<EvalReport, LlvError> {
-    let cases: Vec<Case> = super::test_scenes(cfg.scenes, cfg.size, cfg.size, cfg.seed)
+/// The scenes of `cfg`, rendered noise-free, with their truth.
+pub fn cube_cases(cfg: &EvalConfig) -> Vec<Case> {
+    super::test_scenes(cfg.scenes, cfg.size, cfg.size, cfg.seed)
         .into_iter()
         .map(|(scene, cam, lights)| {
             let o = options(cfg, 0.0, 0, false);
             let exact = super::render_exact(&scene, &cam, &lights, &o);
             let truth = super::true_edges(&scene, &cam, &lights, &o, cfg.min_contrast);
+            let dont_care = super::true_edges(&scene, &cam, &lights, &o, FAINT);
             Case {
                 scene,
                 cam,
                 lights,
                 exact,
                 truth,
+                dont_care,
             }
         })
-        .collect();
+        .collect()
+}
+
+/// The image of scene `i` at noise σ `noise`, the `j`-th level of the run.
+pub fn cube_image(cfg: &EvalConfig, c: &Case, i: usize, j: usize, noise: f64) -> GreyImage {
+    let seed = mix(cfg.seed, 1000 + 64 * i as u64 + j as u64);
+    super::finish(
+        c.exact.clone(),
+        c.cam.width,
+        c.cam.height,
+        &options(cfg, noise, seed, false),
+    )
+}
+
+/// Runs the evaluation with the given LLV parameters.
+pub fn evaluate(cfg: &EvalConfig, params: &Params) -> Result<EvalReport, LlvError> {
+    let cases = cube_cases(cfg);
     let mut levels = Vec::new();
     for (j, &noise) in cfg.noise.iter().enumerate() {
         let (mut sub, mut whole) = (Tally::default(), Tally::default());
         let (mut points, mut nlines) = (0usize, 0usize);
         let (mut st_sub, mut st_whole) = (Straightness::default(), Straightness::default());
         for (i, c) in cases.iter().enumerate() {
-            let seed = mix(cfg.seed, 1000 + 64 * i as u64 + j as u64);
-            let img = super::finish(
-                c.exact.clone(),
-                c.cam.width,
-                c.cam.height,
-                &options(cfg, noise, seed, false),
-            );
+            let img = cube_image(cfg, c, i, j, noise);
             let out = run_one(&img, None, params)?;
-            sub.add(&out.lines, &c.truth);
+            sub.add_with(&out.lines, &c.truth, &c.dont_care);
             points += out.edges_h.points.len() + out.edges_v.points.len();
             nlines += out.lines.len();
             let wp = whole_pixel_lines(&out.edges_h, &out.edges_v, params);
-            whole.add(&wp, &c.truth);
+            whole.add_with(&wp, &c.truth, &c.dont_care);
             let ident = |p: Point| p;
             st_sub.add(&c.truth, &out.edges_h, &out.edges_v, &ident);
             let (rh, rv) = (round_points(&out.edges_h), round_points(&out.edges_v));
@@ -179,7 +204,7 @@ pub fn evaluate(cfg: &EvalConfig, params: &Params) -> Result<EvalReport, LlvErro
     })
 }
 
-fn run_one(
+pub(crate) fn run_one(
     img: &GreyImage,
     lens: Option<&LensMap>,
     params: &Params,
@@ -264,7 +289,7 @@ fn lens_check(cfg: &EvalConfig, cases: &[Case], params: &Params) -> Result<LensR
         let od = options(cfg, cfg.lens_noise, seed, true);
         let distorted = super::render(&c.scene, &cam, &c.lights, &od);
         let out = run_one(&distorted, None, params)?;
-        t_unc.add(&out.lines, &c.truth);
+        t_unc.add_with(&out.lines, &c.truth, &c.dont_care);
         let through_lens = |p: Point| {
             let (x, y) = cam.model.ideal_to_observed(p.x, p.y);
             Point::new(x, y)
@@ -273,7 +298,7 @@ fn lens_check(cfg: &EvalConfig, cases: &[Case], params: &Params) -> Result<LensR
         dist.extend(out.lines_raw);
         let map = LensMap::new(&cam.model, w, h);
         let out = run_one(&distorted, Some(&map), params)?;
-        t_corr.add(&out.lines, &c.truth);
+        t_corr.add_with(&out.lines, &c.truth, &c.dont_care);
         s_corr.add(&c.truth, &out.edges_h, &out.edges_v, &ident);
         corr.extend(out.lines_raw);
     }

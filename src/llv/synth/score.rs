@@ -1,5 +1,5 @@
-//! Scoring detected lines against true edges, with the matching rule of
-//! issue 3.
+//! Scoring detected lines against true edges with the matching rule below,
+//! don't-care edges, and the breakdowns that say where a detector loses.
 //!
 //! A detected segment *supports* a true edge along the part of it that lies
 //! within [`DIST`] px of the true segment (distance to the segment, not to its
@@ -9,19 +9,44 @@
 //!   stretch count once);
 //! - precision: the fraction of detected length that supports some true edge
 //!   (union over true edges, per detected segment);
+//! - don't-care edges (too faint, or in the image's border band): the part of
+//!   a detected segment that supports one, by the same rule, and no true
+//!   edge, is taken out of the detected length; their own length is not
+//!   true length. So they count neither for nor against a detector;
 //! - endpoint distance: for each detected segment that supports a true edge,
 //!   the perpendicular distances of both its endpoints from the line of the
 //!   true edge it supports most (mean and 95th percentile over all such
 //!   endpoints);
 //! - angle error: the direction difference (degrees) to that same true edge,
 //!   averaged over those segments.
+//!
+//! Breakdowns:
+//! - strong recall: recall over the true edges of contrast ≥ [`STRONG`] grey
+//!   levels (a true edge's contrast is its `Segment.response`);
+//! - close recall: recall over the parts of true edges that have another
+//!   true edge within [`ANGLE_DEG`] of their direction at a perpendicular
+//!   distance of [`CLOSE`] px (plate thicknesses seen edge-on);
+//! - off-angle: the fraction of detected length that supports nothing but
+//!   lies within [`DIST`] px of a true edge at a larger angle (a line tilted
+//!   off its edge), plus the stretch of a segment between two close
+//!   parallel true edges it runs near both of (a line bent across them).
 
 use crate::llv::{Point, Segment};
+
+mod intervals;
+#[cfg(test)]
+mod tests;
+
+use intervals::{clip_linear, intersection_length, normalize, union_length};
 
 /// Largest distance (px) of a supporting part from the true edge.
 pub const DIST: f64 = 2.0;
 /// Largest direction difference (degrees) of a supporting segment.
 pub const ANGLE_DEG: f64 = 3.0;
+/// Contrast (grey levels) from which a true edge is strong.
+pub const STRONG: f64 = 30.0;
+/// Perpendicular distances (px) at which two parallel true edges are close.
+pub const CLOSE: (f64, f64) = (4.0, 8.0);
 
 /// The scores of one image or of several pooled.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
@@ -36,12 +61,23 @@ pub struct Metrics {
     pub angle_mean_deg: f64,
     /// Total true edge length (px).
     pub true_length: f64,
-    /// Total detected length (px).
+    /// Total detected length (px), without what don't-care edges took.
     pub detected_length: f64,
     /// Detected segments that support some true edge.
     pub supporting: usize,
     /// Detected segments in all.
     pub detected: usize,
+    /// Recall of the true edges of contrast ≥ [`STRONG`].
+    pub recall_strong: f64,
+    /// Recall of the parts of true edges with a parallel one [`CLOSE`] px away.
+    pub recall_close: f64,
+    /// Off-angle share of the detected length (see the module doc).
+    pub off_angle: f64,
+    /// True length of the strong edges and of the close parts (px).
+    pub strong_length: f64,
+    pub close_length: f64,
+    /// Detected length taken out as matching don't-care edges (px).
+    pub dont_care_length: f64,
 }
 
 impl Metrics {
@@ -67,25 +103,45 @@ pub struct Tally {
     pub endpoint_dists: Vec<f64>,
     pub angle_errors_deg: Vec<f64>,
     pub detected: usize,
+    pub strong_length: f64,
+    pub strong_covered: f64,
+    pub close_length: f64,
+    pub close_covered: f64,
+    pub off_angle_length: f64,
+    pub dont_care_length: f64,
 }
 
 impl Tally {
-    /// Adds one image's detected lines and true edges.
+    /// Adds one image's detected lines and true edges (no don't-care edges).
     pub fn add(&mut self, detected: &[Segment], truth: &[Segment]) {
+        self.add_with(detected, truth, &[]);
+    }
+
+    /// Adds one image's detected lines, true edges and don't-care edges.
+    pub fn add_with(&mut self, detected: &[Segment], truth: &[Segment], dont_care: &[Segment]) {
         let mut covered: Vec<Vec<(f64, f64)>> = vec![Vec::new(); truth.len()];
+        let (mut own, mut near, mut dc) = (Vec::new(), Vec::new(), Vec::new());
+        let mut near_edges: Vec<usize> = Vec::new();
         for d in detected {
             let len = d.length();
             self.detected += 1;
             if !(len.is_finite() && len > 0.0) {
                 continue;
             }
-            self.detected_length += len;
-            let mut own: Vec<(f64, f64)> = Vec::new();
+            own.clear();
+            near.clear();
+            dc.clear();
+            near_edges.clear();
             let mut best: Option<(usize, f64)> = None;
             for (ti, t) in truth.iter().enumerate() {
-                let Some((s0, s1)) = support(d, t) else {
+                let Some((s0, s1)) = within(d, t) else {
                     continue;
                 };
+                near.push((s0, s1));
+                near_edges.push(ti);
+                if angle_diff_deg(d, t) > ANGLE_DEG {
+                    continue;
+                }
                 own.push((s0, s1));
                 if best.is_none_or(|(_, l)| s1 - s0 > l) {
                     best = Some((ti, s1 - s0));
@@ -102,8 +158,24 @@ impl Tally {
                     c.push((c0.min(c1), c0.max(c1)));
                 }
             }
+            for t in dont_care {
+                if let Some(iv) = support(d, t) {
+                    dc.push(iv);
+                }
+            }
+            if let Some(b) = bridge(truth, &near, &near_edges) {
+                near.push(b);
+            }
             let sup = union_length(&mut own);
+            let mut matched: Vec<(f64, f64)> = own.iter().chain(&dc).copied().collect();
+            let with_dc = union_length(&mut matched);
+            let removed = with_dc - sup;
+            matched.extend_from_slice(&near);
+            let off = union_length(&mut matched) - with_dc;
             self.supporting_length += sup;
+            self.detected_length += len - removed;
+            self.dont_care_length += removed;
+            self.off_angle_length += off;
             if let Some((ti, _)) = best
                 && let Some(t) = truth.get(ti)
             {
@@ -112,12 +184,22 @@ impl Tally {
                 self.angle_errors_deg.push(angle_diff_deg(d, t));
             }
         }
-        for (t, mut c) in truth.iter().zip(covered) {
+        for (ti, (t, c)) in truth.iter().zip(covered).enumerate() {
             let tl = t.length();
-            if tl.is_finite() {
-                self.true_length += tl;
-                self.covered_length += union_length(&mut c);
+            if !tl.is_finite() {
+                continue;
             }
+            let c = normalize(c);
+            let cov: f64 = c.iter().map(|(a, b)| b - a).sum();
+            self.true_length += tl;
+            self.covered_length += cov;
+            if t.response >= STRONG {
+                self.strong_length += tl;
+                self.strong_covered += cov;
+            }
+            let close = normalize(close_parts(truth, ti));
+            self.close_length += close.iter().map(|(a, b)| b - a).sum::<f64>();
+            self.close_covered += intersection_length(&c, &close);
         }
     }
 
@@ -141,6 +223,12 @@ impl Tally {
             detected_length: self.detected_length,
             supporting: self.angle_errors_deg.len(),
             detected: self.detected,
+            recall_strong: ratio(self.strong_covered, self.strong_length),
+            recall_close: ratio(self.close_covered, self.close_length),
+            off_angle: ratio(self.off_angle_length, self.detected_length),
+            strong_length: self.strong_length,
+            close_length: self.close_length,
+            dont_care_length: self.dont_care_length,
         }
     }
 }
@@ -183,8 +271,16 @@ pub fn line_distance(t: &Segment, p: Point) -> f64 {
 /// The part `[s0, s1]` (arc length along `d` from `d.a`) of `d` that supports
 /// `t`, if any.
 fn support(d: &Segment, t: &Segment) -> Option<(f64, f64)> {
+    if angle_diff_deg(d, t) > ANGLE_DEG {
+        return None;
+    }
+    within(d, t)
+}
+
+/// The part of `d` within [`DIST`] of the segment `t`, at any angle.
+fn within(d: &Segment, t: &Segment) -> Option<(f64, f64)> {
     let (dl, tl) = (d.length(), t.length());
-    if !(dl > 0.0 && tl > 0.0) || angle_diff_deg(d, t) > ANGLE_DEG {
+    if !(dl > 0.0 && tl > 0.0) {
         return None;
     }
     // d(s) = d.a + s·e, e unit. The set {s : dist(d(s), t) ≤ DIST} is an
@@ -225,36 +321,70 @@ fn support(d: &Segment, t: &Segment) -> Option<(f64, f64)> {
     (hi > lo).then_some((lo, hi))
 }
 
-/// `{s ∈ [s0, s1] : lo ≤ a + b s ≤ hi}`.
-fn clip_linear(a: f64, b: f64, lo: f64, hi: f64, s0: f64, s1: f64) -> Option<(f64, f64)> {
-    if b.abs() < 1e-12 {
-        return (a >= lo && a <= hi).then_some((s0, s1));
-    }
-    let (x, y) = ((lo - a) / b, (hi - a) / b);
-    let (x, y) = (x.min(y), x.max(y));
-    let (r0, r1) = (s0.max(x), s1.min(y));
-    (r0 <= r1).then_some((r0, r1))
+/// Whether two true edges are a close parallel pair: within [`ANGLE_DEG`]
+/// of each other, and `b`'s midpoint farther than [`DIST`] and at most
+/// `CLOSE.1` px from `a`'s line.
+fn close_pair(a: &Segment, b: &Segment) -> bool {
+    let m = lerp(b.a, b.b, 0.5);
+    let dist = line_distance(a, m);
+    angle_diff_deg(a, b) <= ANGLE_DEG && dist > DIST && dist <= CLOSE.1
 }
 
-/// Total length of a union of intervals (sorts them in place).
-fn union_length(iv: &mut [(f64, f64)]) -> f64 {
-    iv.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut total = 0.0;
-    let mut cur: Option<(f64, f64)> = None;
-    for &(a, b) in iv.iter() {
-        match cur {
-            Some((c0, c1)) if a <= c1 => cur = Some((c0, c1.max(b))),
-            Some((c0, c1)) => {
-                total += c1 - c0;
-                cur = Some((a, b));
+/// The stretch of a detected segment between its near parts on two close
+/// parallel true edges, if it runs near such a pair.
+fn bridge(truth: &[Segment], near: &[(f64, f64)], edges: &[usize]) -> Option<(f64, f64)> {
+    let mut out: Option<(f64, f64)> = None;
+    for (i, &ei) in edges.iter().enumerate() {
+        for (j, &ej) in edges.iter().enumerate().skip(i + 1) {
+            let (Some(a), Some(b)) = (truth.get(ei), truth.get(ej)) else {
+                continue;
+            };
+            if close_pair(a, b) {
+                let (p, q) = (near[i], near[j]);
+                let iv = (p.0.min(q.0), p.1.max(q.1));
+                out = Some(out.map_or(iv, |o| (o.0.min(iv.0), o.1.max(iv.1))));
             }
-            None => cur = Some((a, b)),
         }
     }
-    if let Some((c0, c1)) = cur {
-        total += c1 - c0;
+    out
+}
+
+/// The parts (arc length along edge `i`) of true edge `i` that have another
+/// true edge within [`ANGLE_DEG`] at a perpendicular distance in [`CLOSE`].
+fn close_parts(truth: &[Segment], i: usize) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    let Some(t) = truth.get(i) else {
+        return out;
+    };
+    let tl = t.length();
+    if !(tl > 0.0 && tl.is_finite()) {
+        return out;
     }
-    total
+    let u = ((t.b.x - t.a.x) / tl, (t.b.y - t.a.y) / tl);
+    let n = (-u.1, u.0);
+    let proj = |p: Point| {
+        let r = (p.x - t.a.x, p.y - t.a.y);
+        (r.0 * u.0 + r.1 * u.1, r.0 * n.0 + r.1 * n.1)
+    };
+    for (j, o) in truth.iter().enumerate() {
+        if j == i || angle_diff_deg(t, o) > ANGLE_DEG || o.length().is_nan() || o.length() <= 0.0 {
+            continue;
+        }
+        let ((sa, da), (sb, db)) = (proj(o.a), proj(o.b));
+        let (s0, s1) = (sa.min(sb).max(0.0), sa.max(sb).min(tl));
+        if s1 <= s0 || (sb - sa).abs() < 1e-9 {
+            continue;
+        }
+        // Signed distance along the overlap: da + k (s - sa).
+        let k = (db - da) / (sb - sa);
+        let a = da - k * sa;
+        for (lo, hi) in [(CLOSE.0, CLOSE.1), (-CLOSE.1, -CLOSE.0)] {
+            if let Some(iv) = clip_linear(a, k, lo, hi, s0, s1) {
+                out.push(iv);
+            }
+        }
+    }
+    out
 }
 
 /// The `q`-quantile (nearest rank) of the values; 0 when empty.
@@ -266,74 +396,4 @@ pub fn percentile(v: &[f64], q: f64) -> f64 {
     s.sort_by(f64::total_cmp);
     let rank = ((q * s.len() as f64).ceil() as usize).clamp(1, s.len());
     s.get(rank - 1).copied().unwrap_or(0.0)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn seg(ax: f64, ay: f64, bx: f64, by: f64) -> Segment {
-        Segment::new(Point::new(ax, ay), Point::new(bx, by))
-    }
-
-    #[test]
-    fn perfect_detection_scores_one() {
-        let truth = vec![seg(10.0, 10.0, 110.0, 10.0), seg(10.0, 10.0, 10.0, 60.0)];
-        let m = score(&truth, &truth);
-        assert!((m.recall - 1.0).abs() < 1e-12);
-        assert!((m.precision - 1.0).abs() < 1e-12);
-        assert!(m.endpoint_mean < 1e-12 && m.angle_mean_deg < 1e-9);
-    }
-
-    #[test]
-    fn half_covered_edge_and_a_noise_line() {
-        let truth = vec![seg(0.0, 0.0, 100.0, 0.0)];
-        // Covers x 0..50 at 1 px off; the noise line is far away.
-        let det = vec![seg(0.0, 1.0, 50.0, 1.0), seg(0.0, 30.0, 50.0, 30.0)];
-        let m = score(&det, &truth);
-        assert!((m.recall - 0.5).abs() < 1e-9, "{m:?}");
-        assert!((m.precision - 0.5).abs() < 1e-9, "{m:?}");
-        assert!((m.endpoint_mean - 1.0).abs() < 1e-9);
-        assert_eq!(m.supporting, 1);
-    }
-
-    #[test]
-    fn overlapping_detections_are_not_counted_twice() {
-        let truth = vec![seg(0.0, 0.0, 100.0, 0.0)];
-        let det = vec![seg(0.0, 0.5, 60.0, 0.5), seg(40.0, -0.5, 80.0, -0.5)];
-        let m = score(&det, &truth);
-        assert!((m.recall - 0.8).abs() < 1e-9, "{m:?}");
-        assert!((m.precision - 1.0).abs() < 1e-9);
-    }
-
-    #[test]
-    fn support_stops_two_px_beyond_the_true_end_and_at_the_angle_limit() {
-        let truth = vec![seg(0.0, 0.0, 100.0, 0.0)];
-        // Runs 20 px past the end: only 2 px of the overshoot supports.
-        let m = score(&[seg(80.0, 0.0, 120.0, 0.0)], &truth);
-        assert!((m.precision - 22.0 / 40.0).abs() < 1e-9, "{m:?}");
-        assert!((m.recall - 0.2).abs() < 1e-9);
-        // 4° off: no support at all; 2° off: support where within 2 px.
-        let r = 50.0;
-        let t4 = 4f64.to_radians();
-        let off = seg(50.0, 0.0, 50.0 + r * t4.cos(), -r * t4.sin());
-        assert_eq!(score(&[off], &truth).precision, 0.0);
-        let t2 = 2f64.to_radians();
-        let near = seg(0.0, 0.0, 100.0 * t2.cos(), -100.0 * t2.sin());
-        let m = score(&[near], &truth);
-        // Within 2 px while 100·sin(2°)·s/100 ≤ 2 → s ≤ 2/sin 2° ≈ 57.3.
-        let expect = 2.0 / t2.sin() / 100.0;
-        assert!((m.precision - expect).abs() < 1e-6, "{m:?} vs {expect}");
-        assert!((m.angle_mean_deg - 2.0).abs() < 1e-9);
-    }
-
-    #[test]
-    fn pooled_scores_weight_by_length() {
-        let t1 = vec![seg(0.0, 0.0, 100.0, 0.0)];
-        let t2 = vec![seg(0.0, 0.0, 300.0, 0.0)];
-        let m = score_all(&[(t1.clone(), t1), (vec![], t2)]);
-        assert!((m.recall - 0.25).abs() < 1e-9);
-        assert!((m.precision - 1.0).abs() < 1e-9);
-        assert_eq!(percentile(&[1.0, 2.0, 3.0, 4.0], 0.5), 2.0);
-    }
 }

@@ -1,0 +1,219 @@
+//! Camera calibration from images of a calibration plate: the intrinsics
+//! (`C`, `f`, `D` of the Weng model in spec/lens.md, with `S` stated or its
+//! ratio estimated) from several views, and the extrinsic pose `T` from one
+//! view of the plate at its known place in the cell.
+//!
+//! The method, step by step:
+//! - [`plate`]: the plate file — squares or checkerboard, sizes, the origin
+//!   corner and the plate's place in the cell;
+//! - [`detect`]: the grid found with the LLV engine — corners are where the
+//!   fitted lines of two squares' sides cross, never fitted from corner
+//!   pixels alone;
+//! - `zhang`: starting values in closed form — a homography per view,
+//!   Zhang's method for the pinhole, each view's pose;
+//! - `solve`: Levenberg–Marquardt on the reprojection error of every
+//!   corner through the forward model (`model`: the pinhole, then
+//!   [`CameraModel`]'s distortion, the same function lens correction
+//!   inverts), standard errors from the Jacobian, and the checks on the set
+//!   of views (few, alike, the plate always in the middle);
+//! - [`extrinsic`]: one view at the plate's place gives `T`, world → camera.
+//!
+//! The command line (`vss calibrate`) and the console call these same
+//! functions, and write the result through [`write_intrinsics`] and
+//! [`write_extrinsic`].
+
+pub mod detect;
+pub mod extrinsic;
+pub mod model;
+pub mod plate;
+mod quads;
+mod solve;
+mod zhang;
+
+use std::path::Path;
+
+pub use detect::{Corner, DetectError, Detection, Detector};
+pub use plate::{Plate, PlateError, PlateKind};
+pub use solve::{
+    CENTRE_SE, COVERAGE, Calibration, Estimate, FEW_VIEWS, Options, PARALLEL_DEPTH, View, ViewFit,
+    calibrate, coverage, solve_pose,
+};
+
+use crate::formats::cdf::{Cdf, CdfParam, Status};
+use crate::llv::lens::CameraModel;
+
+/// Why a calibration gave no result. Each says what to do.
+#[derive(Debug, thiserror::Error)]
+pub enum CalibError {
+    #[error(
+        "{usable} usable view(s) of the plate; at least 3 are needed: take more views, each with the whole plate in sight and tilted a different way"
+    )]
+    TooFewViews { usable: usize },
+    #[error(
+        "every view shows the plate nearly parallel to the image plane (its depth changes by at most {:.1} % across it), which cannot tell the focal length from the distance: tilt the plate 20–45° in a different direction in each view",
+        100.0 * depth
+    )]
+    AllParallel { depth: f64 },
+    #[error("{what}: take views with the plate tilted differently")]
+    Degenerate { what: String },
+    #[error(
+        "the solution did not converge ({why}): check the plate file against the plate, and take sharper views"
+    )]
+    NoConvergence { why: String },
+    #[error(
+        "{name} = {value:.6e} has a standard error of {se:.3e}, larger than itself: the views do not determine it; {}",
+        if matches!(*name, "Cx" | "Cy" | "g3" | "g4") {
+            "the centre C and the decentering terms g3, g4 trade off in Weng's model, and more views hardly help: state the centre (--centre X,Y from the lens's data sheet, or --centre image)"
+        } else {
+            "take more views, tilted more, with the plate near the image's edges and corners"
+        }
+    )]
+    WeakParameter {
+        name: &'static str,
+        value: f64,
+        se: f64,
+    },
+    #[error(
+        "the plate `{0}` looks the same turned round, so its origin corner cannot be told in an image: the extrinsic pose needs a plate with `origin_mark = true` (squares) or an odd number of rows + columns (checkerboard)"
+    )]
+    Symmetric(String),
+    #[error("the plate file gives no [place] (the plate's pose in the cell): add one to {0}")]
+    NoPlace(String),
+}
+
+/// The `.cdf` with a new intrinsic calibration: `f`, `D` calibrated (`A`),
+/// `C` too unless it was stated (`S`), `S` stated or, when its ratio was
+/// estimated, `A`. Every other
+/// entry of `old` (its `T`, unknown names) is kept in its place.
+pub fn cdf_with_intrinsics(old: Option<&Cdf>, c: &Calibration) -> Cdf {
+    let m = &c.model;
+    let col = |v: &[f64]| v.iter().map(|&x| vec![x]).collect::<Vec<_>>();
+    let mut cdf = old.cloned().unwrap_or_default();
+    let s_status = if c.scale_estimated {
+        Status::Calibrated
+    } else {
+        Status::Stated
+    };
+    let d = m.distortion.unwrap_or([0.0; 5]);
+    for (name, status, rows) in [
+        ("S", s_status, col(&[m.sx, m.sy])),
+        (
+            "C",
+            if c.centre_stated {
+                Status::Stated
+            } else {
+                Status::Calibrated
+            },
+            col(&[m.cx, m.cy]),
+        ),
+        ("f", Status::Calibrated, col(&[m.f])),
+        ("D", Status::Calibrated, col(&d)),
+    ] {
+        cdf.set(CdfParam {
+            name: name.into(),
+            status,
+            rows,
+        });
+    }
+    if cdf.get("T").is_none() {
+        cdf.set(CdfParam {
+            name: "T".into(),
+            status: Status::NotAvailable,
+            rows: vec![vec![0.0; 4]; 3],
+        });
+    }
+    cdf
+}
+
+/// The `.cdf` with a new extrinsic matrix `T` (calibrated), everything else
+/// kept.
+pub fn cdf_with_extrinsic(old: &Cdf, t: &[[f64; 4]; 3]) -> Cdf {
+    let mut cdf = old.clone();
+    cdf.set(CdfParam {
+        name: "T".into(),
+        status: Status::Calibrated,
+        rows: t.iter().map(|r| r.to_vec()).collect(),
+    });
+    cdf
+}
+
+/// Writes `cdf` to `path` atomically; an existing file is kept first as
+/// `path.bak` (itself written atomically).
+pub fn write_cdf_keeping(path: &Path, cdf: &Cdf) -> Result<(), crate::formats::FormatError> {
+    if path.is_file() {
+        let old = crate::formats::cdf::read_cdf(path)?;
+        let mut bak = path.as_os_str().to_owned();
+        bak.push(".bak");
+        crate::formats::cdf::write_cdf(Path::new(&bak), &old)?;
+    }
+    crate::formats::cdf::write_cdf(path, cdf)
+}
+
+/// Writes a new intrinsic calibration into the `.cdf` at `path` (kept
+/// entries as [`cdf_with_intrinsics`]; the old file as `path.bak`).
+pub fn write_intrinsics(path: &Path, c: &Calibration) -> Result<Cdf, crate::formats::FormatError> {
+    let old = if path.is_file() {
+        Some(crate::formats::cdf::read_cdf(path)?)
+    } else {
+        None
+    };
+    let cdf = cdf_with_intrinsics(old.as_ref(), c);
+    write_cdf_keeping(path, &cdf)?;
+    Ok(cdf)
+}
+
+/// Writes `T` into the `.cdf` at `path` (the old file as `path.bak`).
+pub fn write_extrinsic(
+    path: &Path,
+    old: &Cdf,
+    t: &[[f64; 4]; 3],
+) -> Result<Cdf, crate::formats::FormatError> {
+    let cdf = cdf_with_extrinsic(old, t);
+    write_cdf_keeping(path, &cdf)?;
+    Ok(cdf)
+}
+
+/// The plate found in a set of images.
+#[derive(Clone, Debug, Default)]
+pub struct Found {
+    /// The views where the whole grid was found.
+    pub views: Vec<(View, Detection)>,
+    /// The others: name, and why not.
+    pub refused: Vec<(String, DetectError)>,
+}
+
+/// Finds the plate in each image.
+pub fn detect_all(images: &[(String, crate::llv::GreyImage)], plate: &Plate) -> Found {
+    let mut det = Detector::new();
+    let mut ok = Vec::new();
+    let mut bad = Vec::new();
+    for (name, img) in images {
+        match det.detect(img, plate) {
+            Ok(d) => ok.push((
+                View {
+                    name: name.clone(),
+                    corners: d.corners.clone(),
+                },
+                d,
+            )),
+            Err(e) => bad.push((name.clone(), e)),
+        }
+    }
+    Found {
+        views: ok,
+        refused: bad,
+    }
+}
+
+/// The camera an intrinsic calibration starts from when nothing else is
+/// known: a stated scale, the rest found from the views.
+pub fn stated(sx: f64, sy: f64) -> CameraModel {
+    CameraModel {
+        cx: 0.0,
+        cy: 0.0,
+        sx,
+        sy,
+        f: 0.0,
+        distortion: None,
+    }
+}

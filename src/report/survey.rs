@@ -1,0 +1,306 @@
+//! The survey report of a session, whoever asks for it: `vss report` and
+//! the console's export both call [`write`], so they write the same pages.
+//!
+//! [`image_report`] gathers what the report shows about an image: its grey
+//! images, edge files, raw and connected lines (with attributes), and from
+//! the manifest the camera, parameters, counts, timings, whether the
+//! outputs are stale, and the edit log. A file that is missing or
+//! unreadable becomes a note on the page naming it, instead of failing the
+//! whole report or being left out without a word.
+
+use std::path::{Path, PathBuf};
+
+use super::{ImageReport, check_picture_size, ps, svg};
+use crate::formats;
+use crate::fsutil::write_atomic;
+use crate::session::progress::{OutputState, output_state};
+use crate::session::{Session, SessionError};
+
+/// What can stop a report being written.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// Where a survey report goes.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Targets {
+    /// The PostScript report of every image, in one file.
+    pub ps: Option<PathBuf>,
+    /// One SVG per image: this file for a single image, else this file with
+    /// the image number before the extension (`out.svg` → `out3.svg`).
+    pub svg: Option<PathBuf>,
+}
+
+impl Targets {
+    /// What the console's export writes: `NAME.ps` in the session folder and
+    /// `NAMEk.svg` beside it for each image.
+    pub fn in_session(s: &Session) -> Targets {
+        let name = s.name().as_str();
+        Targets {
+            ps: Some(s.path(&format!("{name}.ps"))),
+            svg: Some(s.path(&format!("{name}.svg"))),
+        }
+    }
+}
+
+/// The heading of a survey report, of all images or of image `k`.
+pub fn title(s: &Session, image: Option<u32>) -> String {
+    match image {
+        Some(k) => format!("survey {} image {k}", s.name()),
+        None => format!("survey {}", s.name()),
+    }
+}
+
+/// The reports of image `image`, or of every image with anything recorded,
+/// in order, each with its number.
+pub fn image_reports(
+    s: &Session,
+    image: Option<u32>,
+) -> Result<Vec<(u32, ImageReport)>, SessionError> {
+    match image {
+        Some(k) => Ok(vec![(k, image_report(s, k)?)]),
+        None => s
+            .manifest()
+            .image
+            .iter()
+            .map(|r| Ok((r.number, image_report(s, r.number)?)))
+            .collect(),
+    }
+}
+
+/// Writes the survey report of `image` (or of every image) to `targets`
+/// and returns the files written, in order. A session without images
+/// gives a report without pages.
+pub fn write(
+    s: &Session,
+    image: Option<u32>,
+    targets: &Targets,
+) -> Result<Vec<PathBuf>, ReportError> {
+    let reports = image_reports(s, image)?;
+    let mut written = Vec::new();
+    let mut put = |path: &Path, text: String| -> Result<(), ReportError> {
+        write_atomic(path, text.as_bytes()).map_err(|source| ReportError::Write {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        written.push(path.to_path_buf());
+        Ok(())
+    };
+    if let Some(p) = &targets.ps {
+        let pages: Vec<ImageReport> = reports.iter().map(|(_, r)| r.clone()).collect();
+        put(p, ps::survey_report(&title(s, image), &pages))?;
+    }
+    if let Some(p) = &targets.svg {
+        for (k, r) in &reports {
+            let path = if reports.len() == 1 && image.is_some() {
+                p.clone()
+            } else {
+                numbered(p, *k)
+            };
+            put(&path, svg::image_svg(r))?;
+        }
+    }
+    Ok(written)
+}
+
+/// `out.svg` → `out3.svg`.
+pub fn numbered(p: &Path, k: u32) -> PathBuf {
+    let stem = p
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = p
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "svg".into());
+    p.with_file_name(format!("{stem}{k}.{ext}"))
+}
+
+/// Everything the report shows of image `k`, read from the session's files.
+pub fn image_report(s: &Session, k: u32) -> Result<ImageReport, SessionError> {
+    let m = s.manifest();
+    let rec = m.image(k).ok_or_else(|| SessionError::Missing {
+        session: s.name().to_string(),
+        image: k,
+        what: "nothing recorded for this image".into(),
+    })?;
+    let mut r = ImageReport {
+        title: format!("{}{k}", s.name()),
+        ..Default::default()
+    };
+    let mut notes = vec![format!(
+        "image {k}: camera {}, location {}{}",
+        rec.camera,
+        rec.location,
+        rec.cdf.as_ref().map_or(String::new(), |c| format!(
+            ", camera description {}",
+            c.file
+        ))
+    )];
+    for g in &rec.grey {
+        match formats::img::read_img(&s.path(&g.file)) {
+            Ok(f) => {
+                let light = m
+                    .lighting
+                    .iter()
+                    .find(|l| l.letter == g.letter)
+                    .map_or(String::new(), |l| format!(" (lights: {})", l.on.join(", ")));
+                r.greys.push((format!("{}{light}", g.file), f.image));
+            }
+            Err(e) => notes.push(format!("cannot show {}: {e}", g.file)),
+        }
+    }
+    // Sizes that come from the manifest or an edge header, not from pixels
+    // read, are checked before the report draws with them.
+    if let Some((_, img)) = r.greys.first() {
+        (r.width, r.height) = img.size();
+    } else if let Some(g) = rec.grey.first() {
+        let (w, h) = (g.width as usize, g.height as usize);
+        match check_picture_size(w, h) {
+            Ok(()) => (r.width, r.height) = (w, h),
+            Err(e) => notes.push(format!(
+                "cannot use the size of {} recorded in the manifest: {e}",
+                g.file
+            )),
+        }
+    }
+    // A stage output is shown when it is there; one the manifest records
+    // that is gone is a note, as an unreadable one is.
+    let recorded = |file: &str| {
+        rec.outputs
+            .as_ref()
+            .is_some_and(|o| o.files.iter().any(|f| f.file == file))
+    };
+    let present = |file: &str, notes: &mut Vec<String>| {
+        let there = s.path(file).exists();
+        if !there && recorded(file) {
+            notes.push(format!(
+                "cannot show {file}: the manifest records it, but it is missing"
+            ));
+        }
+        there
+    };
+    for (ext, slot) in [("hpo", &mut r.edges_h), ("vpo", &mut r.edges_v)] {
+        let file = s.file_name(k, None, ext);
+        if !present(&file, &mut notes) {
+            continue;
+        }
+        match formats::edgefile::read_edges(&s.path(&file)) {
+            Ok(e) if e.width > 0 && e.height > 0 => match check_picture_size(e.width, e.height) {
+                Ok(()) => *slot = Some(e),
+                Err(err) => notes.push(format!("cannot show {file}: {err}")),
+            },
+            Ok(e) => *slot = Some(e),
+            Err(e) => notes.push(format!("cannot show {file}: {e}")),
+        }
+    }
+    if r.width == 0
+        && let Some(e) = r.edges_h.as_ref().or(r.edges_v.as_ref())
+    {
+        (r.width, r.height) = (e.width, e.height);
+    }
+    let lex = s.file_name(k, None, "lex");
+    if present(&lex, &mut notes) {
+        match formats::lines::read_lines(&s.path(&lex)) {
+            Ok(mut l) => {
+                if let Some(a) = rec.outputs.as_ref().and_then(|o| o.lex_attributes.as_ref()) {
+                    a.apply(&mut l);
+                }
+                r.lines_raw = Some(l);
+            }
+            Err(e) => notes.push(format!("cannot show {lex}: {e}")),
+        }
+    }
+    let ldr = s.file_name(k, None, "ldr");
+    if present(&ldr, &mut notes) {
+        match s.load_lines(k) {
+            Ok(l) => r.lines = Some(l),
+            Err(e) => notes.push(format!("cannot show {ldr}: {e}")),
+        }
+    }
+    if let Some(o) = &rec.outputs {
+        notes.push(format!(
+            "outputs made {} by vss {}{}",
+            o.made,
+            o.version,
+            match output_state(rec) {
+                OutputState::Stale(why) => format!(" -- STALE: {why}"),
+                _ => String::new(),
+            }
+        ));
+        let c = &o.counts;
+        notes.push(format!(
+            "counts: {} edge points horizontal, {} vertical; {} lines extracted, {} after post-processing",
+            c.edges_h, c.edges_v, c.lines_raw, c.lines
+        ));
+        let t = &o.timings;
+        notes.push(format!(
+            "timings: lens {:.1} ms, edges {:.1} ms, lines {:.1} ms, connect {:.1} ms",
+            t.lens_us as f64 / 1e3,
+            t.edges_us as f64 / 1e3,
+            t.lines_us as f64 / 1e3,
+            t.connect_us as f64 / 1e3
+        ));
+        notes.push("parameters:".into());
+        notes.extend(params_lines(&o.params));
+    } else {
+        notes.push("no stage outputs yet".into());
+    }
+    if !rec.edit.is_empty() {
+        notes.push(format!("manual edits ({}):", rec.edit.len()));
+        notes.extend(
+            rec.edit
+                .iter()
+                .map(|e| format!("  {} {} -> {} lines", e.at, e.op, e.lines)),
+        );
+    }
+    r.notes = notes;
+    Ok(r)
+}
+
+/// The parameters as `  edges.floor = 2` lines.
+pub fn params_lines(p: &crate::llv::Params) -> Vec<String> {
+    let Ok(text) = toml::to_string(p) else {
+        return vec!["  (parameters cannot be shown)".into()];
+    };
+    let mut section = String::new();
+    let mut out = Vec::new();
+    for line in text.lines().map(str::trim).filter(|l| !l.is_empty()) {
+        if let Some(s) = line.strip_prefix('[').and_then(|l| l.strip_suffix(']')) {
+            section = format!("{s}.");
+        } else {
+            out.push(format!("  {section}{line}"));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn params_are_listed_by_dotted_key() {
+        let lines = params_lines(&crate::llv::Params::default());
+        assert!(
+            lines.iter().any(|l| l == "  edges.half_width = 4"),
+            "{lines:?}"
+        );
+        assert!(lines.iter().any(|l| l.starts_with("  connect.wl = ")));
+    }
+
+    #[test]
+    fn numbered_inserts_the_image_number() {
+        assert_eq!(
+            numbered(Path::new("/t/out.svg"), 3),
+            Path::new("/t/out3.svg")
+        );
+    }
+}

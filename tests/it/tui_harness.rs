@@ -1,0 +1,416 @@
+//! The console in a real terminal, for the `tui_pty*` tests: the real `vss`
+//! binary started in a pseudo-terminal (portable-pty), its output read
+//! through a terminal emulator (vt100), keys written as a terminal sends
+//! them. Tests wait for screen states, never for fixed times, and name keys
+//! by what they do ([`Console::press`] reads the console's own key table).
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
+use ratatui::crossterm::event::KeyCode;
+use vss::tui::keymap::{Action, KEYMAP, Key, ModalAction, Scope, ScreenId, SurveyAction};
+
+/// A small, quick simulated cell: 128 × 128 images, short settle, three
+/// lightings (c ambient), four cameras.
+pub const PROFILE: &str = r#"
+name = "pty test cell"
+
+[relay]
+settle_ms = 5
+
+[[lights]]
+name = "left"
+relay = 0
+[[lights]]
+name = "right"
+relay = 1
+
+[[lighting]]
+letter = "a"
+on = ["left"]
+[[lighting]]
+letter = "b"
+on = ["right"]
+[[lighting]]
+letter = "c"
+on = []
+
+[survey]
+dir = "sessions"
+cameras = 4
+
+[sim]
+width = 128
+height = 128
+seed = 7
+noise = 1.0
+"#;
+
+/// The default cell's five lightings (four lights, then ambient) at 128 ×
+/// 128, with each camera's `.cdf` beside the profile so lens correction
+/// runs; `lens` sets `lens.enabled`.
+pub fn five_lightings(lens: bool) -> String {
+    format!(
+        r#"
+name = "five lightings"
+
+[relay]
+settle_ms = 5
+
+[[lights]]
+name = "lf"
+relay = 0
+[[lights]]
+name = "rf"
+relay = 1
+[[lights]]
+name = "lb"
+relay = 2
+[[lights]]
+name = "rb"
+relay = 3
+
+[[lighting]]
+letter = "a"
+on = ["lf"]
+[[lighting]]
+letter = "b"
+on = ["rf"]
+[[lighting]]
+letter = "c"
+on = ["lb"]
+[[lighting]]
+letter = "d"
+on = ["rb"]
+[[lighting]]
+letter = "e"
+on = []
+
+[survey]
+dir = "sessions"
+cameras = 2
+cdf = ["cam1.cdf", "cam2.cdf"]
+
+[sim]
+width = 128
+height = 128
+seed = 3
+noise = 1.0
+
+[llv.lens]
+enabled = {lens}
+"#
+    )
+}
+
+/// Writes the simulated cameras' `.cdf` files for 128 × 128 images.
+pub fn write_cdfs(dir: &Path, cameras: u32) {
+    for cam in 1..=cameras {
+        let cdf = vss::rig::sim::camera_cdf(cam, 128, 128).expect("a simulated camera");
+        vss::formats::cdf::write_cdf(&dir.join(format!("cam{cam}.cdf")), &cdf).unwrap();
+    }
+}
+
+#[allow(dead_code)] // each test module uses some of it
+pub struct Console {
+    pub master: Box<dyn MasterPty + Send>,
+    writer: Box<dyn Write + Send>,
+    pub child: Box<dyn Child + Send + Sync>,
+    parser: Arc<Mutex<vt100::Parser>>,
+    pub raw: Arc<Mutex<Vec<u8>>>,
+    pub dir: tempfile::TempDir,
+}
+
+#[allow(dead_code)]
+impl Console {
+    /// The console on [`PROFILE`].
+    pub fn start(cols: u16, rows: u16, env: &[(&str, &str)]) -> Console {
+        Console::start_with(PROFILE, cols, rows, env, |_| {})
+    }
+
+    /// The console on `profile` (written as `cell.toml` in a fresh folder,
+    /// after `setup` has put whatever else it needs there).
+    pub fn start_with(
+        profile: &str,
+        cols: u16,
+        rows: u16,
+        env: &[(&str, &str)],
+        setup: impl FnOnce(&Path),
+    ) -> Console {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("cell.toml"), profile).unwrap();
+        setup(dir.path());
+        Console::start_in(dir, cols, rows, env, &["--profile", "cell.toml"])
+    }
+
+    /// The console started in `dir` with `args`.
+    pub fn start_in(
+        dir: tempfile::TempDir,
+        cols: u16,
+        rows: u16,
+        env: &[(&str, &str)],
+        args: &[&str],
+    ) -> Console {
+        let pty = native_pty_system();
+        let size = PtySize {
+            rows,
+            cols,
+            pixel_width: 0,
+            pixel_height: 0,
+        };
+        let pair = pty.openpty(size).unwrap();
+        let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_vss"));
+        cmd.args(args);
+        cmd.cwd(dir.path());
+        cmd.env("TERM", "xterm-256color");
+        // The log file goes to the session folder or here, never to the
+        // tester's own state folder.
+        cmd.env("XDG_STATE_HOME", dir.path().join("state"));
+        cmd.env_remove("NO_COLOR");
+        for (k, v) in env {
+            cmd.env(k, v);
+        }
+        let child = pair.slave.spawn_command(cmd).unwrap();
+        drop(pair.slave);
+        let mut reader = pair.master.try_clone_reader().unwrap();
+        let writer = pair.master.take_writer().unwrap();
+        let parser = Arc::new(Mutex::new(vt100::Parser::new(rows, cols, 0)));
+        let raw = Arc::new(Mutex::new(Vec::new()));
+        let (p, r) = (parser.clone(), raw.clone());
+        std::thread::spawn(move || {
+            let mut buf = [0u8; 8192];
+            loop {
+                match reader.read(&mut buf) {
+                    Ok(0) | Err(_) => break,
+                    Ok(n) => {
+                        p.lock().unwrap().process(&buf[..n]);
+                        r.lock().unwrap().extend_from_slice(&buf[..n]);
+                    }
+                }
+            }
+        });
+        Console {
+            master: pair.master,
+            writer,
+            child,
+            parser,
+            raw,
+            dir,
+        }
+    }
+
+    /// Resizes the terminal: the parser first, under its lock, then the pty.
+    /// The console answers SIGWINCH with a clear and a full redraw; bytes it
+    /// wrote for the old size can only reach the parser before that clear,
+    /// so the screen read afterwards is the new size's (resizing the pty
+    /// first let a redraw be parsed at the old size).
+    pub fn resize(&mut self, rows: u16, cols: u16) {
+        let mut parser = self.parser.lock().unwrap();
+        parser.screen_mut().set_size(rows, cols);
+        self.master
+            .resize(PtySize {
+                rows,
+                cols,
+                pixel_width: 0,
+                pixel_height: 0,
+            })
+            .unwrap();
+        drop(parser);
+    }
+
+    pub fn screen(&self) -> String {
+        self.parser.lock().unwrap().screen().contents()
+    }
+
+    /// Runs `f` on the emulated screen (colours, attributes of cells).
+    pub fn with_screen<T>(&self, f: impl FnOnce(&vt100::Screen) -> T) -> T {
+        f(self.parser.lock().unwrap().screen())
+    }
+
+    /// Writes bytes as typed.
+    pub fn send(&mut self, keys: &str) {
+        self.writer.write_all(keys.as_bytes()).unwrap();
+        self.writer.flush().unwrap();
+    }
+
+    /// Presses the key the console's key table binds to `action` in
+    /// `scope` (its first binding).
+    pub fn press(&mut self, scope: Scope, action: Action) {
+        let k = key_of(scope, action);
+        self.send(&bytes(&k));
+    }
+
+    /// Answers the open question with yes.
+    pub fn yes(&mut self) {
+        self.press(Scope::Confirm, Action::Modal(ModalAction::Yes));
+    }
+
+    /// Waits until the screen satisfies `f`, or fails showing the screen.
+    pub fn wait(&self, what: &str, secs: u64, f: impl Fn(&str) -> bool) -> String {
+        let end = Instant::now() + Duration::from_secs(secs);
+        loop {
+            let s = self.screen();
+            if f(&s) {
+                return s;
+            }
+            if Instant::now() > end {
+                panic!("timed out waiting for {what}; screen:\n{s}");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    pub fn wait_text(&self, text: &str, secs: u64) -> String {
+        self.wait(text, secs, |s| s.contains(text))
+    }
+
+    pub fn wait_exit(&mut self, secs: u64) {
+        let end = Instant::now() + Duration::from_secs(secs);
+        while Instant::now() < end {
+            if self.child.try_wait().unwrap().is_some() {
+                // Let the reader drain the last bytes.
+                std::thread::sleep(Duration::from_millis(200));
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let _ = self.child.kill();
+        panic!("vss did not exit; screen:\n{}", self.screen());
+    }
+
+    pub fn sessions(&self) -> PathBuf {
+        self.dir.path().join("sessions")
+    }
+
+    pub fn session(&self) -> PathBuf {
+        self.sessions().join("cube")
+    }
+
+    /// Creates session `name` by keys.
+    pub fn create_session(&mut self, name: &str) {
+        self.wait_text("choose a session", 10);
+        self.press(SURVEY, Action::Survey(SurveyAction::NewSession));
+        self.wait_text("new session name", 5);
+        self.send(name);
+        self.send("\r");
+        self.wait_text(&format!("session {name}"), 10);
+    }
+
+    /// Captures and runs the survey's current image (Survey screen) and
+    /// waits for its review.
+    pub fn capture_current(&mut self, k: u32) {
+        self.wait_text(&format!("Image {k}: camera"), 20);
+        self.press(SURVEY, Action::Survey(SurveyAction::Enter));
+        self.wait(&format!("image {k} reviewed"), 60, |s| {
+            s.contains(&format!("Image {k}: ")) && s.contains("before CONNECT")
+        });
+    }
+
+    /// Creates session `cube` and surveys `n` images by keys alone.
+    pub fn survey(&mut self, n: u32) {
+        self.create_session("cube");
+        for k in 1..=n {
+            self.capture_current(k);
+            self.press(SURVEY, Action::Survey(SurveyAction::Accept));
+            self.wait_text(&format!("Image {}: camera", k + 1), 20);
+        }
+    }
+}
+
+impl Drop for Console {
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+        }
+    }
+}
+
+pub const SURVEY: Scope = Scope::Screen(ScreenId::Survey);
+pub const PIPELINE: Scope = Scope::Screen(ScreenId::Pipeline);
+#[allow(dead_code)]
+pub const EDIT: Scope = Scope::Screen(ScreenId::Edit);
+#[allow(dead_code)]
+pub const SESSION: Scope = Scope::Screen(ScreenId::Session);
+
+/// The first key the table binds to `action` in `scope` (or globally).
+pub fn key_of(scope: Scope, action: Action) -> Key {
+    KEYMAP
+        .iter()
+        .find(|b| b.scope == scope && b.action == action)
+        .or_else(|| {
+            KEYMAP
+                .iter()
+                .find(|b| b.scope == Scope::Global && b.action == action)
+        })
+        .map(|b| b.key)
+        .unwrap_or_else(|| panic!("no key for {action:?} in {scope:?}"))
+}
+
+/// The bytes an xterm sends for a key.
+pub fn bytes(k: &Key) -> String {
+    let mods = 1 + u8::from(k.shift) + 4 * u8::from(k.ctrl);
+    let csi = |c: char| {
+        if mods > 1 {
+            format!("\x1b[1;{mods}{c}")
+        } else {
+            format!("\x1b[{c}")
+        }
+    };
+    match k.code {
+        KeyCode::Char(c) if k.ctrl => ((c as u8 & 0x1f) as char).to_string(),
+        KeyCode::Char(c) => c.to_string(),
+        KeyCode::Enter => "\r".into(),
+        KeyCode::Esc => "\x1b".into(),
+        KeyCode::Tab => "\t".into(),
+        KeyCode::BackTab => "\x1b[Z".into(),
+        KeyCode::Backspace => "\x7f".into(),
+        KeyCode::Up => csi('A'),
+        KeyCode::Down => csi('B'),
+        KeyCode::Right => csi('C'),
+        KeyCode::Left => csi('D'),
+        KeyCode::Home => csi('H'),
+        KeyCode::End => csi('F'),
+        KeyCode::PageUp => "\x1b[5~".into(),
+        KeyCode::PageDown => "\x1b[6~".into(),
+        KeyCode::Delete => "\x1b[3~".into(),
+        other => panic!("no bytes known for {other:?}"),
+    }
+}
+
+/// The value the parameter panel shows for `key` (`None` when the row is
+/// not on screen).
+pub fn panel_value(screen: &str, key: &str) -> Option<String> {
+    // Rows of the panel start at its border; the log also names keys.
+    screen.lines().find_map(|l| {
+        let at = ["│", "|"]
+            .iter()
+            .find_map(|b| l.starts_with(&format!("{b}{key} ")).then_some(b.len()))?;
+        let rest = l[at + key.len()..].trim_start();
+        let v: String = rest
+            .chars()
+            .take_while(|c| !c.is_whitespace() && !matches!(c, '│' | '|' | '*'))
+            .collect();
+        (!v.is_empty()).then_some(v)
+    })
+}
+
+/// The line count the Pipeline screen shows as `lines N raw M`.
+pub fn line_count(screen: &str) -> Option<usize> {
+    screen.match_indices("lines ").find_map(|(i, l)| {
+        let rest = &screen[i + l.len()..];
+        let digits: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
+        let after = &rest[digits.len()..];
+        if digits.is_empty() || !after.starts_with(" raw") {
+            return None;
+        }
+        digits.parse().ok()
+    })
+}
+
+/// Whether `dir` holds a file `name`.
+pub fn exists(dir: &Path, name: &str) -> bool {
+    dir.join(name).is_file()
+}

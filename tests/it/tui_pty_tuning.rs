@@ -1,0 +1,151 @@
+//! Tuning through the real console (a pty, 80 × 24): every LLV parameter
+//! is changed and changed back on a captured image of five lightings (an
+//! ambient one among them), with lens correction on and off. After each
+//! change the screen shows the new value with outputs made from it (no
+//! "stale", no pipeline error), and the save key writes outputs whose
+//! recorded parameters and line count are those on screen.
+//!
+//! With lens correction on, a new `edges.half_width` or `edges.noise_factor`
+//! once failed on every other key press ("image sizes differ: (512, 512)
+//! and (0, 0)": the corrected ambient image was missing from the re-run)
+//! while the panel showed the new value, and the save key wrote the old
+//! value's outputs.
+
+use std::time::{Duration, Instant};
+
+use vss::llv::params::{Kind, PARAMS};
+use vss::session::Session;
+use vss::tui::keymap::{Action, PipelineAction};
+
+use super::tui_harness::{Console, PIPELINE, five_lightings, line_count, panel_value, write_cdfs};
+
+/// The parameter values and line count of image 1's saved outputs.
+fn saved(c: &Console) -> Option<(vss::llv::Params, usize)> {
+    let s = Session::inspect(&c.session()).ok()?;
+    let o = s.manifest().image(1)?.outputs.clone()?;
+    Some((o.params, o.counts.lines as usize))
+}
+
+/// Waits for the saved outputs to carry `key = value`.
+fn wait_saved(c: &Console, key: &str, value: f64) -> (vss::llv::Params, usize) {
+    let end = Instant::now() + Duration::from_secs(20);
+    loop {
+        if let Some((p, n)) = saved(c)
+            && p.get(key) == Some(value)
+        {
+            return (p, n);
+        }
+        assert!(
+            Instant::now() < end,
+            "outputs with {key} = {value} never saved; screen:\n{}",
+            c.screen()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn every_parameter(lens: bool) {
+    let mut c = Console::start_with(&five_lightings(lens), 80, 24, &[], |d| write_cdfs(d, 2));
+    c.create_session("cube");
+    c.capture_current(1);
+    c.send("3");
+    c.wait_text("parameters", 10);
+    let mut values = vss::llv::Params::default();
+    values.lens.enabled = lens;
+    for (i, sp) in PARAMS.iter().enumerate() {
+        if i > 0 {
+            c.press(PIPELINE, Action::Pipeline(PipelineAction::ParamNext));
+        }
+        // Keys are taken in order: the change below goes to this parameter.
+        let now = values.get(sp.key).unwrap();
+        let up = match sp.kind {
+            Kind::Bool => now == 0.0,
+            _ => now + sp.step <= sp.max,
+        };
+        let changed = if up { now + sp.step } else { now - sp.step };
+        let changed = if sp.kind == Kind::Bool {
+            changed.clamp(0.0, 1.0)
+        } else {
+            changed
+        };
+        for (target, action) in [
+            (
+                changed,
+                if up {
+                    PipelineAction::Inc
+                } else {
+                    PipelineAction::Dec
+                },
+            ),
+            (
+                now,
+                if up {
+                    PipelineAction::Dec
+                } else {
+                    PipelineAction::Inc
+                },
+            ),
+        ] {
+            c.press(PIPELINE, Action::Pipeline(action));
+            let s = c.wait(&format!("{} = {target} run", sp.key), 20, |s| {
+                panel_value(s, sp.key).and_then(|v| v.parse::<f64>().ok()) == Some(target)
+                    && !s.contains("running")
+            });
+            assert!(
+                !s.contains("stale") && !s.contains("pipeline:"),
+                "{} = {target} (lens {lens}): the outputs on screen are not the panel's:\n{s}",
+                sp.key
+            );
+            let shown = line_count(&s).expect("a line count on the Pipeline screen");
+            c.press(PIPELINE, Action::Pipeline(PipelineAction::Save));
+            // Once saved, image 1 is accepted: saving over it asks.
+            let s = c.wait("saved, or the question", 10, |s| {
+                s.contains("Replace its saved outputs")
+                    || saved(&c).is_some_and(|(p, _)| p.get(sp.key) == Some(target))
+            });
+            if s.contains("Replace its saved outputs") {
+                c.yes();
+            }
+            let (p, n) = wait_saved(&c, sp.key, target);
+            values.set(sp.key, target).unwrap();
+            assert_eq!(
+                p, values,
+                "saved with the panel's values ({} = {target})",
+                sp.key
+            );
+            assert_eq!(
+                n, shown,
+                "saved the line count on screen ({} = {target})",
+                sp.key
+            );
+        }
+    }
+    if lens {
+        let m = Session::inspect(&c.session()).unwrap();
+        let files = &m
+            .manifest()
+            .image(1)
+            .unwrap()
+            .outputs
+            .as_ref()
+            .unwrap()
+            .files;
+        assert!(
+            files.iter().any(|f| f.file == "cube1a.imc"),
+            "lens-corrected images among the outputs: {files:?}"
+        );
+    }
+    let s = c.screen();
+    assert!(!s.contains("pipeline:"), "{s}");
+    c.send("q");
+}
+
+#[test]
+fn every_parameter_with_lens_correction() {
+    every_parameter(true);
+}
+
+#[test]
+fn every_parameter_without_lens_correction() {
+    every_parameter(false);
+}
