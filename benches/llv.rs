@@ -1,13 +1,16 @@
 //! LLV benchmarks (divan): each stage and the whole single-image pipeline at
-//! 512² and 2048², on one core, on a realistic scene (anti-aliased polygons
-//! with noise σ = 2, `tests/it/support/llv_scene.rs`). Lens correction uses a
+//! 512² and 2048², on one thread (`edges.threads = 1`, the default) and, for
+//! the pipeline, on two; on a realistic scene (anti-aliased polygons with
+//! noise σ = 2, `tests/it/support/llv_scene.rs`). Lens correction uses a
 //! precomputed map of a distorting camera. Run: `cargo bench --bench llv`.
 
 use divan::{Bencher, black_box};
 use vss::llv::connect::{ConnectScratch, connect_into};
-use vss::llv::edges::{PeakScratch, Response, ResponseScratch, exact_response_into, peaks_into};
+use vss::llv::edges::{
+    NoiseMap, PeakMap, PeakScratch, Response, ResponseScratch, detect_into, exact_response_into,
+};
 use vss::llv::lens::{CameraModel, LensMap, correct_into};
-use vss::llv::lines::{LineScratch, extract_into};
+use vss::llv::lines::{LineScratch, track_into};
 use vss::llv::pipeline::{Input, StageOutputs, Workspace};
 use vss::llv::{EdgePoints, GreyImage, Params, ScanDir};
 
@@ -56,32 +59,62 @@ fn lens_correct(b: Bencher, n: usize) {
     });
 }
 
+/// Response, noise scale, peak map and edge points, both directions.
 #[divan::bench(args = SIZES)]
 fn edges_both_directions(b: Bencher, n: usize) {
     let img = image(n);
     let p = Params::default();
+    let t = p.lines.track_sigmas;
     let (mut rh, mut rv) = (Response::default(), Response::default());
     let (mut eh, mut ev) = (EdgePoints::default(), EdgePoints::default());
+    let (mut nh, mut nv) = (NoiseMap::default(), NoiseMap::default());
+    let (mut mh, mut mv) = (PeakMap::default(), PeakMap::default());
     let mut counts = ResponseScratch::default();
     let mut ps = PeakScratch::default();
     b.bench_local(|| {
         let img = black_box(&img);
         exact_response_into(img, ScanDir::Horizontal, 4, &mut rh, &mut counts).expect("size");
         exact_response_into(img, ScanDir::Vertical, 4, &mut rv, &mut counts).expect("size");
-        peaks_into(&rh, &p.edges, &mut eh, &mut ps);
-        peaks_into(&rv, &p.edges, &mut ev, &mut ps);
+        detect_into(&rh, &p.edges, t, &mut nh, &mut mh, &mut eh, &mut ps);
+        detect_into(&rv, &p.edges, t, &mut nv, &mut mv, &mut ev, &mut ps);
     });
 }
 
+/// The line extractor on both directions' responses and edge points.
 #[divan::bench(args = SIZES)]
 fn lines_both_directions(b: Bencher, n: usize) {
     let o = outputs(n);
     let p = Params::default();
     let mut s = LineScratch::default();
     let (mut lh, mut lv) = (Vec::new(), Vec::new());
+    // The peak maps as the edge stage leaves them.
+    let (mut mh, mut mv) = (PeakMap::default(), PeakMap::default());
+    let (mut nh, mut nv) = (NoiseMap::default(), NoiseMap::default());
+    let (mut eh, mut ev) = (EdgePoints::default(), EdgePoints::default());
+    let (t, mut ps) = (p.lines.track_sigmas, PeakScratch::default());
+    detect_into(
+        &o.response_h,
+        &p.edges,
+        t,
+        &mut nh,
+        &mut mh,
+        &mut eh,
+        &mut ps,
+    );
+    detect_into(
+        &o.response_v,
+        &p.edges,
+        t,
+        &mut nv,
+        &mut mv,
+        &mut ev,
+        &mut ps,
+    );
+    let (f, a) = (p.edges.floor, p.edges.half_width as usize);
     b.bench_local(|| {
-        extract_into(black_box(&o.edges_h), &p.lines, &mut lh, &mut s);
-        extract_into(black_box(&o.edges_v), &p.lines, &mut lv, &mut s);
+        let (rh, rv) = (black_box(&o.response_h), black_box(&o.response_v));
+        track_into(rh, &nh, &mh, &eh, f, a, &p.lines, &mut lh, &mut s);
+        track_into(rv, &nv, &mv, &ev, f, a, &p.lines, &mut lv, &mut s);
     });
 }
 
@@ -120,6 +153,26 @@ fn pipeline_no_lens(b: Bencher, n: usize) {
     let img = image(n);
     let p = Params::default();
     let input = Input::single(&img);
+    let mut ws = Workspace::new();
+    ws.run(&input, &p).expect("runs");
+    b.bench_local(|| {
+        ws.run(black_box(&input), &p).expect("runs");
+    });
+}
+
+/// The pipeline with lens correction on two threads, one for each scan
+/// direction (`edges.threads = 2`).
+#[divan::bench(args = SIZES)]
+fn pipeline_two_threads(b: Bencher, n: usize) {
+    let img = image(n);
+    let map = lens_map(n);
+    let mut p = Params::default();
+    p.edges.threads = 2;
+    let input = Input {
+        images: std::slice::from_ref(&img),
+        ambient: None,
+        lens: Some(&map),
+    };
     let mut ws = Workspace::new();
     ws.run(&input, &p).expect("runs");
     b.bench_local(|| {

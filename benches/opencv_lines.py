@@ -1,58 +1,187 @@
-"""OpenCV's line detectors on the LLV bench scene, for scale (issue 3).
-
-Times FLD, EDLines and LSD on one core on the same 512² image the LLV
-benchmarks use (`tests/it/support/llv_scene.rs`, noise σ 2, seed 42), so that
-their figures and `cargo bench --bench llv` come from the same machine:
+"""vss beside OpenCV's line detectors (FLD, EDLines, LSD) and, when built,
+ELSED: the same images, the same run, the same scorer, one thread each.
 
     pip install opencv-contrib-python-headless
-    cargo run --release --example llv_count scene /tmp/scene.pgm
-    python3 benches/opencv_lines.py /tmp/scene.pgm
+    cargo build --release
+    python3 benches/opencv_lines.py compare [--elsed /work/peers/elsed_bench]
 
-Prints the fastest and the median of N runs (default 200; LSD 50) and the
-number of segments each found. Not part of the test suite.
+`compare` does, in one run:
+1. `vss selftest --export DIR`: both families of synthetic scenes (cubes at
+   noise σ 2, 5, 10; yard at σ 0, 2, 5, 10 and signal-dependent) as PGM,
+   their truth, and vss's segments, vss timed in-process (warm workspace,
+   fastest and median of RUNS per image);
+2. FLD, EDLines and LSD (default parameters) on every image in this
+   process, one thread (cv2.setNumThreads(1)), fastest and median of RUNS
+   per image after one warm-up; their segments and times beside vss's;
+3. the ELSED driver (benches/elsed_bench.cpp, built as benches/README.md
+   says) on the same images, if --elsed names it;
+4. `vss selftest --score DIR`: every detector scored by vss's scorer (same
+   matching rule, don't-care edges), one table per family and noise level;
+   the JSON goes to DIR/scores.json.
+
+Options: --vss BIN (default target/release/vss), --dir DIR (default
+/tmp/vss-compare), --scenes N (12), --size N (512), --runs N (20),
+--family cubes|yard|all (all), --skip-export (reuse DIR's images, re-run
+the peers and the scoring).
+
+The older use, timing the three on one image, still works:
+
+    cargo run --release --example llv_count scene /tmp/scene.pgm
+    python3 benches/opencv_lines.py /tmp/scene.pgm [RUNS]
+
+Not part of the test suite.
 """
 
+import argparse
+import json
+import os
 import statistics
+import subprocess
 import sys
 import time
 
 import cv2
 
 
-def bench(name, detect, runs):
-    detect()  # warm-up
+def detectors():
+    """The OpenCV detectors, each a function from image to an (N, 4) list."""
+    fld = cv2.ximgproc.createFastLineDetector()
+    ed = cv2.ximgproc.createEdgeDrawing()
+    lsd = cv2.createLineSegmentDetector()
+
+    def edlines(img):
+        ed.detectEdges(img)
+        return ed.detectLines()
+
+    return [
+        ("FLD", fld.detect),
+        ("EDLines", edlines),
+        ("LSD", lambda img: lsd.detect(img)[0]),
+    ]
+
+
+def timed(detect, img, runs):
+    detect(img)  # warm-up
     times = []
-    for _ in range(runs):
+    found = None
+    for _ in range(max(runs, 1)):
         t = time.perf_counter()
-        found = detect()
-        times.append(time.perf_counter() - t)
+        found = detect(img)
+        times.append((time.perf_counter() - t) * 1e3)
+    times.sort()
+    # Nearest-rank median, as vss's own times.
+    return found, times[0], times[(len(times) + 1) // 2 - 1]
+
+
+def rows(found):
+    if found is None:
+        return []
+    return [tuple(float(v) for v in s.reshape(-1)[:4]) for s in found]
+
+
+def write_segments(path, name, segs):
+    with open(path, "w") as f:
+        f.write(f"# x0 y0 x1 y1 ({name}, OpenCV {cv2.__version__}, default parameters)\n")
+        for s in segs:
+            f.write("%.6f %.6f %.6f %.6f\n" % s)
+
+
+def level_dirs(root):
+    with open(os.path.join(root, "manifest.json")) as f:
+        manifest = json.load(f)
+    for fam in manifest["families"]:
+        for level in fam["levels"]:
+            d = os.path.join(root, fam["name"], level)
+            stems = [f"s{i:02d}" for i in range(fam["scenes"])]
+            yield fam["name"], level, d, stems
+
+
+def run_peers(root, runs, elsed):
+    dets = detectors()
+    for family, level, d, stems in level_dirs(root):
+        times = {name: [] for name, _ in dets}
+        for stem in stems:
+            pgm = os.path.join(d, stem + ".pgm")
+            img = cv2.imread(pgm, cv2.IMREAD_GRAYSCALE)
+            if img is None:
+                sys.exit(f"{pgm}: not an image OpenCV can read; run the export again")
+            for name, detect in dets:
+                found, fastest, median = timed(detect, img, runs)
+                write_segments(os.path.join(d, f"{stem}.{name}.seg"), name, rows(found))
+                times[name].append((stem, fastest, median))
+        for name, t in times.items():
+            with open(os.path.join(d, f"{name}.times"), "w") as f:
+                f.write(f"# scene fastest_ms median_ms runs ({name}, in-process, one thread)\n")
+                for stem, fastest, median in t:
+                    f.write(f"{stem} {fastest:.4f} {median:.4f} {runs}\n")
+        if elsed:
+            pgms = [os.path.join(d, s + ".pgm") for s in stems]
+            out = subprocess.run(
+                [elsed, str(runs), "ELSED", *pgms], check=True, capture_output=True, text=True
+            ).stdout
+            with open(os.path.join(d, "ELSED.times"), "w") as f:
+                f.write("# scene fastest_ms median_ms runs (ELSED, C++, in-process, one thread)\n")
+                for line in out.splitlines():
+                    path, fastest, median, n = line.split()
+                    stem = os.path.basename(path)[: -len(".pgm")]
+                    f.write(f"{stem} {fastest} {median} {n}\n")
+        print(f"{family}/{level}: peers done", file=sys.stderr)
+
+
+def compare(argv):
+    p = argparse.ArgumentParser(prog="opencv_lines.py compare")
+    p.add_argument("--vss", default="target/release/vss")
+    p.add_argument("--dir", default="/tmp/vss-compare")
+    p.add_argument("--scenes", type=int, default=12)
+    p.add_argument("--size", type=int, default=512)
+    p.add_argument("--runs", type=int, default=20)
+    p.add_argument("--family", default="all")
+    p.add_argument("--elsed", default=None, help="the ELSED driver (benches/elsed_bench.cpp)")
+    p.add_argument("--skip-export", action="store_true")
+    a = p.parse_args(argv)
+    cv2.setNumThreads(1)
+    print(f"OpenCV {cv2.__version__}, one thread; vss {a.vss}", file=sys.stderr)
+    if not a.skip_export:
+        subprocess.run(
+            [a.vss, "selftest", "--export", a.dir, "--family", a.family,
+             "--scenes", str(a.scenes), "--size", str(a.size), "--runs", str(a.runs)],
+            check=True,
+        )
+    run_peers(a.dir, a.runs, a.elsed)
+    table = subprocess.run([a.vss, "selftest", "--score", a.dir], check=True,
+                           capture_output=True, text=True).stdout
+    print(table, end="")
+    scores = subprocess.run([a.vss, "selftest", "--score", a.dir, "--json"], check=True,
+                            capture_output=True, text=True).stdout
+    with open(os.path.join(a.dir, "scores.json"), "w") as f:
+        f.write(scores)
+
+
+def bench(name, detect, runs):
+    found, fastest, median = timed(detect, bench.img, runs)
     n = 0 if found is None else len(found)
-    print(
-        f"{name:8} fastest {min(times) * 1e3:6.3f} ms  "
-        f"median {statistics.median(times) * 1e3:6.3f} ms  segments {n}"
-    )
+    print(f"{name:8} fastest {fastest:6.3f} ms  median {median:6.3f} ms  segments {n}")
+
+
+def one_image(argv):
+    img = cv2.imread(argv[0], cv2.IMREAD_GRAYSCALE)
+    if img is None:
+        sys.exit(f"{argv[0]}: not an image OpenCV can read")
+    runs = int(argv[1]) if len(argv) > 1 else 200
+    cv2.setNumThreads(1)
+    print(f"OpenCV {cv2.__version__}, {img.shape[1]}x{img.shape[0]}, one thread")
+    bench.img = img
+    for name, detect in detectors():
+        bench(name, detect, max(runs // 4, 1) if name == "LSD" else runs)
 
 
 def main():
     if len(sys.argv) < 2:
-        sys.exit("usage: opencv_lines.py SCENE.pgm [RUNS]")
-    img = cv2.imread(sys.argv[1], cv2.IMREAD_GRAYSCALE)
-    if img is None:
-        sys.exit(f"{sys.argv[1]}: not an image OpenCV can read")
-    runs = int(sys.argv[2]) if len(sys.argv) > 2 else 200
-    cv2.setNumThreads(1)
-    print(f"OpenCV {cv2.__version__}, {img.shape[1]}x{img.shape[0]}, one thread")
-    fld = cv2.ximgproc.createFastLineDetector()
-    bench("FLD", lambda: fld.detect(img), runs)
-    ed = cv2.ximgproc.createEdgeDrawing()
-
-    def edlines():
-        ed.detectEdges(img)
-        return ed.detectLines()
-
-    bench("EDLines", edlines, runs)
-    lsd = cv2.createLineSegmentDetector()
-    bench("LSD", lambda: lsd.detect(img)[0], max(runs // 4, 1))
+        sys.exit("usage: opencv_lines.py compare [OPTIONS] | opencv_lines.py SCENE.pgm [RUNS]")
+    if sys.argv[1] == "compare":
+        compare(sys.argv[2:])
+    else:
+        one_image(sys.argv[1:])
 
 
 if __name__ == "__main__":

@@ -6,7 +6,7 @@
 //! line extraction and CONNECT.
 
 use divan::{Bencher, black_box};
-use vss::llv::edges::{PeakScratch, Response, peaks_into};
+use vss::llv::edges::{NoiseMap, PeakMap, PeakScratch, Response, detect_into};
 use vss::llv::photometric::{PhotoScratch, combined_response, combined_response_into};
 use vss::llv::pipeline::{Input, Workspace};
 use vss::llv::synth::{self, PointLight, RenderOptions};
@@ -61,6 +61,9 @@ fn combined_edges_both_directions(b: Bencher) {
     let mut ps = PeakScratch::default();
     let (mut rh, mut rv) = (Response::default(), Response::default());
     let (mut eh, mut ev) = (EdgePoints::default(), EdgePoints::default());
+    let (mut nh, mut nv) = (NoiseMap::default(), NoiseMap::default());
+    let (mut mh, mut mv) = (PeakMap::default(), PeakMap::default());
+    let t = p.lines.track_sigmas;
     b.bench_local(|| {
         let (lit, amb) = (black_box(&lit), black_box(&amb));
         combined_response_into(
@@ -74,8 +77,8 @@ fn combined_edges_both_directions(b: Bencher) {
         .expect("same size");
         combined_response_into(lit, Some(amb), ScanDir::Vertical, &p.edges, &mut rv, &mut s)
             .expect("same size");
-        peaks_into(&rh, &p.edges, &mut eh, &mut ps);
-        peaks_into(&rv, &p.edges, &mut ev, &mut ps);
+        detect_into(&rh, &p.edges, t, &mut nh, &mut mh, &mut eh, &mut ps);
+        detect_into(&rv, &p.edges, t, &mut nv, &mut mv, &mut ev, &mut ps);
     });
 }
 

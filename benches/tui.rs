@@ -1,4 +1,4 @@
-//! Console benchmarks (issue 7).
+//! Console benchmarks.
 //!
 //! Timed by divan: a parameter key press on a 512 × 512 survey image (five
 //! lightings of the simulated cell) → `App::update` → the pipeline re-run
@@ -75,6 +75,7 @@ fn ready() -> (App, Engine) {
         Look {
             mode: PreviewMode::Blocks,
             colour: true,
+            c256: true,
         },
     );
     app.update(Msg::Store(StoreEvent::Opened(SessionView {
@@ -105,7 +106,7 @@ fn key(code: KeyCode) -> Msg {
 fn run_pipeline(app: &mut App, engine: &mut Engine, cmds: Vec<Cmd>) {
     for c in cmds {
         if let Cmd::Pipeline(req) = c {
-            let outcome = engine.process(&req).map_err(|e| e.to_string());
+            let outcome = engine.process(&req);
             app.update(Msg::Pipeline(PipelineResult {
                 generation: req.generation,
                 image_key: req.image_key,
@@ -161,7 +162,8 @@ fn tweak_bytes(param: &str, key_char: char, presses: usize) -> Vec<(usize, usize
     term.draw(|f| f.render_widget(&app, f.area()))
         .expect("draw");
     let lines = |app: &App| {
-        app.current
+        app.tracker
+            .current
             .as_ref()
             .and_then(|c| c.outputs.as_ref())
             .map_or(0, |o| o.lines.len())
@@ -289,12 +291,18 @@ fn binary_figures() -> Option<(Duration, u64)> {
     send("n");
     send("bench\r");
     for k in 1..=5 {
+        // Past the plan (one image per camera), another image is asked for.
+        if wait("Survey complete", 1) {
+            send("\r");
+            wait("beyond the plan?", 10).then_some(())?;
+            send("y");
+        }
         wait(&format!("Image {k}: camera"), 30).then_some(())?;
         send("\r");
         wait("before CONNECT", 120).then_some(())?;
         send("a");
+        wait(&format!("image {k} accepted"), 30).then_some(())?;
     }
-    wait("Image 6: camera", 30).then_some(())?;
     let pid = child.process_id()?;
     let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
     let hwm_kib: u64 = status

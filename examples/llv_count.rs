@@ -9,16 +9,18 @@
 //!
 //! Instructions per run = (total at N = 15 − total at N = 5) / 10, which
 //! takes out the scene's rendering and the warm-up. Stages: `pipeline`
-//! (edges, lines, CONNECT; no lens), `edges` (response and peaks, both
-//! directions), `response`, `peaks` (`peaks_h`, `peaks_v`: one direction),
-//! `lines`, `split` (the pipeline's stages with each scan direction on a
-//! thread of its own, then CONNECT without corners: what two cores would
-//! give; time it, its instruction count means nothing); `scene FILE.pgm`
-//! writes the scene.
+//! (edges, lines, CONNECT; no lens), `pipeline2` (the same with a thread for
+//! each scan direction: time it, its instruction count means little),
+//! `edges` (response, noise scale and edge points, both directions),
+//! `response`, `noise`, `peaks`, `lines`, `connect`; `scene FILE.pgm` writes
+//! the scene.
 
 use vss::llv::connect::{ConnectScratch, connect_into};
-use vss::llv::edges::{PeakScratch, Response, ResponseScratch, exact_response_into, peaks_into};
-use vss::llv::lines::{LineScratch, extract_into};
+use vss::llv::edges::{
+    KeyBuf, NoiseMap, NoiseScratch, PeakMap, PeakScratch, Response, ResponseScratch, detect_into,
+    exact_response_into, peaks_into,
+};
+use vss::llv::lines::{LineScratch, track_into};
 use vss::llv::pipeline::{Input, Workspace};
 use vss::llv::{EdgePoints, Params, ScanDir};
 
@@ -29,7 +31,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let (Some(stage), Some(n)) = (args.get(1), args.get(2)) else {
         eprintln!(
-            "usage: llv_count pipeline|edges|response|peaks|peaks_h|peaks_v|lines|split N | scene FILE.pgm"
+            "usage: llv_count pipeline|pipeline2|edges|response|noise|peaks|lines|connect N | scene FILE.pgm"
         );
         std::process::exit(2);
     };
@@ -46,71 +48,99 @@ fn main() {
         eprintln!("N must be a whole number, not {n:?}");
         std::process::exit(2);
     };
-    let p = Params::default();
+    let mut p = Params::default();
+    if stage == "pipeline2" {
+        p.edges.threads = 2;
+    }
     let a = p.edges.half_width as usize;
     let mut ws = Workspace::new();
     ws.run(&Input::single(&img), &p).expect("the scene runs");
     let warm = ws.outputs().clone();
     let (mut rh, mut rv) = (Response::default(), Response::default());
     let (mut eh, mut ev) = (EdgePoints::default(), EdgePoints::default());
+    let (mut nh, mut nv) = (NoiseMap::default(), NoiseMap::default());
+    let (mut mh, mut mv) = (PeakMap::default(), PeakMap::default());
+    // The peak maps of the warm outputs, for the line stage alone.
+    let (mut wmh, mut wmv) = (PeakMap::default(), PeakMap::default());
+    for (r, nm, m) in [
+        (&warm.response_h, &warm.noise_h, &mut wmh),
+        (&warm.response_v, &warm.noise_v, &mut wmv),
+    ] {
+        let mut kb = KeyBuf::default();
+        let k = r.keys(&mut kb);
+        m.build_into(
+            &k,
+            nm,
+            p.edges.floor,
+            p.lines.track_sigmas,
+            p.edges.noise_sigmas,
+            &mut PeakScratch::default(),
+        );
+    }
     let mut rs = ResponseScratch::default();
     let mut ps = PeakScratch::default();
+    let mut ns = NoiseScratch::default();
+    let (mut kh, mut kv) = (KeyBuf::default(), KeyBuf::default());
     let mut ls = LineScratch::default();
     let (mut lh, mut lv) = (Vec::new(), Vec::new());
-    let mut response = |rh: &mut Response, rv: &mut Response| {
-        exact_response_into(&img, ScanDir::Horizontal, a, rh, &mut rs).expect("size");
-        exact_response_into(&img, ScanDir::Vertical, a, rv, &mut rs).expect("size");
-    };
-    if stage.starts_with("peaks") {
-        response(&mut rh, &mut rv);
-    }
-    let (mut split_h, mut split_v) = Default::default();
     let (mut joined, mut cs) = (Vec::new(), ConnectScratch::default());
     let mut check = 0usize;
     for _ in 0..n {
         match stage.as_str() {
-            "pipeline" => {
+            "pipeline" | "pipeline2" => {
                 ws.run(&Input::single(&img), &p).expect("the scene runs");
                 check += ws.outputs().lines.len();
             }
-            "edges" | "response" | "peaks" | "peaks_h" | "peaks_v" => {
-                if !stage.starts_with("peaks") {
-                    response(&mut rh, &mut rv);
-                }
-                if stage != "response" && stage != "peaks_v" {
-                    peaks_into(&rh, &p.edges, &mut eh, &mut ps);
-                }
-                if stage != "response" && stage != "peaks_h" {
-                    peaks_into(&rv, &p.edges, &mut ev, &mut ps);
+            "edges" | "response" => {
+                exact_response_into(&img, ScanDir::Horizontal, a, &mut rh, &mut rs).expect("size");
+                exact_response_into(&img, ScanDir::Vertical, a, &mut rv, &mut rs).expect("size");
+                if stage == "edges" {
+                    let t = p.lines.track_sigmas;
+                    detect_into(&rh, &p.edges, t, &mut nh, &mut mh, &mut eh, &mut ps);
+                    detect_into(&rv, &p.edges, t, &mut nv, &mut mv, &mut ev, &mut ps);
                 }
                 check += eh.points.len() + ev.points.len();
             }
+            "noise" => {
+                nh.estimate_into(&warm.response_h.keys(&mut kh), &mut ns);
+                nv.estimate_into(&warm.response_v.keys(&mut kv), &mut ns);
+                check += nh.tiles().0;
+            }
+            "peaks" => {
+                let t = p.lines.track_sigmas.min(p.edges.noise_sigmas);
+                for (r, nm, m, e) in [
+                    (&warm.response_h, &warm.noise_h, &mut mh, &mut eh),
+                    (&warm.response_v, &warm.noise_v, &mut mv, &mut ev),
+                ] {
+                    let k = r.keys(&mut kh);
+                    m.build_into(&k, nm, p.edges.floor, t, p.edges.noise_sigmas, &mut ps);
+                    peaks_into(&k, nm, m, &p.edges, e, &mut ps);
+                    check += e.points.len();
+                }
+            }
             "lines" => {
-                extract_into(&warm.edges_h, &p.lines, &mut lh, &mut ls);
-                extract_into(&warm.edges_v, &p.lines, &mut lv, &mut ls);
+                for (r, nm, m, e, out) in [
+                    (
+                        &warm.response_h,
+                        &warm.noise_h,
+                        &wmh,
+                        &warm.edges_h,
+                        &mut lh,
+                    ),
+                    (
+                        &warm.response_v,
+                        &warm.noise_v,
+                        &wmv,
+                        &warm.edges_v,
+                        &mut lv,
+                    ),
+                ] {
+                    track_into(r, nm, m, e, p.edges.floor, a, &p.lines, out, &mut ls);
+                }
                 check += lh.len() + lv.len();
             }
-            "split" => {
-                // What two cores would give: each scan direction's response,
-                // peaks and lines on a thread of its own (a scoped thread a
-                // run, as a plain implementation would), then CONNECT.
-                let img = &img;
-                let one =
-                    |dir,
-                     r: &mut Response,
-                     e: &mut EdgePoints,
-                     l: &mut Vec<_>,
-                     sc: &mut (ResponseScratch, PeakScratch, LineScratch)| {
-                        exact_response_into(img, dir, a, r, &mut sc.0).expect("size");
-                        peaks_into(r, &p.edges, e, &mut sc.1);
-                        extract_into(e, &p.lines, l, &mut sc.2);
-                    };
-                std::thread::scope(|s| {
-                    s.spawn(|| one(ScanDir::Vertical, &mut rv, &mut ev, &mut lv, &mut split_v));
-                    one(ScanDir::Horizontal, &mut rh, &mut eh, &mut lh, &mut split_h);
-                });
-                lh.extend_from_slice(&lv);
-                connect_into(&lh, &p.connect, &mut joined, &mut cs);
+            "connect" => {
+                connect_into(&warm.lines_raw, &p.connect, &mut joined, &mut cs);
                 check += joined.len();
             }
             other => {

@@ -1,5 +1,5 @@
-//! The operator console: a keyboard-driven TUI over the survey,
-//! the capture hardware, the LLV pipeline, the line editor and the reports.
+//! The operator console: a keyboard-driven TUI over the survey, the
+//! capture hardware, the LLV pipeline, the line editor and the reports.
 //!
 //! "Functional core, imperative shell": [`app::App`] holds the state and
 //! turns messages into commands without any I/O; this file is the shell —
@@ -20,8 +20,6 @@ use ratatui::backend::CrosstermBackend;
 use ratatui::crossterm::event as term_event;
 use ratatui::crossterm::{cursor, execute, terminal};
 
-use crate::cli::Global;
-
 pub mod app;
 pub mod event;
 pub mod keymap;
@@ -37,12 +35,20 @@ use event::{Cmd, Msg};
 /// Least time between two draws while messages pour in (progress, live).
 const FRAME: Duration = Duration::from_millis(16);
 
-/// Opens the console on the profile's cell.
-pub fn run(g: &Global, preview: Option<&str>) -> anyhow::Result<ExitCode> {
-    let profile = g
-        .load_profile()
-        .context("loading the profile for the console")?;
-    let look = mode::from_env(preview);
+/// Opens the console on `profile`'s cell, drawn as `look` says.
+pub fn run(profile: crate::profile::Profile, look: mode::Look) -> anyhow::Result<ExitCode> {
+    // A terminal without cursor addressing gets words, not escape sequences.
+    if let Some(why) = mode::unusable(std::env::var("TERM").ok().as_deref()) {
+        eprintln!("{why}");
+        return Ok(ExitCode::from(2));
+    }
+    if !io::IsTerminal::is_terminal(&io::stdout()) {
+        eprintln!(
+            "vss: the console needs a terminal on its output; use the vss subcommands \
+             (`vss --help`) in scripts and pipes"
+        );
+        return Ok(ExitCode::from(2));
+    }
 
     // Signals first: a hang-up during start-up must still restore the terminal.
     let stop = Arc::new(AtomicBool::new(false));
@@ -69,7 +75,13 @@ type Term = Terminal<CrosstermBackend<io::Stdout>>;
 fn enter() -> io::Result<Term> {
     terminal::enable_raw_mode()?;
     let mut out = io::stdout();
-    if let Err(e) = execute!(out, terminal::EnterAlternateScreen, cursor::Hide) {
+    // Mouse reports where the terminal sends them; others ignore the request.
+    if let Err(e) = execute!(
+        out,
+        terminal::EnterAlternateScreen,
+        cursor::Hide,
+        term_event::EnableMouseCapture
+    ) {
         leave();
         return Err(e);
     }
@@ -81,7 +93,12 @@ fn enter() -> io::Result<Term> {
 pub fn leave() {
     let _ = terminal::disable_raw_mode();
     let mut out = io::stdout();
-    let _ = execute!(out, cursor::Show, terminal::LeaveAlternateScreen);
+    let _ = execute!(
+        out,
+        term_event::DisableMouseCapture,
+        cursor::Show,
+        terminal::LeaveAlternateScreen
+    );
     let _ = out.flush();
 }
 
@@ -108,6 +125,7 @@ fn spawn_input(tx: Sender<Msg>, stop: Arc<AtomicBool>) -> io::Result<()> {
                 let msg = match term_event::read() {
                     Ok(term_event::Event::Key(k)) => Msg::Key(k),
                     Ok(term_event::Event::Resize(w, h)) => Msg::Resize(w, h),
+                    Ok(term_event::Event::Mouse(m)) => Msg::Mouse(m),
                     Ok(_) => continue,
                     Err(_) => break,
                 };
@@ -129,6 +147,9 @@ fn run_loop(
 ) -> anyhow::Result<()> {
     let (tx, rx) = mpsc::channel::<Msg>();
     let mut app = App::new(&profile, look);
+    if let Ok(size) = terminal.size() {
+        app.update(Msg::Resize(size.width, size.height));
+    }
     // Draw before anything slow starts: the operator sees the console at once.
     terminal.draw(|f| f.render_widget(&app, f.area()))?;
     spawn_input(tx.clone(), stop.clone())?;
@@ -140,9 +161,10 @@ fn run_loop(
     drop(tx);
     let first = app.start();
     workers.dispatch(first);
+    workers.dispatch(app.take_log_lines().into_iter().collect());
     let mut dirty = true;
     let mut last_draw = Instant::now();
-    while !app.quit && !stop.load(Ordering::SeqCst) {
+    while !app.quit() && !stop.load(Ordering::SeqCst) {
         if dirty && last_draw.elapsed() >= FRAME {
             terminal.draw(|f| f.render_widget(&app, f.area()))?;
             last_draw = Instant::now();
@@ -155,26 +177,44 @@ fn run_loop(
         };
         match rx.recv_timeout(wait) {
             Ok(msg) => {
+                let msg = place(&app, msg);
                 dirty |= !matches!(msg, Msg::Tick);
                 let cmds = app.update(msg);
                 workers.dispatch(cmds);
                 // Take whatever else is waiting before drawing again (a key
                 // queued behind a tick must still mark the screen dirty).
                 while let Ok(msg) = rx.try_recv() {
+                    let msg = place(&app, msg);
                     dirty |= !matches!(msg, Msg::Tick);
                     let cmds = app.update(msg);
                     workers.dispatch(cmds);
-                    if app.quit {
+                    if app.quit() {
                         break;
                     }
                 }
+                // Every message of the run also goes to the log file.
+                workers.dispatch(app.take_log_lines().into_iter().collect());
             }
             Err(RecvTimeoutError::Timeout) => {}
             Err(RecvTimeoutError::Disconnected) => break,
         }
     }
+    workers.dispatch(app.take_log_lines().into_iter().collect());
     workers.finish();
     Ok(())
+}
+
+/// A mouse event placed on what the screen shows there (nothing, where
+/// it falls on nothing that takes the mouse).
+fn place(app: &App, msg: Msg) -> Msg {
+    match msg {
+        Msg::Mouse(m) => {
+            let (w, h) = app.chrome.size;
+            let area = ratatui::layout::Rect::new(0, 0, w, h);
+            screens::pointer(app, area, m).map_or(Msg::Tick, Msg::Pointer)
+        }
+        other => other,
+    }
 }
 
 struct Workers {

@@ -7,11 +7,12 @@
 //!
 //! The search is a fixed grid (deterministic, no randomness), nested by
 //! stage so that the expensive stages run least often:
-//! `edges.per_region × edges.floor` (edge stage) → `lines.min_length ×
-//! lines.min_response` (line stage) → `connect.min_line_length` (CONNECT
-//! only). Each axis holds the base value and a ladder around it: with the
-//! default base, 21 edge runs, 168 line runs and 840 CONNECT runs (1030
-//! runs; CONNECT runs are cheap). With several lightings `edges.noise_factor`
+//! `edges.per_region × edges.noise_sigmas` (edge stage: how many starts,
+//! and how far above the noise) → `lines.min_length × lines.log_nfa` (line
+//! stage: how significant a segment must be) → `connect.min_line_length`
+//! (CONNECT only). Each axis holds the base value and a ladder around it:
+//! with the default base, 40 edge runs, 480 line runs and 3360 CONNECT runs
+//! (CONNECT runs are cheap). With several lightings `edges.noise_factor`
 //! is a third edge-stage axis (three times the runs).
 //!
 //! **"clean", measurably.** The edges an operator must not lose are the
@@ -155,30 +156,30 @@ pub fn search(input: &Input, base: &Params, target: &Target) -> Result<AutoResul
         ladder(base.edges.per_region as f64, PER_REGION)
             .into_iter()
             .flat_map(move |pr| {
-                ladder(base.edges.floor, FLOOR)
+                ladder(base.edges.noise_sigmas, NOISE_SIGMAS)
                     .into_iter()
-                    .map(move |fl| (nf, pr, fl))
+                    .map(move |ns| (nf, pr, ns))
             })
     });
-    for (noise_factor, per_region, floor) in edge_grid {
+    for (noise_factor, per_region, noise_sigmas) in edge_grid {
         {
             let mut p = base.clone();
             p.edges.noise_factor = noise_factor;
             p.edges.per_region = per_region as u32;
-            p.edges.floor = floor;
+            p.edges.noise_sigmas = noise_sigmas;
             ws.rerun(Stage::Edges, input, &p)?;
             runs += 1;
-            for (min_len, min_resp) in ladder(base.lines.min_length, MIN_LENGTH)
+            for (min_len, log_nfa) in ladder(base.lines.min_length, MIN_LENGTH)
                 .into_iter()
                 .flat_map(|l| {
-                    ladder(base.lines.min_response, MIN_RESPONSE)
+                    ladder(base.lines.log_nfa, LOG_NFA)
                         .into_iter()
                         .map(move |r| (l, r))
                 })
             {
                 let mut q = p.clone();
                 q.lines.min_length = min_len;
-                q.lines.min_response = min_resp;
+                q.lines.log_nfa = log_nfa;
                 ws.rerun(Stage::Lines, input, &q)?;
                 runs += 1;
                 for mll in ladder(base.connect.min_line_length, MIN_LINE_LENGTH) {
@@ -207,12 +208,12 @@ pub fn search(input: &Input, base: &Params, target: &Target) -> Result<AutoResul
 }
 
 /// The grid's ladders (module doc); the base value is always tried too.
-const PER_REGION: &[f64] = &[3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0];
-const FLOOR: &[f64] = &[2.0, 4.0, 8.0];
+const PER_REGION: &[f64] = &[3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0, 32.0];
+const NOISE_SIGMAS: &[f64] = &[2.0, 2.5, 3.5, 5.0, 7.0];
 const NOISE_FACTOR: &[f64] = &[2.0, 3.0, 5.0];
 const MIN_LENGTH: &[f64] = &[8.0, 12.0];
-const MIN_RESPONSE: &[f64] = &[0.0, 3.0, 6.0, 10.0];
-const MIN_LINE_LENGTH: &[f64] = &[12.0, 16.0, 20.0, 30.0, 40.0];
+const LOG_NFA: &[f64] = &[-10.0, -5.0, 0.0, 5.0, 10.0, 15.0];
+const MIN_LINE_LENGTH: &[f64] = &[12.0, 16.0, 20.0, 30.0, 40.0, 60.0, 80.0];
 
 struct Candidate {
     /// (target cost, parameters changed, distance in steps): smaller wins.
@@ -337,7 +338,7 @@ mod tests {
         assert_eq!(
             changes(&base, &p),
             vec![
-                ("edges.per_region".to_string(), 8.0, 12.0),
+                ("edges.per_region".to_string(), 16.0, 12.0),
                 ("connect.min_line_length".to_string(), 12.0, 20.0)
             ]
         );

@@ -179,9 +179,82 @@ impl LineEditor {
         &self.log[..self.pos.min(self.log.len())]
     }
 
+    /// The operation a redo would re-apply.
+    pub fn next_redo(&self) -> Option<&EditOp> {
+        self.log.get(self.pos)
+    }
+
     /// The original line set.
     pub fn original(&self) -> &[Segment] {
         self.states.first().map_or(&[], |v| v.as_slice())
+    }
+}
+
+/// Distance from a point to a segment (pixels).
+pub fn point_segment_distance(p: Point, s: &Segment) -> f64 {
+    let (vx, vy) = (s.b.x - s.a.x, s.b.y - s.a.y);
+    let len2 = vx * vx + vy * vy;
+    let t = if len2 > 0.0 {
+        (((p.x - s.a.x) * vx + (p.y - s.a.y) * vy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.dist(Point::new(s.a.x + t * vx, s.a.y + t * vy))
+}
+
+/// The index of the line nearest to `p`.
+pub fn nearest_line(lines: &[Segment], p: Point) -> Option<usize> {
+    lines
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (i, point_segment_distance(p, s)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| i)
+}
+
+/// The two different lines whose endpoints are nearest to `p`: the two ends
+/// of the corner the operator points at.
+pub fn corner_lines(lines: &[Segment], p: Point) -> Vec<usize> {
+    let mut ends: Vec<(usize, f64)> = lines
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (i, s.a.dist(p).min(s.b.dist(p))))
+        .collect();
+    ends.sort_by(|a, b| a.1.total_cmp(&b.1));
+    ends.into_iter().take(2).map(|e| e.0).collect()
+}
+
+/// An edit in words, with the lines it touched as they were before it:
+/// `connected lines 5 (10,20)-(90,20) and 4 (92,21)-(160,21)`.
+pub fn describe(op: &EditOp, before: &[Segment]) -> String {
+    let line = |i: usize| match before.get(i) {
+        Some(s) => format!(
+            "{i} ({:.0},{:.0})-({:.0},{:.0})",
+            s.a.x, s.a.y, s.b.x, s.b.y
+        ),
+        None => i.to_string(),
+    };
+    match op {
+        EditOp::Connect(i, j) => format!("connected lines {} and {}", line(*i), line(*j)),
+        EditOp::Extend(i, j) => format!(
+            "extended lines {} and {} to their intersection",
+            line(*i),
+            line(*j)
+        ),
+        EditOp::Delete(v) => {
+            let list: Vec<String> = v.iter().map(|i| line(*i)).collect();
+            let s = if v.len() == 1 { "" } else { "s" };
+            format!("deleted line{s} {}", list.join(", "))
+        }
+    }
+}
+
+/// The lines an edit made or moved, as indices of the set after it.
+pub fn result_lines(op: &EditOp, after: &[Segment]) -> Vec<usize> {
+    match op {
+        EditOp::Connect(..) => after.len().checked_sub(1).into_iter().collect(),
+        EditOp::Extend(i, j) => vec![*i, *j],
+        EditOp::Delete(_) => Vec::new(),
     }
 }
 
@@ -191,6 +264,31 @@ mod tests {
 
     fn seg(ax: f64, ay: f64, bx: f64, by: f64) -> Segment {
         Segment::new(Point::new(ax, ay), Point::new(bx, by))
+    }
+
+    #[test]
+    fn nearest_corner_and_words() {
+        let ls = [
+            Segment::new(Point::new(0.0, 0.0), Point::new(10.0, 0.0)),
+            Segment::new(Point::new(11.0, 1.0), Point::new(11.0, 20.0)),
+            Segment::new(Point::new(0.0, 30.0), Point::new(20.0, 30.0)),
+        ];
+        assert_eq!(nearest_line(&ls, Point::new(5.0, 28.0)), Some(2));
+        let mut c = corner_lines(&ls, Point::new(10.5, 0.5));
+        c.sort();
+        assert_eq!(c, vec![0, 1]);
+        assert_eq!(nearest_line(&[], Point::new(0.0, 0.0)), None);
+        assert_eq!(
+            describe(&EditOp::Connect(1, 0), &ls),
+            "connected lines 1 (11,1)-(11,20) and 0 (0,0)-(10,0)"
+        );
+        assert_eq!(
+            describe(&EditOp::Delete(vec![2]), &ls),
+            "deleted line 2 (0,30)-(20,30)"
+        );
+        let after = apply(&ls, &EditOp::Connect(0, 1)).unwrap();
+        assert_eq!(result_lines(&EditOp::Connect(0, 1), &after), vec![3]);
+        assert!((point_segment_distance(Point::new(5.0, 3.0), &ls[0]) - 3.0).abs() < 1e-12);
     }
 
     #[test]

@@ -49,6 +49,19 @@ impl ParamSpec {
     }
 }
 
+/// A parameter value as an operator types it: integers without a
+/// fraction, others with at most four decimals, never `-0`.
+pub fn fmt_value(v: f64) -> String {
+    let v = if v == 0.0 { 0.0 } else { v };
+    if v == v.trunc() && v.abs() < 1e12 {
+        format!("{}", v as i64)
+    } else {
+        let s = format!("{v:.4}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        if s == "-0" { "0".into() } else { s.to_string() }
+    }
+}
+
 fn fmt_num(v: f64) -> String {
     if v == v.trunc() && v.abs() < 1e15 {
         format!("{}", v as i64)
@@ -194,13 +207,24 @@ params! {
             "grey levels", 0.0..=255.0, step 0.5,
             "floor threshold T: weaker peaks are never edges";
         /// `M`: edge pixels kept per region by the adaptive threshold.
-        per_region: u32 = 8,
+        per_region: u32 = 16,
             "points", 1.0..=4096.0, step 1.0,
             "adaptive threshold M: strongest edge points kept per region";
         /// Scan lines per region of the adaptive threshold (1 = one scan line).
         region_lines: u32 = 1,
             "lines", 1.0..=4096.0, step 1.0,
             "scan lines per adaptive-threshold region";
+        /// Edge points must exceed this many times the noise scale of the
+        /// response in their tile (its robust standard deviation, estimated
+        /// from the image; `edges/noise.rs`). 0 switches the test off.
+        noise_sigmas: f64 = 3.5,
+            "σ", 0.0..=20.0, step 0.25,
+            "edge points must beat this many noise sigmas of their tile";
+        /// Threads for the two scan directions (edges and lines; 1 or 2).
+        /// The results are the same.
+        threads: u32 = 1,
+            "threads", 1.0..=2.0, step 1.0,
+            "threads for the two scan directions; the results are the same";
         /// Photometric combination (llv.md §2.6): an image's noise level `τ` is
         /// this multiple of its median absolute kernel response.
         noise_factor: f64 = 5.0,
@@ -227,13 +251,24 @@ params! {
             "deg", 0.0..=45.0, step 0.5,
             "least angle between a line and the scan direction";
         /// Line significance (grey levels): a segment whose points' mean
-        /// |response| is below this is dropped as noise. Not in the original VSS:
-        /// with the floor `T` at its default 2 grey levels, `M` points per scan
-        /// line promote noise peaks in rows with few edges, and their chains make
-        /// short lines of mean |response| 3–4 at noise σ = 2. 0 switches it off.
-        min_response: f64 = 6.0,
+        /// |response| is below this is dropped. Off by default: the
+        /// a-contrario test (`log_nfa`) measures significance against the
+        /// image's own noise instead. 0 switches it off.
+        min_response: f64 = 0.0,
             "grey levels", 0.0..=255.0, step 0.5,
             "lines whose mean |edge response| is below this are noise; 0 is off";
+        /// Points a line takes after its start must exceed this many noise
+        /// sigmas of their tile (fewer than an edge point needs: a weak
+        /// stretch of an edge is followed once the edge is found).
+        track_sigmas: f64 = 2.0,
+            "σ", 0.0..=20.0, step 0.25,
+            "points a line follows must beat this many noise sigmas";
+        /// A-contrario significance: a segment is kept when noise alone
+        /// would give fewer than `10^log_nfa` segments as good in the image
+        /// (`lines/nfa.rs`). 0: one false segment per image at most.
+        log_nfa: f64 = 0.0,
+            "log10", -20.0..=20.0, step 1.0,
+            "keep segments whose log10 number of false alarms is below this";
     }
 
     /// CONNECT, the automatic post-processing (llv.md §4), and the corner closing
@@ -353,6 +388,16 @@ pub enum ParamError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn values_read_as_typed() {
+        assert_eq!(fmt_value(4.0), "4");
+        assert_eq!(fmt_value(2.25), "2.25");
+        assert_eq!(fmt_value(1.0 / 3.0), "0.3333");
+        assert_eq!(fmt_value(-0.0), "0");
+        assert_eq!(fmt_value(-0.00001), "0");
+        assert_eq!(fmt_value(-1.5), "-1.5");
+    }
 
     #[test]
     fn table_and_accessors_agree() {

@@ -14,10 +14,12 @@ use serde::Serialize;
 
 use super::connect::{ConnectScratch, connect_into};
 use super::corners::{CornerScratch, close_corners_with};
-use super::edges::{PeakScratch, Response, ResponseScratch, exact_response_into, peaks_into};
+use super::edges::{
+    NoiseMap, PeakMap, PeakScratch, Response, ResponseScratch, detect_into, exact_response_into,
+};
 use super::image::GreyImage;
 use super::lens::{LensMap, correct_into};
-use super::lines::{LineScratch, extract_into};
+use super::lines::{LineScratch, extract_into, track_into};
 use super::params::{Params, Stage};
 use super::photometric::{PhotoScratch, combined_response_into};
 use super::{EdgePoints, LlvError, ScanDir, Segment};
@@ -47,6 +49,9 @@ pub struct StageOutputs {
     pub corrected: Vec<GreyImage>,
     pub response_h: Response,
     pub response_v: Response,
+    /// The noise scale of each response, per tile (`edges/noise.rs`).
+    pub noise_h: NoiseMap,
+    pub noise_v: NoiseMap,
     pub edges_h: EdgePoints,
     pub edges_v: EdgePoints,
     /// Extracted lines: those of `edges_h` first, then those of `edges_v`.
@@ -92,10 +97,10 @@ pub enum Saved {
 pub struct Workspace {
     out: StageOutputs,
     ambient_corrected: GreyImage,
-    response: ResponseScratch,
-    /// Buffers of the several-lightings combination (llv.md §2.6).
-    photo: PhotoScratch,
-    peaks: PeakScratch,
+    /// Each scan direction's buffers.
+    dir_h: DirScratch,
+    dir_v: DirScratch,
+    /// Line extraction from edge points alone.
     lines: LineScratch,
     connect: ConnectScratch,
     tmp: Vec<Segment>,
@@ -152,8 +157,6 @@ impl Workspace {
         p: &Params,
     ) -> Result<&StageOutputs, LlvError> {
         let size = check_input(input)?;
-        // The kernel checks the half-width (`edges::check_half_width`).
-        let a = p.edges.half_width as usize;
         // The responses of a lens-corrected run with an ambient image are made
         // from the corrected ambient, which a workspace built from earlier
         // outputs alone (`with_outputs`) does not have: it corrects again.
@@ -175,30 +178,75 @@ impl Workspace {
             self.lens(input, p)?;
             self.out.timings.lens_us = micros(t);
         }
-        if from <= Stage::Edges {
-            let t = Instant::now();
-            let same_response = from == Stage::Edges
+        if from <= Stage::Lines {
+            let same_response = from >= Stage::Edges
                 && prev_params.edges.half_width == p.edges.half_width
                 && prev_params.edges.noise_factor == p.edges.noise_factor;
-            if !same_response {
-                self.responses(input, a)?;
+            let job = Job {
+                from,
+                response: !same_response,
+                params: p,
+            };
+            let StageOutputs {
+                corrected,
+                response_h,
+                response_v,
+                noise_h,
+                noise_v,
+                edges_h,
+                edges_v,
+                lines_raw,
+                timings,
+                ..
+            } = &mut self.out;
+            let lensed = !corrected.is_empty();
+            let images: &[GreyImage] = if lensed { corrected } else { input.images };
+            let ambient = if lensed {
+                input.ambient.map(|_| &self.ambient_corrected)
+            } else {
+                input.ambient
+            };
+            let h = DirOut {
+                dir: ScanDir::Horizontal,
+                response: response_h,
+                noise: noise_h,
+                edges: edges_h,
+                s: &mut self.dir_h,
+            };
+            let v = DirOut {
+                dir: ScanDir::Vertical,
+                response: response_v,
+                noise: noise_v,
+                edges: edges_v,
+                s: &mut self.dir_v,
+            };
+            let (th, tv) = if p.edges.threads >= 2 {
+                std::thread::scope(|sc| {
+                    let other = sc.spawn(|| job.run(images, ambient, v));
+                    let here = job.run(images, ambient, h);
+                    let there = other
+                        .join()
+                        .unwrap_or_else(|e| std::panic::resume_unwind(e));
+                    Ok::<_, LlvError>((here?, there?))
+                })?
+            } else {
+                (job.run(images, ambient, h)?, job.run(images, ambient, v)?)
+            };
+            // With two threads a stage takes as long as its slower direction.
+            let both = |a: u64, b: u64| {
+                if p.edges.threads >= 2 {
+                    a.max(b)
+                } else {
+                    a + b
+                }
+            };
+            if from <= Stage::Edges {
+                timings.edges_us = both(th.0, tv.0);
             }
-            peaks_into(
-                &self.out.response_h,
-                &p.edges,
-                &mut self.out.edges_h,
-                &mut self.peaks,
-            );
-            peaks_into(
-                &self.out.response_v,
-                &p.edges,
-                &mut self.out.edges_v,
-                &mut self.peaks,
-            );
-            self.out.timings.edges_us = micros(t);
-        }
-        if from <= Stage::Lines {
-            self.extract_lines(p);
+            timings.lines_us = both(th.1, tv.1);
+            lines_raw.clear();
+            lines_raw.extend_from_slice(&self.dir_h.segs);
+            lines_raw.extend_from_slice(&self.dir_v.segs);
         }
         self.connect_lines(p);
         self.valid = true;
@@ -215,6 +263,8 @@ impl Workspace {
         self.out.corrected.clear();
         self.out.response_h = Response::default();
         self.out.response_v = Response::default();
+        self.out.noise_h = NoiseMap::default();
+        self.out.noise_v = NoiseMap::default();
         self.out.params = p.clone();
         self.out.timings = Timings::default();
         match saved {
@@ -233,6 +283,7 @@ impl Workspace {
         &self.out
     }
 
+    /// Line extraction from edge points alone.
     fn extract_lines(&mut self, p: &Params) {
         let t = Instant::now();
         extract_into(
@@ -281,45 +332,94 @@ impl Workspace {
         }
         Ok(())
     }
+}
 
-    fn responses(&mut self, input: &Input, a: usize) -> Result<(), LlvError> {
-        let lensed = !self.out.corrected.is_empty();
-        let images: &[GreyImage] = if lensed {
-            &self.out.corrected
-        } else {
-            input.images
-        };
-        let ambient = if lensed {
-            input.ambient.map(|_| &self.ambient_corrected)
-        } else {
-            input.ambient
-        };
-        if images.len() == 1 && ambient.is_none() {
-            let img = &images[0];
-            exact_response_into(
-                img,
-                ScanDir::Horizontal,
-                a,
-                &mut self.out.response_h,
-                &mut self.response,
-            )?;
-            exact_response_into(
-                img,
-                ScanDir::Vertical,
-                a,
-                &mut self.out.response_v,
-                &mut self.response,
-            )?;
-        } else {
-            let ep = &self.out.params.edges;
-            for (dir, out) in [
-                (ScanDir::Horizontal, &mut self.out.response_h),
-                (ScanDir::Vertical, &mut self.out.response_v),
-            ] {
-                combined_response_into(images, ambient, dir, ep, out, &mut self.photo)?;
+/// One scan direction's buffers: the response, the several-lightings
+/// combination, the edge points and the line extractor each keep theirs,
+/// so that the two directions can run on two threads.
+#[derive(Clone, Debug, Default)]
+struct DirScratch {
+    response: ResponseScratch,
+    photo: PhotoScratch,
+    peaks: PeakScratch,
+    /// The peaks the edge points and the line extractor are taken from.
+    map: PeakMap,
+    lines: LineScratch,
+    /// The direction's extracted lines.
+    segs: Vec<Segment>,
+}
+
+/// One scan direction's outputs and buffers.
+struct DirOut<'a> {
+    dir: ScanDir,
+    response: &'a mut Response,
+    noise: &'a mut NoiseMap,
+    edges: &'a mut EdgePoints,
+    s: &'a mut DirScratch,
+}
+
+/// What a run does in each scan direction: from the edges (the response
+/// too, unless it can be kept) or from the lines on.
+#[derive(Clone, Copy)]
+struct Job<'p> {
+    from: Stage,
+    response: bool,
+    params: &'p Params,
+}
+
+impl Job<'_> {
+    /// Runs one direction; returns the microseconds of its edge stage and
+    /// of its line extraction.
+    fn run(
+        &self,
+        images: &[GreyImage],
+        ambient: Option<&GreyImage>,
+        o: DirOut,
+    ) -> Result<(u64, u64), LlvError> {
+        let p = self.params;
+        let mut edges_us = 0;
+        if self.from <= Stage::Edges {
+            let t = Instant::now();
+            if self.response {
+                let a = p.edges.half_width as usize;
+                match (images, ambient) {
+                    ([img], None) => {
+                        exact_response_into(img, o.dir, a, o.response, &mut o.s.response)?
+                    }
+                    _ => combined_response_into(
+                        images,
+                        ambient,
+                        o.dir,
+                        &p.edges,
+                        o.response,
+                        &mut o.s.photo,
+                    )?,
+                }
             }
+            detect_into(
+                o.response,
+                &p.edges,
+                p.lines.track_sigmas,
+                o.noise,
+                &mut o.s.map,
+                o.edges,
+                &mut o.s.peaks,
+            );
+            edges_us = micros(t);
         }
-        Ok(())
+        let t = Instant::now();
+        track_into(
+            o.response,
+            o.noise,
+            &o.s.map,
+            o.edges,
+            p.edges.floor,
+            p.edges.half_width as usize,
+            &p.lines,
+            &mut o.s.segs,
+            &mut o.s.lines,
+        );
+        Ok((edges_us, micros(t)))
     }
 }
 

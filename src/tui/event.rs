@@ -6,16 +6,24 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use ratatui::crossterm::event::KeyEvent;
+use ratatui::crossterm::event::{KeyEvent, MouseEvent};
 
 use crate::llv::lens::CameraModel;
 use crate::llv::pipeline::StageOutputs;
-use crate::llv::{GreyImage, Params, Segment};
+use crate::llv::{GreyImage, LlvError, Params, Segment};
+use crate::session::input::PipelineInput;
+
+pub use super::workers::store::StoreError;
 
 /// Everything that can happen to the console.
 #[derive(Debug)]
 pub enum Msg {
     Key(KeyEvent),
+    /// A click or the wheel as the terminal reports it; the shell places it
+    /// on what is drawn there ([`Msg::Pointer`]) before the App sees it.
+    Mouse(MouseEvent),
+    /// A mouse event placed on the screen's contents.
+    Pointer(Pointer),
     Resize(u16, u16),
     /// Regular wake-up (throttled work, blinking nothing): redraws only if
     /// something changed.
@@ -23,6 +31,25 @@ pub enum Msg {
     Device(DeviceEvent),
     Pipeline(PipelineResult),
     Store(StoreEvent),
+}
+
+/// A mouse event placed on the screen's contents.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pointer {
+    /// The wheel over a list: one row up or down.
+    ScrollList { up: bool },
+    /// The wheel over the expanded log pane or a help/message window.
+    ScrollLog { up: bool },
+    /// The wheel over a picture: zoom in or out.
+    Zoom { zoom_in: bool },
+    /// A click on checklist row `k`.
+    Checklist(u32),
+    /// A click on row `i` of the session list.
+    SessionRow(usize),
+    /// A click on row `i` of the parameter panel.
+    Param(usize),
+    /// A click on the picture, at image pixel `(x, y)`.
+    Pixel(usize, usize),
 }
 
 /// What a captured frame was for.
@@ -43,6 +70,8 @@ pub enum DeviceEvent {
     Connected { grabber: String, relay: String },
     /// A device stopped answering; the worker retries on its own.
     Lost { error: String },
+    /// The lights are switched and settling before the freeze.
+    Settling { ms: u64 },
     /// Transfer progress of the frame under way.
     Progress { done: usize, total: usize },
     Frame {
@@ -66,7 +95,7 @@ pub struct PipelineResult {
     pub generation: u64,
     pub image_key: ImageKey,
     pub params: Params,
-    pub outcome: Result<Arc<StageOutputs>, String>,
+    pub outcome: Result<Arc<StageOutputs>, LlvError>,
 }
 
 /// Which set of grey images a pipeline run is about (the session's image
@@ -92,6 +121,50 @@ pub struct SessionView {
     pub next: Option<(u32, Option<char>)>,
     /// Every file of the session with its state.
     pub files: Vec<FileState>,
+    /// Whether the files were read and checked for this view (not only
+    /// the manifest).
+    pub checked: bool,
+}
+
+impl SessionView {
+    /// Files that are missing or do not read.
+    pub fn problems(&self) -> usize {
+        self.files.iter().filter(|f| !f.ok).count()
+    }
+}
+
+/// A session of the survey folder, as the picker lists it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SessionEntry {
+    pub name: String,
+    pub dir: PathBuf,
+    /// `3/4 done`, and who holds it.
+    pub summary: String,
+    /// Why the session cannot be opened (its manifest does not read).
+    pub damaged: Option<String>,
+}
+
+/// An image read back from the session.
+#[derive(Debug, Default)]
+pub struct LoadedImage {
+    pub k: u32,
+    /// The grey images that read, by lighting letter.
+    pub images: Vec<(char, GreyImage)>,
+    /// The lightings whose grey image does not read, with why.
+    pub damaged: Vec<(char, String)>,
+    /// The saved outputs, when every file reads and they are current.
+    pub saved: Option<SavedOutputs>,
+    /// The `.ldr` as it stands (hand edits included).
+    pub lines: Option<Vec<Segment>>,
+    /// The session holds accepted (current) outputs of the image.
+    pub accepted: bool,
+}
+
+/// Outputs read from a session's files, with the values they were made with.
+#[derive(Debug)]
+pub struct SavedOutputs {
+    pub outputs: StageOutputs,
+    pub params: Params,
 }
 
 /// One image number of a session.
@@ -104,6 +177,10 @@ pub struct ImageState {
     pub outputs: bool,
     pub stale: bool,
     pub edits: usize,
+    /// Lightings whose grey image is missing or does not read, with why.
+    pub damaged: Vec<(char, String)>,
+    /// Why an output file (`.hpo .vpo .lex .ldr`) is missing or does not read.
+    pub outputs_damaged: Option<String>,
 }
 
 /// A file of the session and how it stands.
@@ -117,25 +194,26 @@ pub struct FileState {
 /// Reports of the store (session) worker.
 #[derive(Debug)]
 pub enum StoreEvent {
-    /// Sessions found in the survey folder (name, folder, one-line summary).
-    Sessions(Vec<(String, PathBuf, String)>),
+    /// Sessions found in the survey folder, damaged ones included.
+    Sessions(Vec<SessionEntry>),
     Opened(SessionView),
     Updated(SessionView),
-    /// Grey images of an image number read back from disk (resume).
-    Images {
-        k: u32,
-        images: Vec<(char, GreyImage)>,
-    },
-    /// Lines of an image read back (`.ldr`), for the editor.
-    Lines {
-        k: u32,
-        lines: Vec<Segment>,
-    },
+    /// An image number read back from disk (resume, going back).
+    Loaded(Box<LoadedImage>),
     /// The camera models, index 0 = camera 1 (`None` where no `.cdf`).
     Cameras(Vec<Option<CameraModel>>),
     Saved(String),
+    /// A note worth a log line (a stale lock taken over).
+    Note(String),
     Reports(Vec<PathBuf>),
-    Error(String),
+    /// The session is held by a console that still runs.
+    Locked {
+        dir: PathBuf,
+        holder: String,
+    },
+    /// Where the console's log file is.
+    LogFile(PathBuf),
+    Error(StoreError),
 }
 
 /// Commands from the UI to its workers.
@@ -177,10 +255,9 @@ pub enum DeviceCmd {
 pub struct PipelineRequest {
     pub generation: u64,
     pub image_key: ImageKey,
-    /// Lit images (one or more), and the ambient one if the lighting set has it.
-    pub images: Arc<Vec<GreyImage>>,
-    pub ambient: Option<Arc<GreyImage>>,
-    pub camera: Option<CameraModel>,
+    /// The image's frames split by the profile's rule, with its camera
+    /// (the one input the session code and the CLI run too).
+    pub input: Arc<PipelineInput>,
     pub params: Params,
 }
 
@@ -189,6 +266,10 @@ pub enum StoreCmd {
     List,
     Create(String),
     Open(PathBuf),
+    /// Open, taking the lock of a console that still runs (asked first).
+    TakeOver(PathBuf),
+    /// Lines for the log file (the session's, or the state folder's).
+    Log(Vec<String>),
     SaveImage {
         k: u32,
         letter: char,
@@ -207,10 +288,22 @@ pub enum StoreCmd {
         what: String,
         lines: Vec<Segment>,
     },
+    /// Take back the last recorded edit: the lines before it.
+    UndoEdit {
+        k: u32,
+        lines: Vec<Segment>,
+    },
     /// Read the grey images and lines of an image number back.
     Load(u32),
     /// Forget the captured data of an image number before it is redone.
     Redo(u32),
     Export,
+    /// Re-read the session, checking every file.
     Refresh,
+    /// Write a camera's calibration into the profile's `.cdf` of that
+    /// camera (the old file kept as `.bak`), then report the cameras again.
+    WriteCdf {
+        camera: u32,
+        calibration: Box<crate::calib::Calibration>,
+    },
 }

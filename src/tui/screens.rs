@@ -1,34 +1,33 @@
-//! Drawing the console: the frame every screen shares (top bar with the
-//! screen keys, log pane, status bar with the current keys, help overlay,
-//! questions) and, under `screens/`, one file per screen with its own state,
-//! its `handle_key` and its drawing. Drawing only reads the [`App`].
+//! Drawing the console: the frame every screen shares (`screens/chrome.rs`:
+//! top bar with the screen keys, session and profile; the newest message
+//! wrapped over up to three rows, or the scrollable log pane; the hints of
+//! the current keys; help, message window, questions) and, under
+//! `screens/`, one file per screen. Drawing only reads the [`App`].
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{Block, Borders, Clear, Paragraph, Widget, Wrap};
+use ratatui::widgets::{Block, Borders, Paragraph, Widget, Wrap};
 
-use super::app::{App, Level, LogView, Modal};
-use super::keymap::{self, Action, Scope, ScreenId};
-use super::widgets::preview::Viewport;
+use super::app::{App, Level, LogView};
+use super::keymap::ScreenId;
+use super::widgets::preview::PreviewMode;
 
 mod calibrate;
 mod capture;
+mod chrome;
 mod edit;
 mod pipeline;
 mod session;
 mod survey;
 
-pub use calibrate::CalibrateScreen;
-pub use capture::CaptureScreen;
-pub use edit::EditScreen;
-pub use pipeline::{PipelineScreen, StageView};
-pub use session::SessionScreen;
-pub use survey::SurveyScreen;
+/// The smallest terminal the screens are drawn in.
+pub const MIN_SIZE: (u16, u16) = (64, 18);
 
 /// Styles that respect `NO_COLOR`: without colour only bold, reverse and
-/// dim are used.
+/// dim are used; with colour only the sixteen basic colours, which every
+/// colour terminal has (the Linux console included).
 #[derive(Clone, Copy, Debug)]
 pub struct Theme {
     pub colour: bool,
@@ -89,12 +88,36 @@ impl Theme {
     }
 }
 
+impl App {
+    pub fn theme(&self) -> Theme {
+        Theme {
+            colour: self.chrome.look.colour,
+        }
+    }
+
+    pub fn ascii(&self) -> bool {
+        self.chrome.look.mode == PreviewMode::Ascii
+    }
+
+    /// The preview mode as the operator would ask for it.
+    pub fn look_name(&self) -> &'static str {
+        use super::widgets::preview::PreviewMode as M;
+        match (self.chrome.look.mode, self.chrome.look.colour) {
+            (M::Ascii, true) => "ascii, 16 colours",
+            (M::Ascii, false) => "ascii",
+            (M::Braille, _) => "braille",
+            (M::Blocks, true) => "blocks",
+            (M::Blocks, false) => "blocks, no colour",
+        }
+    }
+}
+
 /// A bordered block with a title; plain ASCII borders in ASCII mode.
 pub fn block(app: &App, title: &str) -> Block<'static> {
     let b = Block::default()
         .borders(Borders::ALL)
         .title(Span::styled(format!(" {title} "), app.theme().title()));
-    if app.look.mode == super::widgets::preview::PreviewMode::Ascii {
+    if app.ascii() {
         b.border_set(ratatui::symbols::border::Set {
             top_left: "+",
             top_right: "+",
@@ -108,6 +131,12 @@ pub fn block(app: &App, title: &str) -> Block<'static> {
     } else {
         b
     }
+}
+
+/// [`block`] with a second title on its bottom border (what a picture
+/// shows: its stretch, where the view is).
+pub fn block2(app: &App, title: &str, bottom: &str) -> Block<'static> {
+    block(app, title).title_bottom(Span::styled(format!(" {bottom} "), app.theme().dim()))
 }
 
 /// A progress bar in text: `[#####.....] 52%`, ASCII in every mode.
@@ -127,311 +156,245 @@ pub fn gauge_text(done: usize, total: usize, width: usize) -> String {
     )
 }
 
-/// Zoom, pan and a cursor over a preview: shared by Pipeline and Edit.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PreviewNav {
-    pub view: Viewport,
-    /// Pixel under the cursor (`None` = image centre).
-    pub cursor: Option<(usize, usize)>,
+/// Two areas side by side: a panel of `panel` columns (at most half) and the rest.
+pub fn split_panel(area: Rect, panel: u16) -> (Rect, Rect) {
+    let p = panel.min(area.width / 2);
+    let [a, b] = Layout::horizontal([Constraint::Length(p), Constraint::Min(1)]).areas(area);
+    (a, b)
 }
 
-impl PreviewNav {
-    /// Applies a navigation action; false if it is not one.
-    pub fn apply(&mut self, a: Action, size: Option<(usize, usize)>) -> bool {
-        let Some((w, h)) = size else {
-            return matches!(
-                a,
-                Action::ZoomIn
-                    | Action::ZoomOut
-                    | Action::CursorLeft
-                    | Action::CursorRight
-                    | Action::CursorUp
-                    | Action::CursorDown
-                    | Action::PanLeft
-                    | Action::PanRight
-                    | Action::PanUp
-                    | Action::PanDown
-            );
-        };
-        let (cx, cy) = self.cursor_or_centre((w, h));
-        // One press moves about a sixty-fourth of the visible width.
-        let step = ((w as f64 / 64.0 / self.view.zoom).round() as usize).max(1);
-        let mv = |c: usize, d: isize, max: usize| -> usize {
-            (c as isize + d * step as isize).clamp(0, max as isize - 1) as usize
-        };
-        match a {
-            Action::ZoomIn => {
-                self.view.zoom_in();
-                self.view.centre = Some((cx as f64 + 0.5, cy as f64 + 0.5));
-            }
-            Action::ZoomOut => self.view.zoom_out(),
-            Action::CursorLeft => self.cursor = Some((mv(cx, -1, w), cy)),
-            Action::CursorRight => self.cursor = Some((mv(cx, 1, w), cy)),
-            Action::CursorUp => self.cursor = Some((cx, mv(cy, -1, h))),
-            Action::CursorDown => self.cursor = Some((cx, mv(cy, 1, h))),
-            Action::PanLeft => self.view.pan(-0.25, 0.0, (w, h)),
-            Action::PanRight => self.view.pan(0.25, 0.0, (w, h)),
-            Action::PanUp => self.view.pan(0.0, -0.25, (w, h)),
-            Action::PanDown => self.view.pan(0.0, 0.25, (w, h)),
-            _ => return false,
+/// Which rows of a list of `n` a box of `room` rows shows around row
+/// `focus`: the first shown, how many, and whether a "more" marker sits
+/// above them (and so below, when they end before the list).
+pub fn window_span(n: usize, focus: usize, room: usize) -> (usize, usize, bool) {
+    if n <= room {
+        return (0, n, false);
+    }
+    if room == 0 {
+        return (0, 0, false);
+    }
+    let focus = focus.min(n - 1);
+    let mut shown = room;
+    loop {
+        let start = focus.saturating_sub(shown / 2).min(n - shown);
+        let (above, below) = (start > 0, start + shown < n);
+        if shown + usize::from(above) + usize::from(below) <= room || shown == 1 {
+            return (start, shown, above);
         }
-        true
+        shown -= 1;
     }
+}
 
-    pub fn cursor_or_centre(&self, (w, h): (usize, usize)) -> (usize, usize) {
-        let (x, y) = self.cursor.unwrap_or((w / 2, h / 2));
-        (x.min(w.saturating_sub(1)), y.min(h.saturating_sub(1)))
+/// Lines of a list cut to `room` rows around row `focus`, with a "more"
+/// marker where rows are left out above or below.
+pub fn window<'a>(rows: Vec<Line<'a>>, focus: usize, room: usize, t: Theme) -> Vec<Line<'a>> {
+    let n = rows.len();
+    let (start, shown, above) = window_span(n, focus, room);
+    if shown == n {
+        return rows;
     }
+    let mut out = Vec::with_capacity(room);
+    if above {
+        out.push(Line::styled(format!("  ↑ {start} more"), t.dim()));
+    }
+    out.extend(rows.into_iter().skip(start).take(shown));
+    if start + shown < n {
+        out.push(Line::styled(
+            format!("  ↓ {} more", n - start - shown),
+            t.dim(),
+        ));
+    }
+    out.truncate(room);
+    out
+}
+
+/// The areas of the frame at `area`: top bar, body, message rows, hints.
+pub struct Frame {
+    pub top: Rect,
+    pub body: Rect,
+    pub message: Rect,
+    pub hints: Rect,
 }
 
 impl App {
-    pub fn theme(&self) -> Theme {
-        Theme {
-            colour: self.look.colour,
-        }
-    }
-
-    /// The preview mode as the operator would ask for it.
-    pub fn look_name(&self) -> &'static str {
-        use super::widgets::preview::PreviewMode as M;
-        match (self.look.mode, self.look.colour) {
-            (M::Ascii, _) => "ascii",
-            (M::Braille, _) => "braille",
-            (M::Blocks, true) => "blocks",
-            (M::Blocks, false) => "blocks, no colour",
+    /// How the frame divides the terminal (used by drawing and the mouse).
+    pub fn frame(&self, area: Rect) -> Frame {
+        let msg_rows = match self.chrome.log_view {
+            LogView::Hidden => 0,
+            LogView::Line => chrome::message_rows(self, area.width),
+            LogView::Expanded => (area.height / 2).max(5),
+        };
+        let [top, body, message, hints] = Layout::vertical([
+            Constraint::Length(1),
+            Constraint::Min(1),
+            Constraint::Length(msg_rows),
+            Constraint::Length(chrome::hint_rows(self, area.width)),
+        ])
+        .areas(area);
+        Frame {
+            top,
+            body,
+            message,
+            hints,
         }
     }
 }
 
 impl Widget for &App {
     fn render(self, area: Rect, buf: &mut Buffer) {
-        if area.width < 10 || area.height < 4 {
-            Paragraph::new("vss: window too small").render(area, buf);
-            return;
-        }
-        let log_rows = match self.log_view {
-            LogView::Hidden => 0,
-            LogView::Line => 1,
-            LogView::Expanded => (area.height / 2).max(3),
-        };
-        let [top, body, log, status] = Layout::vertical([
-            Constraint::Length(1),
-            Constraint::Min(1),
-            Constraint::Length(log_rows),
-            Constraint::Length(1),
-        ])
-        .areas(area);
-        self.top_bar(top, buf);
-        match self.screen {
-            ScreenId::Survey => survey::render(self, body, buf),
-            ScreenId::Capture => capture::render(self, body, buf),
-            ScreenId::Pipeline => pipeline::render(self, body, buf),
-            ScreenId::Edit => edit::render(self, body, buf),
-            ScreenId::Session => session::render(self, body, buf),
-            ScreenId::Calibrate => calibrate::render(self, body, buf),
-        }
-        self.log_pane(log, buf);
-        self.status_bar(status, buf);
-        if let Some(m) = &self.modal {
-            self.modal_box(m, area, buf);
-        }
-        if self.help {
-            self.help_overlay(area, buf);
-        }
-        if self.look.mode == super::widgets::preview::PreviewMode::Ascii {
-            asciify(area, buf);
-        }
-    }
-}
-
-/// Replaces every non-ASCII symbol with an ASCII look-alike, for terminals
-/// without Unicode (the ASCII preview mode promises plain ASCII output).
-fn asciify(area: Rect, buf: &mut Buffer) {
-    for y in area.top()..area.bottom() {
-        for x in area.left()..area.right() {
-            let Some(cell) = buf.cell_mut((x, y)) else {
-                continue;
-            };
-            if cell.symbol().is_ascii() {
-                continue;
+        if area.width < MIN_SIZE.0 || area.height < MIN_SIZE.1 {
+            let t = self.theme();
+            let text = vec![
+                Line::styled("terminal too small", t.error()),
+                Line::raw(format!("now {} × {}", area.width, area.height)),
+                Line::raw(format!("vss needs {} × {}", MIN_SIZE.0, MIN_SIZE.1)),
+                Line::raw("enlarge the window; q quits"),
+            ];
+            Paragraph::new(text)
+                .wrap(Wrap { trim: true })
+                .render(area, buf);
+            if self.ascii() {
+                chrome::asciify(area, buf);
             }
-            let c = match cell.symbol().chars().next().unwrap_or(' ') {
-                '—' | '–' | '─' | '━' => '-',
-                '│' | '┃' => '|',
-                '…' | '·' => '.',
-                '×' => 'x',
-                '←' => '<',
-                '→' => '>',
-                '↑' => '^',
-                '↓' => 'v',
-                '°' => 'o',
-                '┌' | '┐' | '└' | '┘' | '├' | '┤' | '┬' | '┴' | '┼' => '+',
-                _ => '?',
-            };
-            cell.set_char(c);
-        }
-    }
-}
-
-impl App {
-    fn top_bar(&self, area: Rect, buf: &mut Buffer) {
-        let t = self.theme();
-        let mut spans = vec![Span::styled(" vss ", t.title())];
-        for (i, s) in ScreenId::ALL.iter().enumerate() {
-            let label = format!(" {} {} ", i + 1, s.title());
-            let st = if *s == self.screen {
-                t.selected()
-            } else {
-                Style::new()
-            };
-            spans.push(Span::styled(label, st));
-        }
-        if let Some(s) = &self.session {
-            let bar = if self.look.mode == super::widgets::preview::PreviewMode::Ascii {
-                '|'
-            } else {
-                '│'
-            };
-            spans.push(Span::styled(format!(" {bar} {}", s.name), t.title()));
-        }
-        Line::from(spans).render(area, buf);
-    }
-
-    fn log_pane(&self, area: Rect, buf: &mut Buffer) {
-        if area.height == 0 {
             return;
         }
-        let t = self.theme();
-        let rows = area.height as usize;
-        let (inner, show) = if rows >= 3 {
-            let b = block(self, "log");
-            let inner = b.inner(area);
-            b.render(area, buf);
-            (inner, inner.height as usize)
-        } else {
-            (area, rows)
-        };
-        let n = self.log.len();
-        let lines: Vec<Line> = self
-            .log
-            .entries()
-            .skip(n.saturating_sub(show))
-            .map(|e| {
-                Line::from(vec![
-                    Span::styled(format!("{} ", e.time), t.dim()),
-                    Span::styled(e.text.clone(), t.level(e.level)),
-                ])
-            })
-            .collect();
-        Paragraph::new(lines).render(inner, buf);
-    }
-
-    fn status_bar(&self, area: Rect, buf: &mut Buffer) {
-        let t = self.theme();
-        let mut spans = Vec::new();
-        if let Some(lost) = &self.device.lost {
-            spans.push(Span::styled(format!("DEVICE LOST: {lost} "), t.error()));
-        } else if !self.device.connected {
-            spans.push(Span::styled("connecting… ", t.warn()));
+        let f = self.frame(area);
+        chrome::top_bar(self, f.top, buf);
+        match self.chrome.screen {
+            ScreenId::Survey => survey::render(self, f.body, buf),
+            ScreenId::Capture => capture::render(self, f.body, buf),
+            ScreenId::Pipeline => pipeline::render(self, f.body, buf),
+            ScreenId::Edit => edit::render(self, f.body, buf),
+            ScreenId::Session => session::render(self, f.body, buf),
+            ScreenId::Calibrate => calibrate::render(self, f.body, buf),
         }
-        if let Some((_, done, total)) = self.device.transfer {
-            spans.push(Span::styled(
-                format!("transfer {} ", gauge_text(done, total, 18)),
-                t.warn(),
-            ));
+        match self.chrome.log_view {
+            LogView::Expanded => chrome::log_pane(self, f.message, buf),
+            LogView::Line | LogView::Hidden => chrome::message(self, f.message, buf),
         }
-        if self.pipeline_busy() {
-            spans.push(Span::styled("running… ", t.warn()));
+        chrome::hints(self, f.hints, buf);
+        if let Some(m) = &self.chrome.modal {
+            chrome::modal_box(self, m, area, buf);
         }
-        // The keys that always work come first, so a narrow terminal cuts
-        // the screen's own hints rather than how to get help or out.
-        let scope = self.scope();
-        let mut hints = if matches!(scope, Scope::Screen(_)) {
-            keymap::hints(Scope::Global)
-        } else {
-            Vec::new()
-        };
-        hints.extend(keymap::hints(scope));
-        for (k, d) in hints {
-            spans.push(Span::styled(k, t.key()));
-            spans.push(Span::raw(format!(" {d} ")));
+        if let Some(o) = self.chrome.overlay {
+            chrome::overlay(self, o, area, buf);
         }
-        Line::from(spans).render(area, buf);
-    }
-
-    fn modal_box(&self, m: &Modal, area: Rect, buf: &mut Buffer) {
-        let t = self.theme();
-        let w = area.width.min(64);
-        let r = Rect::new(
-            area.x + (area.width - w) / 2,
-            area.y + area.height / 2 - 2,
-            w,
-            4.min(area.height),
-        );
-        Clear.render(r, buf);
-        let (title, body) = match m {
-            Modal::Prompt { title, text, .. } => (
-                "type, Enter accepts, Esc cancels",
-                Line::from(vec![
-                    Span::styled(format!("{title} "), t.title()),
-                    Span::raw(text.clone()),
-                    Span::styled("_", t.key()),
-                ]),
-            ),
-            Modal::Confirm { question, .. } => (
-                "y / n",
-                Line::from(vec![Span::styled(question.clone(), t.warn())]),
-            ),
-        };
-        Paragraph::new(body)
-            .wrap(Wrap { trim: true })
-            .block(block(self, title))
-            .render(r, buf);
-    }
-
-    fn help_overlay(&self, area: Rect, buf: &mut Buffer) {
-        let t = self.theme();
-        let r = Rect::new(
-            area.x + 1,
-            area.y + 1,
-            area.width.saturating_sub(2),
-            area.height.saturating_sub(2),
-        );
-        Clear.render(r, buf);
-        let mut lines = vec![Line::styled(
-            format!("{} screen", self.screen.title()),
-            t.title(),
-        )];
-        let row = |(k, d): (String, &str)| {
-            Line::from(vec![
-                Span::styled(format!("{k:>9} "), t.key()),
-                Span::raw(d.to_string()),
-            ])
-        };
-        lines.extend(
-            keymap::describe(Scope::Screen(self.screen))
-                .into_iter()
-                .map(row),
-        );
-        lines.push(Line::styled("Everywhere", t.title()));
-        lines.extend(keymap::describe(Scope::Global).into_iter().map(row));
-        let b = block(self, "help — any key closes");
-        let inner = b.inner(r);
-        b.render(r, buf);
-        // Too many rows for one column (80 x 24): flow into two.
-        let rows = inner.height.max(1) as usize;
-        let cols = lines.len().div_ceil(rows).clamp(1, 3);
-        let areas = Layout::horizontal(vec![Constraint::Ratio(1, cols as u32); cols]).split(inner);
-        for (i, a) in areas.iter().enumerate() {
-            let part: Vec<Line> = lines.iter().skip(i * rows).take(rows).cloned().collect();
-            Paragraph::new(part).render(*a, buf);
+        if self.ascii() {
+            chrome::asciify(area, buf);
         }
     }
 }
 
-/// Two areas side by side: a panel of `panel` columns (at most half) and the rest.
-pub fn split_panel(area: Rect, panel: u16) -> (Rect, Rect) {
-    let p = panel.min(area.width / 2);
-    let [a, b] = Layout::horizontal([Constraint::Length(p), Constraint::Min(1)]).areas(area);
-    (a, b)
+/// A signed readout with one decimal, never `-0.0`.
+pub fn signed(v: f32) -> String {
+    let s = format!("{v:+.1}");
+    match s.as_str() {
+        "-0.0" | "+0.0" => "0.0".into(),
+        _ => s,
+    }
+}
+
+/// The columns of a screen's left panel.
+pub fn panel_width(s: ScreenId) -> u16 {
+    match s {
+        ScreenId::Survey | ScreenId::Session | ScreenId::Calibrate => 34,
+        ScreenId::Capture | ScreenId::Pipeline => 32,
+        ScreenId::Edit => 30,
+    }
+}
+
+/// Where a mouse event falls on the console drawn at `area`.
+pub fn pointer(
+    app: &App,
+    area: Rect,
+    m: ratatui::crossterm::event::MouseEvent,
+) -> Option<super::event::Pointer> {
+    use super::event::Pointer;
+    use ratatui::crossterm::event::{MouseButton, MouseEventKind};
+    let (col, row) = (m.column, m.row);
+    let inside = |r: Rect| col >= r.x && col < r.right() && row >= r.y && row < r.bottom();
+    let f = app.frame(area);
+    let wheel = match m.kind {
+        MouseEventKind::ScrollUp => Some(true),
+        MouseEventKind::ScrollDown => Some(false),
+        MouseEventKind::Down(MouseButton::Left) => None,
+        _ => return None,
+    };
+    if app.chrome.overlay.is_some() || inside(f.message) {
+        return wheel.map(|up| Pointer::ScrollLog { up });
+    }
+    if !inside(f.body) {
+        return None;
+    }
+    let screen = app.chrome.screen;
+    let (panel, right) = split_panel(f.body, panel_width(screen));
+    let inner = |r: Rect| Block::default().borders(Borders::ALL).inner(r);
+    if inside(panel) {
+        if let Some(up) = wheel {
+            return Some(Pointer::ScrollList { up });
+        }
+        let p = inner(panel);
+        let r = row.checked_sub(p.y)? as usize;
+        return match screen {
+            ScreenId::Survey if app.session.view.is_none() || app.screens.survey.picking => {
+                let n = app.session.list.len();
+                let room = (p.height as usize).saturating_sub(4);
+                let (start, _, above) = window_span(n, app.screens.survey.selected, room);
+                let i = (r.checked_sub(1 + usize::from(above))? + start).min(n);
+                (i < n).then_some(Pointer::SessionRow(i))
+            }
+            ScreenId::Survey => {
+                let ks = app.session.numbers();
+                let sel = app.screens.survey.row(&app.session.work);
+                let focus = ks.iter().position(|&k| k == sel).unwrap_or(0);
+                let room = (p.height as usize).saturating_sub(survey::CHECKLIST_HEAD as usize);
+                let (start, shown, above) = window_span(ks.len(), focus, room);
+                let i = r.checked_sub(survey::CHECKLIST_HEAD as usize + usize::from(above))?;
+                (i < shown).then(|| ks.get(start + i).copied().map(Pointer::Checklist))?
+            }
+            ScreenId::Pipeline => {
+                let n = crate::llv::params::PARAMS.len();
+                let inner_h = p.height as usize;
+                let doc = app.screens.pipeline.param_spec().doc;
+                let doc_rows = chrome::wrap(doc, p.width as usize).len();
+                let room = inner_h
+                    .saturating_sub((5 + doc_rows).min(inner_h / 2))
+                    .max(1);
+                let (start, shown, above) = window_span(n, app.screens.pipeline.param, room);
+                let i = r.checked_sub(usize::from(above))?;
+                (i < shown).then_some(Pointer::Param(start + i))
+            }
+            ScreenId::Capture | ScreenId::Edit | ScreenId::Session | ScreenId::Calibrate => None,
+        };
+    }
+    if !inside(right) || !super::keymap::has_picture(screen) {
+        return wheel.map(|up| Pointer::ScrollList { up });
+    }
+    if let Some(zoom_in) = wheel {
+        return Some(Pointer::Zoom { zoom_in });
+    }
+    // The picture's cells: the right side below the survey's step box,
+    // above the Pipeline's cursor line, inside the border.
+    let pic = match screen {
+        ScreenId::Survey => Rect {
+            y: right.y + 5,
+            height: right.height.saturating_sub(5),
+            ..right
+        },
+        ScreenId::Pipeline if app.screens.pipeline.side_by_side => return None,
+        ScreenId::Pipeline => Rect {
+            height: right.height.saturating_sub(1),
+            ..right
+        },
+        _ => right,
+    };
+    let pic = inner(pic);
+    if !inside(pic) {
+        return None;
+    }
+    let size = app.picture_size(screen)?;
+    let nav = app.screens.nav(screen)?;
+    let geo = super::widgets::preview::Geometry::new(pic, size, &nav.view);
+    let (x, y) = geo.cell_to_pixel(col - pic.x, row - pic.y, size)?;
+    Some(Pointer::Pixel(x, y))
 }

@@ -305,9 +305,7 @@ fn the_calibration_page_renders_in_ghostscript() {
         ps.contains("C \\(stated\\)"),
         "the stated centre is on the page"
     );
-    if !crate::support::gs::have_gs() {
-        return;
-    }
+    crate::support::gs::require_gs();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("cal.ps");
     std::fs::write(&path, &ps).unwrap();

@@ -5,7 +5,7 @@
 //! one is kept beside it as `.bak`.
 
 use vss::formats::cdf::{Status, read_cdf, write_cdf};
-use vss::tui::keymap::{Action, Scope, ScreenId};
+use vss::tui::keymap::{Action, CalibrateAction as CA, GlobalAction, Scope, ScreenId};
 
 use super::tui_harness::Console;
 
@@ -50,29 +50,32 @@ fn a_camera_calibrated_on_the_calibrate_screen() {
         .camera_model()
         .unwrap();
     c.wait_text("Survey", 10);
-    c.press(Scope::Global, Action::GoTo(ScreenId::Calibrate));
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
+    );
     c.wait_text("views kept: 0", 10);
     let cb = Scope::Screen(ScreenId::Calibrate);
-    c.press(cb, Action::CalibPlate);
+    c.press(cb, Action::Calibrate(CA::Plate));
     c.wait_text("(in view)", 10);
     for n in 1..=6 {
-        c.press(cb, Action::Grab);
+        c.press(cb, Action::Calibrate(CA::Grab));
         c.wait("a grid in the new frame", 30, |s| {
             s.contains("188 corners found")
         });
-        c.press(cb, Action::CalibKeep);
+        c.press(cb, Action::Calibrate(CA::Keep));
         c.wait_text(&format!("views kept: {n}"), 10);
     }
-    c.press(cb, Action::CalibCentre);
+    c.press(cb, Action::Calibrate(CA::Centre));
     c.wait_text("stated, image middle", 10);
-    c.press(cb, Action::CalibSolve);
+    c.press(cb, Action::Calibrate(CA::Solve));
     let s = c.wait("the calibration", 30, |s| {
         s.contains("RMS 0.") && s.contains("worst:")
     });
     assert!(s.contains("residuals ×"), "{s}");
-    c.press(cb, Action::CalibAccept);
-    c.wait_text("replace S, C, f, D", 10);
-    c.press(Scope::Confirm, Action::Yes);
+    c.press(cb, Action::Calibrate(CA::Accept));
+    c.wait_text("write S, C, f, D", 10);
+    c.yes();
     c.wait("the file written", 10, |_| {
         std::fs::read(dir.join("cam1.cdf")).is_ok_and(|b| b != before)
     });
@@ -88,6 +91,50 @@ fn a_camera_calibrated_on_the_calibrate_screen() {
         m.f,
         truth.f
     );
+    c.send("q");
+    c.wait_exit(10);
+}
+
+/// At 80 × 24: a frame without the plate is not kept and says why, and
+/// two views are refused with what to do; no `.cdf` is touched.
+#[test]
+fn too_few_views_and_no_plate_are_refused_at_80_by_24() {
+    let mut c = Console::start_with(PROFILE, 80, 24, &[], |dir| {
+        for cam in 1..=2 {
+            let cdf = vss::rig::sim::camera_cdf(cam, 512, 512).unwrap();
+            write_cdf(&dir.join(format!("cam{cam}.cdf")), &cdf).unwrap();
+        }
+    });
+    let dir = c.dir.path().to_path_buf();
+    let before = std::fs::read(dir.join("cam1.cdf")).unwrap();
+    c.wait_text("Survey", 10);
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
+    );
+    c.wait_text("views kept: 0", 10);
+    let cb = Scope::Screen(ScreenId::Calibrate);
+    c.press(cb, Action::Calibrate(CA::Keep));
+    c.wait_words("no grid of camera 1 to keep", 10);
+    // The bare cell: the grab has no plate in it.
+    c.press(cb, Action::Calibrate(CA::Grab));
+    c.wait_words("grid: the plate is not in view", 30);
+    c.press(cb, Action::Calibrate(CA::Keep));
+    c.wait_words("not kept: the plate is not in view", 10);
+    c.press(cb, Action::Calibrate(CA::Plate));
+    c.wait_text("(in view)", 10);
+    for n in 1..=2 {
+        c.press(cb, Action::Calibrate(CA::Grab));
+        c.wait("a grid in the new frame", 30, |s| s.contains("188 corners"));
+        c.press(cb, Action::Calibrate(CA::Keep));
+        c.wait_text(&format!("views kept: {n}"), 10);
+    }
+    c.press(cb, Action::Calibrate(CA::Solve));
+    c.wait_words("2 usable view(s) of the plate; at least 3 are needed", 30);
+    c.press(cb, Action::Calibrate(CA::Accept));
+    c.wait_words("nothing to accept", 10);
+    assert_eq!(std::fs::read(dir.join("cam1.cdf")).unwrap(), before);
+    assert!(!dir.join("cam1.cdf.bak").exists());
     c.send("q");
     c.wait_exit(10);
 }

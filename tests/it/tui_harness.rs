@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use portable_pty::{Child, CommandBuilder, MasterPty, PtySize, native_pty_system};
 use ratatui::crossterm::event::KeyCode;
-use vss::tui::keymap::{Action, KEYMAP, Key, Scope, ScreenId};
+use vss::tui::keymap::{Action, KEYMAP, Key, ModalAction, Scope, ScreenId, SurveyAction};
 
 /// A small, quick simulated cell: 128 × 128 images, short settle, three
 /// lightings (c ambient), four cameras.
@@ -122,6 +122,8 @@ pub struct Console {
     parser: Arc<Mutex<vt100::Parser>>,
     pub raw: Arc<Mutex<Vec<u8>>>,
     pub dir: tempfile::TempDir,
+    /// Started in another console's folder.
+    pub twin: bool,
 }
 
 #[allow(dead_code)]
@@ -154,6 +156,18 @@ impl Console {
         env: &[(&str, &str)],
         args: &[&str],
     ) -> Console {
+        let cwd = dir.path().to_path_buf();
+        Console::spawn(&cwd, dir, cols, rows, env, args)
+    }
+
+    fn spawn(
+        cwd: &Path,
+        dir: tempfile::TempDir,
+        cols: u16,
+        rows: u16,
+        env: &[(&str, &str)],
+        args: &[&str],
+    ) -> Console {
         let pty = native_pty_system();
         let size = PtySize {
             rows,
@@ -164,11 +178,11 @@ impl Console {
         let pair = pty.openpty(size).unwrap();
         let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_vss"));
         cmd.args(args);
-        cmd.cwd(dir.path());
+        cmd.cwd(cwd);
         cmd.env("TERM", "xterm-256color");
         // The log file goes to the session folder or here, never to the
         // tester's own state folder.
-        cmd.env("XDG_STATE_HOME", dir.path().join("state"));
+        cmd.env("XDG_STATE_HOME", cwd.join("state"));
         cmd.env_remove("NO_COLOR");
         for (k, v) in env {
             cmd.env(k, v);
@@ -199,6 +213,7 @@ impl Console {
             parser,
             raw,
             dir,
+            twin: false,
         }
     }
 
@@ -243,6 +258,11 @@ impl Console {
         self.send(&bytes(&k));
     }
 
+    /// Answers the open question with yes.
+    pub fn yes(&mut self) {
+        self.press(Scope::Confirm, Action::Modal(ModalAction::Yes));
+    }
+
     /// Waits until the screen satisfies `f`, or fails showing the screen.
     pub fn wait(&self, what: &str, secs: u64, f: impl Fn(&str) -> bool) -> String {
         let end = Instant::now() + Duration::from_secs(secs);
@@ -262,6 +282,11 @@ impl Console {
         self.wait(text, secs, |s| s.contains(text))
     }
 
+    /// Waits for `text`, which may be wrapped over rows.
+    pub fn wait_words(&self, text: &str, secs: u64) -> String {
+        self.wait(text, secs, |s| flat(s).contains(text))
+    }
+
     pub fn wait_exit(&mut self, secs: u64) {
         let end = Instant::now() + Duration::from_secs(secs);
         while Instant::now() < end {
@@ -276,6 +301,46 @@ impl Console {
         panic!("vss did not exit; screen:\n{}", self.screen());
     }
 
+    /// Quits (answering yes if asked) and starts the console again in the
+    /// same folder, with the same profile.
+    pub fn restart(mut self, cols: u16, rows: u16, env: &[(&str, &str)]) -> Console {
+        self.send("q");
+        self.wait_exit(15);
+        let dir = std::mem::replace(&mut self.dir, tempfile::tempdir().unwrap());
+        Console::start_in(dir, cols, rows, env, &["--profile", "cell.toml"])
+    }
+
+    /// Quits, lets `setup` change the folder, and starts again there at
+    /// the same size.
+    pub fn restart_after(mut self, setup: impl FnOnce(&Path)) -> Console {
+        let (rows, cols) = self.parser.lock().unwrap().screen().size();
+        self.send("q");
+        self.wait_exit(15);
+        let dir = std::mem::replace(&mut self.dir, tempfile::tempdir().unwrap());
+        setup(dir.path());
+        Console::start_in(dir, cols, rows, &[], &["--profile", "cell.toml"])
+    }
+
+    /// A second console started in the same folder (its own `dir` is an
+    /// empty one, for its drop).
+    pub fn another(&self, cols: u16, rows: u16) -> Console {
+        let mut c = Console::spawn(
+            self.dir.path(),
+            tempfile::tempdir().unwrap(),
+            cols,
+            rows,
+            &[],
+            &["--profile", "cell.toml"],
+        );
+        c.twin = true;
+        c
+    }
+
+    /// The child's exit status, once it has ended.
+    pub fn exit_code(&mut self) -> Option<u32> {
+        self.child.try_wait().ok().flatten().map(|s| s.exit_code())
+    }
+
     pub fn sessions(&self) -> PathBuf {
         self.dir.path().join("sessions")
     }
@@ -287,7 +352,7 @@ impl Console {
     /// Creates session `name` by keys.
     pub fn create_session(&mut self, name: &str) {
         self.wait_text("choose a session", 10);
-        self.press(SURVEY, Action::NewSession);
+        self.press(SURVEY, Action::Survey(SurveyAction::NewSession));
         self.wait_text("new session name", 5);
         self.send(name);
         self.send("\r");
@@ -298,7 +363,7 @@ impl Console {
     /// waits for its review.
     pub fn capture_current(&mut self, k: u32) {
         self.wait_text(&format!("Image {k}: camera"), 20);
-        self.press(SURVEY, Action::NextStep);
+        self.press(SURVEY, Action::Survey(SurveyAction::Enter));
         self.wait(&format!("image {k} reviewed"), 60, |s| {
             s.contains(&format!("Image {k}: ")) && s.contains("before CONNECT")
         });
@@ -309,7 +374,7 @@ impl Console {
         self.create_session("cube");
         for k in 1..=n {
             self.capture_current(k);
-            self.press(SURVEY, Action::Accept);
+            self.press(SURVEY, Action::Survey(SurveyAction::Accept));
             self.wait_text(&format!("Image {}: camera", k + 1), 20);
         }
     }
@@ -330,16 +395,12 @@ pub const EDIT: Scope = Scope::Screen(ScreenId::Edit);
 #[allow(dead_code)]
 pub const SESSION: Scope = Scope::Screen(ScreenId::Session);
 
-/// The first key the table binds to `action` in `scope` (or globally).
+/// The first key the table binds to `action` in `scope`, else among the
+/// picture keys (a screen with a picture), else globally.
 pub fn key_of(scope: Scope, action: Action) -> Key {
-    KEYMAP
+    [scope, Scope::Picture, Scope::Global]
         .iter()
-        .find(|b| b.scope == scope && b.action == action)
-        .or_else(|| {
-            KEYMAP
-                .iter()
-                .find(|b| b.scope == Scope::Global && b.action == action)
-        })
+        .find_map(|sc| KEYMAP.iter().find(|b| b.scope == *sc && b.action == action))
         .map(|b| b.key)
         .unwrap_or_else(|| panic!("no key for {action:?} in {scope:?}"))
 }
@@ -378,12 +439,15 @@ pub fn bytes(k: &Key) -> String {
 /// The value the parameter panel shows for `key` (`None` when the row is
 /// not on screen).
 pub fn panel_value(screen: &str, key: &str) -> Option<String> {
+    // Rows of the panel start at its border; the log also names keys.
     screen.lines().find_map(|l| {
-        let at = l.find(&format!("{key} "))?;
+        let at = ["│", "|"]
+            .iter()
+            .find_map(|b| l.starts_with(&format!("{b}{key} ")).then_some(b.len()))?;
         let rest = l[at + key.len()..].trim_start();
         let v: String = rest
             .chars()
-            .take_while(|c| !c.is_whitespace() && *c != '│' && *c != '|')
+            .take_while(|c| !c.is_whitespace() && !matches!(c, '│' | '|' | '*'))
             .collect();
         (!v.is_empty()).then_some(v)
     })
@@ -400,6 +464,12 @@ pub fn line_count(screen: &str) -> Option<usize> {
         }
         digits.parse().ok()
     })
+}
+
+/// The screen's text with every run of blanks and line ends made one
+/// space, so wrapped words read on.
+pub fn flat(screen: &str) -> String {
+    screen.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// Whether `dir` holds a file `name`.

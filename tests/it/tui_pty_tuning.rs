@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use vss::llv::params::{Kind, PARAMS};
 use vss::session::Session;
-use vss::tui::keymap::Action;
+use vss::tui::keymap::{Action, PipelineAction};
 
 use super::tui_harness::{Console, PIPELINE, five_lightings, line_count, panel_value, write_cdfs};
 
@@ -54,7 +54,7 @@ fn every_parameter(lens: bool) {
     values.lens.enabled = lens;
     for (i, sp) in PARAMS.iter().enumerate() {
         if i > 0 {
-            c.press(PIPELINE, Action::ParamNext);
+            c.press(PIPELINE, Action::Pipeline(PipelineAction::ParamNext));
         }
         // Keys are taken in order: the change below goes to this parameter.
         let now = values.get(sp.key).unwrap();
@@ -72,21 +72,21 @@ fn every_parameter(lens: bool) {
             (
                 changed,
                 if up {
-                    Action::ParamInc
+                    PipelineAction::Inc
                 } else {
-                    Action::ParamDec
+                    PipelineAction::Dec
                 },
             ),
             (
                 now,
                 if up {
-                    Action::ParamDec
+                    PipelineAction::Dec
                 } else {
-                    Action::ParamInc
+                    PipelineAction::Inc
                 },
             ),
         ] {
-            c.press(PIPELINE, action);
+            c.press(PIPELINE, Action::Pipeline(action));
             let s = c.wait(&format!("{} = {target} run", sp.key), 20, |s| {
                 panel_value(s, sp.key).and_then(|v| v.parse::<f64>().ok()) == Some(target)
                     && !s.contains("running")
@@ -97,7 +97,15 @@ fn every_parameter(lens: bool) {
                 sp.key
             );
             let shown = line_count(&s).expect("a line count on the Pipeline screen");
-            c.press(PIPELINE, Action::SaveOutputs);
+            c.press(PIPELINE, Action::Pipeline(PipelineAction::Save));
+            // Once saved, image 1 is accepted: saving over it asks.
+            let s = c.wait("saved, or the question", 10, |s| {
+                s.contains("Replace its saved outputs")
+                    || saved(&c).is_some_and(|(p, _)| p.get(sp.key) == Some(target))
+            });
+            if s.contains("Replace its saved outputs") {
+                c.yes();
+            }
             let (p, n) = wait_saved(&c, sp.key, target);
             values.set(sp.key, target).unwrap();
             assert_eq!(

@@ -1,7 +1,9 @@
 //! Every screen of the console drawn through ratatui's `TestBackend`
 //! (80 × 24 and larger), driven by messages alone — the same messages the
-//! workers send — so the survey flow, the generation rule, the modal
-//! questions and the no-colour mode are checked without a terminal.
+//! workers send — so the survey flow, the generation rule, the questions,
+//! the messages and the no-colour mode are checked without a terminal.
+//! Keys are pressed by what they do, through the console's key table.
+//! The helpers here are shared with `tui_flow`.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -11,13 +13,16 @@ use ratatui::backend::TestBackend;
 use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::style::Color;
 
-use vss::llv::pipeline::{self, Input};
+use vss::llv::pipeline;
 use vss::llv::{GreyImage, Params};
 use vss::profile::Profile;
 use vss::tui::app::{App, Phase};
 use vss::tui::event::{
-    Cmd, DeviceCmd, DeviceEvent, FramePurpose, ImageState, Msg, PipelineResult, SessionView,
-    StoreCmd, StoreEvent,
+    Cmd, DeviceCmd, DeviceEvent, FramePurpose, Msg, PipelineResult, SessionView, StoreCmd,
+    StoreEvent,
+};
+use vss::tui::keymap::{
+    Action, EditAction, GlobalAction, KEYMAP, Key, PipelineAction, Scope, ScreenId, SurveyAction,
 };
 use vss::tui::mode::Look;
 use vss::tui::widgets::preview::PreviewMode;
@@ -41,18 +46,19 @@ letter = "c"
 on = []
 "#;
 
-fn profile() -> Profile {
+pub fn profile() -> Profile {
     Profile::from_toml(PROFILE, Path::new("test.toml")).unwrap()
 }
 
-fn colour() -> Look {
+pub fn colour() -> Look {
     Look {
         mode: PreviewMode::Blocks,
         colour: true,
+        c256: true,
     }
 }
 
-fn draw(app: &App, w: u16, h: u16) -> (String, ratatui::buffer::Buffer) {
+pub fn draw(app: &App, w: u16, h: u16) -> (String, ratatui::buffer::Buffer) {
     let mut t = Terminal::new(TestBackend::new(w, h)).unwrap();
     t.draw(|f| f.render_widget(app, f.area())).unwrap();
     let buf = t.backend().buffer().clone();
@@ -66,19 +72,54 @@ fn draw(app: &App, w: u16, h: u16) -> (String, ratatui::buffer::Buffer) {
     (s, buf)
 }
 
-fn key(app: &mut App, c: char) -> Vec<Cmd> {
+pub fn event(k: Key) -> KeyEvent {
+    let mut m = KeyModifiers::NONE;
+    if k.ctrl {
+        m |= KeyModifiers::CONTROL;
+    }
+    if k.shift {
+        m |= KeyModifiers::SHIFT;
+    }
+    KeyEvent::new(k.code, m)
+}
+
+/// Presses the key the table binds to `action` in `scope` (or globally).
+pub fn press(app: &mut App, scope: Scope, action: Action) -> Vec<Cmd> {
+    let k = KEYMAP
+        .iter()
+        .find(|b| b.action == action && (b.scope == scope || b.scope == Scope::Global))
+        .or_else(|| KEYMAP.iter().find(|b| b.action == action))
+        .unwrap_or_else(|| panic!("no key for {action:?}"))
+        .key;
+    app.update(Msg::Key(event(k)))
+}
+
+pub fn survey(app: &mut App, a: SurveyAction) -> Vec<Cmd> {
+    press(app, Scope::Screen(ScreenId::Survey), Action::Survey(a))
+}
+pub fn pipe(app: &mut App, a: PipelineAction) -> Vec<Cmd> {
+    press(app, Scope::Screen(ScreenId::Pipeline), Action::Pipeline(a))
+}
+pub fn edit(app: &mut App, a: EditAction) -> Vec<Cmd> {
+    press(app, Scope::Screen(ScreenId::Edit), Action::Edit(a))
+}
+pub fn go(app: &mut App, s: ScreenId) {
+    press(app, Scope::Global, Action::Global(GlobalAction::GoTo(s)));
+}
+
+pub fn key(app: &mut App, c: char) -> Vec<Cmd> {
     app.update(Msg::Key(KeyEvent::new(
         KeyCode::Char(c),
         KeyModifiers::NONE,
     )))
 }
 
-fn code(app: &mut App, k: KeyCode) -> Vec<Cmd> {
+pub fn code(app: &mut App, k: KeyCode) -> Vec<Cmd> {
     app.update(Msg::Key(KeyEvent::new(k, KeyModifiers::NONE)))
 }
 
 /// A dark image with a bright square: a few clear lines.
-fn square(level: u8) -> GreyImage {
+pub fn square(level: u8) -> GreyImage {
     let (w, h) = (96, 96);
     let mut d = vec![30u8; w * h];
     for y in 30..66 {
@@ -89,7 +130,7 @@ fn square(level: u8) -> GreyImage {
     GreyImage::new(w, h, d).unwrap()
 }
 
-fn view() -> SessionView {
+pub fn view() -> SessionView {
     SessionView {
         name: "cube".into(),
         dir: PathBuf::from("/tmp/sessions/cube"),
@@ -97,20 +138,36 @@ fn view() -> SessionView {
         images: Vec::new(),
         next: Some((1, Some('a'))),
         files: Vec::new(),
+        checked: true,
+    }
+}
+
+/// Runs a pipeline request in the test, as the worker would.
+pub fn run(app: &mut App, cmds: Vec<Cmd>) {
+    for c in cmds {
+        if let Cmd::Pipeline(req) = c {
+            let out = pipeline::run(&req.input.input(None), &req.params).unwrap();
+            app.update(Msg::Pipeline(PipelineResult {
+                generation: req.generation,
+                image_key: req.image_key,
+                params: req.params.clone(),
+                outcome: Ok(Arc::new(out)),
+            }));
+        }
     }
 }
 
 /// Runs the survey for image 1 through messages; returns the app in Review.
-fn reviewed() -> App {
+pub fn reviewed() -> App {
     reviewed_in(view())
 }
 
 /// [`reviewed`] in the session `v`.
-fn reviewed_in(v: SessionView) -> App {
+pub fn reviewed_in(v: SessionView) -> App {
     let mut app = App::new(&profile(), colour());
     app.start();
     app.update(Msg::Store(StoreEvent::Opened(v)));
-    let mut cmds = code(&mut app, KeyCode::Enter);
+    let mut cmds = survey(&mut app, SurveyAction::Enter);
     for (i, letter) in ['a', 'b', 'c'].into_iter().enumerate() {
         assert!(
             cmds.iter().any(|c| matches!(c, Cmd::Device(DeviceCmd::Capture {
@@ -128,54 +185,63 @@ fn reviewed_in(v: SessionView) -> App {
         );
     }
     let req = cmds
-        .into_iter()
+        .iter()
         .find_map(|c| match c {
             Cmd::Pipeline(r) => Some(r),
             _ => None,
         })
         .expect("pipeline asked once all lightings are in");
-    assert_eq!(req.images.len(), 2, "lit images");
-    assert!(req.ambient.is_some(), "lighting c is ambient");
-    let out = pipeline::run(
-        &Input {
-            images: &req.images,
-            ambient: req.ambient.as_deref(),
-            lens: None,
-        },
-        &req.params,
-    )
-    .unwrap();
-    app.update(Msg::Pipeline(PipelineResult {
-        generation: req.generation,
-        image_key: req.image_key,
-        params: req.params.clone(),
-        outcome: Ok(Arc::new(out)),
-    }));
-    assert_eq!(app.work.phase, Phase::Review);
+    assert_eq!(req.input.letters, vec!['a', 'b'], "lit images");
+    assert!(
+        req.input.ambient.as_ref().is_some_and(|a| a.0 == 'c'),
+        "lighting c is ambient"
+    );
+    run(&mut app, cmds);
+    assert_eq!(app.session.work.phase, Phase::Review);
     app
+}
+
+pub fn lines_shown(app: &App) -> usize {
+    app.tracker
+        .current
+        .as_ref()
+        .and_then(|c| c.lines())
+        .map_or(0, <[_]>::len)
 }
 
 #[test]
 fn every_screen_is_usable_at_80x24() {
     let mut app = reviewed();
-    let wants: [(char, &[&str]); 5] = [
-        ('1', &["1 Survey", "checklist", "a accept"]),
-        ('2', &["lights", "left", "grabber"]),
+    let wants: [(ScreenId, &[&str]); 5] = [
+        (ScreenId::Survey, &["1 Survey", "session cube", "accepts"]),
+        (ScreenId::Capture, &["lights", "left", "grabber"]),
         (
-            '3',
-            &["parameters", "edges.half_width", "lines over grey", "grey "],
+            ScreenId::Pipeline,
+            &[
+                "parameters",
+                "edges.half_width",
+                "lines over grey",
+                "stretched",
+            ],
         ),
-        ('4', &["lines over grey", "selected"]),
-        ('5', &["session", "e exports"]),
+        (ScreenId::Edit, &["lines over", "highlighted"]),
+        (ScreenId::Session, &["session", "e writes"]),
     ];
-    for (k, texts) in wants {
-        key(&mut app, k);
-        let (s, _) = draw(&app, 80, 24);
+    for (s, texts) in wants {
+        go(&mut app, s);
+        let (text, _) = draw(&app, 80, 24);
         for t in texts {
-            assert!(s.contains(t), "screen {k} lacks {t:?}:\n{s}");
+            assert!(text.contains(t), "{s:?} lacks {t:?}:\n{text}");
         }
-        let last = s.lines().nth(23).unwrap();
-        assert!(last.contains("quit"), "status bar on screen {k}: {last}");
+        let last = text.lines().nth(23).unwrap();
+        assert!(
+            text.lines().skip(21).any(|l| l.contains("quit")),
+            "hints on {s:?}: {last}"
+        );
+        assert!(
+            text.lines().next().unwrap().contains("screen test cell"),
+            "the profile's name in the top bar:\n{text}"
+        );
     }
 }
 
@@ -183,18 +249,10 @@ fn every_screen_is_usable_at_80x24() {
 fn survey_review_shows_the_line_count_and_accept_moves_on() {
     let mut app = reviewed();
     let (s, _) = draw(&app, 100, 30);
-    let n = app
-        .current
-        .as_ref()
-        .unwrap()
-        .outputs
-        .as_ref()
-        .unwrap()
-        .lines
-        .len();
+    let n = lines_shown(&app);
     assert!(n >= 4, "the square gives lines: {n}");
     assert!(s.contains(&format!("Image 1: {n} lines")), "{s}");
-    let cmds = key(&mut app, 'a');
+    let cmds = survey(&mut app, SurveyAction::Accept);
     assert!(
         cmds.iter()
             .any(|c| matches!(c, Cmd::Store(StoreCmd::SaveOutputs { k: 1, .. })))
@@ -203,144 +261,194 @@ fn survey_review_shows_the_line_count_and_accept_moves_on() {
     assert!(s.contains("Image 2: camera"), "{s}");
 }
 
+/// Enter in review never accepts on its own: it asks.
 #[test]
-fn accept_moves_on_to_the_camera_and_location_the_survey_planned() {
-    // The session has image 2 on record for camera 3 at location 2 (a new
-    // survey plans one image per camera); image 1 is taken with camera 1.
-    let plan = |k, camera, location| ImageState {
-        k,
-        camera,
-        location,
-        captured: Vec::new(),
-        outputs: false,
-        stale: false,
-        edits: 0,
-    };
-    let mut v = view();
-    v.images = vec![plan(1, 1, 1), plan(2, 3, 2)];
-    let mut app = reviewed_in(v);
-    key(&mut app, 'a');
-    let (s, _) = draw(&app, 100, 30);
-    assert!(s.contains("Image 2: camera 3 (c), location 2 (p)"), "{s}");
-    // Enter captures image 2 with that camera.
-    let cmds = code(&mut app, KeyCode::Enter);
-    assert!(
-        cmds.iter().any(|c| matches!(
-            c,
-            Cmd::Device(DeviceCmd::Capture {
-                purpose: FramePurpose::Survey { k: 2, .. },
-                camera: 3,
-                ..
-            })
-        )),
-        "capture with camera 3 asked: {cmds:?}"
+fn enter_in_review_asks_before_accepting() {
+    let mut app = reviewed();
+    let cmds = survey(&mut app, SurveyAction::Enter);
+    assert!(cmds.is_empty(), "{cmds:?}");
+    let (s, _) = draw(&app, 80, 24);
+    assert!(s.contains("Accept image 1"), "{s}");
+    press(
+        &mut app,
+        Scope::Confirm,
+        Action::Modal(vss::tui::keymap::ModalAction::No),
     );
+    assert_eq!(app.session.work.phase, Phase::Review);
+    survey(&mut app, SurveyAction::Enter);
+    let cmds = press(
+        &mut app,
+        Scope::Confirm,
+        Action::Modal(vss::tui::keymap::ModalAction::Yes),
+    );
+    assert!(
+        cmds.iter()
+            .any(|c| matches!(c, Cmd::Store(StoreCmd::SaveOutputs { k: 1, .. })))
+    );
+    assert_eq!(app.session.work.k, 2);
 }
 
 #[test]
 fn a_parameter_change_reruns_and_older_results_never_win() {
     let mut app = reviewed();
-    key(&mut app, '3');
-    code(&mut app, KeyCode::Down); // edges.half_width
-    let before = app.generation;
-    let cmds = key(&mut app, '+');
-    let Some(Cmd::Pipeline(req)) = cmds.into_iter().next() else {
+    go(&mut app, ScreenId::Pipeline);
+    pipe(&mut app, PipelineAction::ParamNext); // edges.half_width
+    let before = app.tracker.generation;
+    let cmds = pipe(&mut app, PipelineAction::Inc);
+    let Some(Cmd::Pipeline(req)) = cmds.first() else {
         panic!("a parameter step asks for a run");
     };
     assert_eq!(req.generation, before + 1);
     assert_ne!(req.params, Params::default());
-    let out = pipeline::run(
-        &Input {
-            images: &req.images,
-            ambient: req.ambient.as_deref(),
-            lens: None,
-        },
-        &req.params,
-    )
-    .unwrap();
-    let mut stale = out.clone();
-    stale.lines.clear();
-    app.update(Msg::Pipeline(PipelineResult {
-        generation: req.generation,
-        image_key: req.image_key,
-        params: req.params.clone(),
-        outcome: Ok(Arc::new(out)),
-    }));
-    let shown = app
+    assert!(
+        app.chrome
+            .log
+            .last()
+            .unwrap()
+            .text
+            .contains("edges.half_width 4 → 5"),
+        "the change is logged"
+    );
+    let req = req.clone();
+    run(&mut app, cmds);
+    let shown = lines_shown(&app);
+    // A result of an older generation arriving late is ignored.
+    let mut stale = (*app
+        .tracker
         .current
         .as_ref()
         .unwrap()
         .outputs
-        .as_ref()
-        .unwrap()
-        .lines
-        .len();
-    // A result of an older generation arriving late is ignored.
+        .clone()
+        .unwrap())
+    .clone();
+    stale.lines.clear();
     app.update(Msg::Pipeline(PipelineResult {
         generation: before,
         image_key: req.image_key,
         params: Params::default(),
         outcome: Ok(Arc::new(stale)),
     }));
-    assert_eq!(
-        app.current
-            .as_ref()
-            .unwrap()
-            .outputs
-            .as_ref()
-            .unwrap()
-            .lines
-            .len(),
-        shown
-    );
-}
-
-#[test]
-fn redo_asks_before_overwriting() {
-    let mut app = reviewed();
-    key(&mut app, '1');
-    assert!(key(&mut app, 'r').is_empty());
+    assert_eq!(lines_shown(&app), shown);
     let (s, _) = draw(&app, 80, 24);
-    assert!(s.contains("Redo image 1?"), "{s}");
-    assert!(key(&mut app, 'n').is_empty());
-    assert_eq!(app.work.phase, Phase::Review);
-    key(&mut app, 'r');
-    let cmds = key(&mut app, 'y');
     assert!(
-        cmds.iter()
-            .any(|c| matches!(c, Cmd::Store(StoreCmd::Redo(1))))
+        s.lines()
+            .any(|l| l.contains("edges.half_width") && l.contains(" 5*")),
+        "changed values are marked:\n{s}"
     );
-    assert_eq!(app.work.phase, Phase::Setup);
+}
+
+/// A run that fails leaves the older outputs on screen: the views say so,
+/// and neither the save key nor accept writes them as if they were the
+/// panel's values.
+#[test]
+fn a_failed_run_is_stale_and_is_never_saved() {
+    let mut app = reviewed();
+    go(&mut app, ScreenId::Pipeline);
+    pipe(&mut app, PipelineAction::ParamNext);
+    let cmds = pipe(&mut app, PipelineAction::Inc);
+    let Some(Cmd::Pipeline(req)) = cmds.into_iter().next() else {
+        panic!("a parameter step asks for a run");
+    };
+    let (s, _) = draw(&app, 80, 24);
+    assert!(s.contains("stale: running"), "{s}");
+    app.update(Msg::Pipeline(PipelineResult {
+        generation: req.generation,
+        image_key: req.image_key,
+        params: req.params.clone(),
+        outcome: Err(vss::llv::LlvError::SizeMismatch {
+            a: (96, 96),
+            b: (0, 0),
+        }),
+    }));
+    let (s, _) = draw(&app, 80, 24);
+    assert!(s.contains("stale: last run failed"), "{s}");
+    let cmds = pipe(&mut app, PipelineAction::Save);
+    assert!(
+        !cmds.iter().any(|c| matches!(c, Cmd::Store(_))),
+        "nothing saved: {cmds:?}"
+    );
+    assert!(app.chrome.log.last().unwrap().text.contains("not saved"));
+    go(&mut app, ScreenId::Survey);
+    let cmds = survey(&mut app, SurveyAction::Accept);
+    assert!(
+        !cmds.iter().any(|c| matches!(c, Cmd::Store(_))),
+        "accept saves nothing: {cmds:?}"
+    );
+    assert_eq!(
+        app.session.work.phase,
+        Phase::Review,
+        "still reviewing image 1"
+    );
 }
 
 #[test]
-fn help_lists_the_key_table_of_the_screen() {
+fn help_fits_80x24_scrolls_and_lists_every_key_and_the_marks() {
     let mut app = App::new(&profile(), colour());
-    key(&mut app, '3');
-    key(&mut app, '?');
-    let (s, _) = draw(&app, 100, 40);
-    assert!(s.contains("help"));
-    assert!(s.contains("+ = →"), "{s}");
-    assert!(s.contains("type a value"));
-    key(&mut app, 'x');
-    assert!(!app.help);
+    go(&mut app, ScreenId::Pipeline);
+    press(&mut app, Scope::Global, Action::Global(GlobalAction::Help));
+    let mut seen = String::new();
+    for _ in 0..40 {
+        let (s, _) = draw(&app, 80, 24);
+        for l in s.lines() {
+            assert!(l.chars().count() <= 80);
+        }
+        seen.push_str(&s);
+        code(&mut app, KeyCode::PageDown);
+    }
+    assert!(seen.contains("+ = →"), "{seen}");
+    assert!(seen.contains("type a value"));
+    assert!(seen.contains("The checklist's marks"));
+    assert!(seen.contains("DAMAGED"));
+    assert!(seen.contains("Every picture"));
+    for b in KEYMAP.iter().filter(|b| {
+        matches!(b.scope, Scope::Global | Scope::Picture)
+            || b.scope == Scope::Screen(ScreenId::Pipeline)
+    }) {
+        assert!(seen.contains(b.desc), "help lacks {:?}", b.desc);
+    }
+    code(&mut app, KeyCode::Esc);
+    assert!(app.chrome.overlay.is_none());
 }
 
 #[test]
 fn no_colour_mode_draws_without_colour_attributes() {
     let mut app = reviewed();
-    app.look = Look {
+    app.chrome.look = Look {
         mode: PreviewMode::Ascii,
         colour: false,
+        c256: false,
     };
-    for k in ['1', '2', '3', '4', '5'] {
-        key(&mut app, k);
+    for s in ScreenId::ALL {
+        go(&mut app, s);
         let (_, buf) = draw(&app, 80, 24);
         for c in buf.content() {
-            assert_eq!((c.fg, c.bg), (Color::Reset, Color::Reset), "screen {k}");
-            assert!(c.symbol().is_ascii(), "screen {k}: {:?}", c.symbol());
+            assert_eq!((c.fg, c.bg), (Color::Reset, Color::Reset), "{s:?}");
+            assert!(c.symbol().is_ascii(), "{s:?}: {:?}", c.symbol());
         }
     }
+}
+
+/// The Linux console: sixteen colours, no 256-colour index anywhere.
+#[test]
+fn the_linux_console_gets_its_sixteen_colours() {
+    let mut app = reviewed();
+    app.chrome.look = vss::tui::mode::pick(None, Some("linux"), None);
+    let mut coloured = 0;
+    for s in ScreenId::ALL {
+        go(&mut app, s);
+        let (_, buf) = draw(&app, 80, 24);
+        for c in buf.content() {
+            assert!(
+                !matches!(c.fg, Color::Indexed(_) | Color::Rgb(..))
+                    && !matches!(c.bg, Color::Indexed(_) | Color::Rgb(..)),
+                "{s:?}: {c:?}"
+            );
+            assert!(c.symbol().is_ascii());
+            coloured += usize::from(c.fg != Color::Reset);
+        }
+    }
+    assert!(coloured > 0, "some colour is used");
 }
 
 #[test]
@@ -361,261 +469,69 @@ fn device_trouble_and_hostile_text_are_shown_cleanly() {
     assert!(s.contains("devices back"), "{s}");
 }
 
+/// A long message wraps over up to three rows; past that `!` shows it
+/// all, and the expanded log keeps and scrolls the whole run.
 #[test]
-fn resuming_a_session_loads_the_partial_image() {
+fn every_message_is_readable_at_80x24() {
     let mut app = App::new(&profile(), colour());
-    let mut v = view();
-    v.images = vec![
-        ImageState {
-            k: 1,
-            camera: 2,
-            location: 1,
-            captured: vec!['a', 'b', 'c'],
-            outputs: true,
-            ..Default::default()
-        },
-        ImageState {
-            k: 2,
-            camera: 3,
-            location: 2,
-            captured: vec!['a'],
-            ..Default::default()
-        },
-    ];
-    v.next = Some((2, Some('b')));
-    let cmds = app.update(Msg::Store(StoreEvent::Opened(v)));
-    assert!(
-        cmds.iter()
-            .any(|c| matches!(c, Cmd::Store(StoreCmd::Load(2))))
+    let long = format!(
+        "capture failed: {}",
+        "transfer cancelled at byte 16384 of 262144; ".repeat(3)
     );
-    app.update(Msg::Store(StoreEvent::Images {
-        k: 2,
-        images: vec![('a', square(200))],
+    app.update(Msg::Device(DeviceEvent::CaptureFailed {
+        purpose: FramePurpose::Snapshot,
+        error: long.clone(),
     }));
-    assert_eq!(app.work.k, 2);
-    assert_eq!(app.work.camera, 3);
-    assert_eq!(app.missing_letters(), vec!['b', 'c']);
     let (s, _) = draw(&app, 80, 24);
-    assert!(s.contains("captures lightings bc"), "{s}");
-}
-
-#[test]
-fn edits_select_delete_undo_and_go_to_the_session_log() {
-    let mut app = reviewed();
-    key(&mut app, '4');
-    let n = app
-        .current
-        .as_ref()
-        .unwrap()
-        .editor
-        .as_ref()
-        .unwrap()
-        .lines()
-        .len();
+    let rows: Vec<&str> = s.lines().collect();
+    let shown: String = rows[..].join(" ");
     assert!(
-        key(&mut app, 'x').is_empty(),
-        "nothing selected: nothing deleted"
+        shown.contains("transfer cancelled at byte 16384 of 262144"),
+        "{s}"
     );
-    key(&mut app, 'n');
-    assert_eq!(app.edit.selected, vec![0]);
+    assert!(
+        rows.iter().filter(|r| r.contains("262144")).count() >= 2,
+        "wrapped:\n{s}"
+    );
+    let very = "x ".repeat(200);
+    app.update(Msg::Device(DeviceEvent::Note(very.clone())));
     let (s, _) = draw(&app, 80, 24);
-    assert!(s.contains("#0 ("), "selected line listed:\n{s}");
-    let cmds = key(&mut app, 'x');
-    assert!(
-        cmds.iter().any(|c| matches!(c, Cmd::Store(StoreCmd::RecordEdit { k: 1, lines, .. }) if lines.len() == n - 1)),
-        "{cmds:?}"
+    assert!(s.contains("! shows all"), "{s}");
+    press(
+        &mut app,
+        Scope::Global,
+        Action::Global(GlobalAction::LastMessage),
     );
-    let cmds = key(&mut app, 'u');
-    assert!(cmds.iter().any(|c| matches!(c, Cmd::Store(StoreCmd::RecordEdit { what, lines, .. }) if what == "undo" && lines.len() == n)));
-    // The corner key picks two different lines near the cursor.
-    key(&mut app, 'k');
-    assert_eq!(app.edit.selected.len(), 2);
-    assert_ne!(app.edit.selected[0], app.edit.selected[1]);
-}
-
-#[test]
-fn the_worker_engine_reruns_from_the_changed_stage() {
-    use vss::tui::workers::pipeline::Engine;
-    let mut app = reviewed();
-    key(&mut app, '3');
-    let i = vss::llv::params::PARAMS
-        .iter()
-        .position(|p| p.key == "connect.min_line_length")
-        .unwrap();
-    for _ in 0..i {
-        code(&mut app, KeyCode::Down);
+    let (s, _) = draw(&app, 80, 24);
+    assert!(s.matches('x').count() >= 200, "the whole message:\n{s}");
+    code(&mut app, KeyCode::Esc);
+    for i in 0..60 {
+        app.update(Msg::Device(DeviceEvent::Note(format!("note {i}"))));
     }
-    let lines = |app: &App| {
-        app.current
-            .as_ref()
-            .unwrap()
-            .outputs
-            .as_ref()
-            .unwrap()
-            .lines
-            .len()
-    };
-    let before = lines(&app);
-    let mut engine = Engine::default();
-    for _ in 0..3 {
-        for c in key(&mut app, '>') {
-            if let Cmd::Pipeline(req) = c {
-                let outcome = engine.process(&req).map_err(|e| e.to_string());
-                app.update(Msg::Pipeline(PipelineResult {
-                    generation: req.generation,
-                    image_key: req.image_key,
-                    params: req.params.clone(),
-                    outcome,
-                }));
-            }
-        }
-    }
-    assert_eq!(app.params.connect.min_line_length, 42.0);
-    let after = lines(&app);
-    assert!(
-        after < before,
-        "longer minimum keeps fewer lines: {before} -> {after}"
+    press(
+        &mut app,
+        Scope::Global,
+        Action::Global(GlobalAction::ToggleLog),
     );
-}
-
-#[test]
-fn accepting_after_hand_edits_keeps_the_edits_on_disk() {
-    let mut app = reviewed();
-    let n = app
-        .current
-        .as_ref()
-        .unwrap()
-        .editor
-        .as_ref()
-        .unwrap()
-        .lines()
-        .len();
-    key(&mut app, '4');
-    key(&mut app, 'n');
-    key(&mut app, 'x');
-    key(&mut app, '1');
-    let cmds = key(&mut app, 'a');
-    let save = cmds
-        .iter()
-        .position(|c| matches!(c, Cmd::Store(StoreCmd::SaveOutputs { k: 1, .. })));
-    let edit = cmds.iter().position(
-        |c| matches!(c, Cmd::Store(StoreCmd::RecordEdit { k: 1, lines, .. }) if lines.len() == n - 1),
-    );
-    assert!(
-        save.is_some() && edit.is_some() && save < edit,
-        "outputs, then the edits on top: {cmds:?}"
-    );
-}
-
-#[test]
-fn resumed_hand_edited_lines_win_over_the_first_rerun() {
-    let mut app = App::new(&profile(), colour());
-    let mut v = view();
-    v.images = vec![ImageState {
-        k: 1,
-        camera: 1,
-        location: 1,
-        captured: vec!['a', 'b', 'c'],
-        edits: 1,
-        ..Default::default()
-    }];
-    v.next = Some((1, None));
-    app.update(Msg::Store(StoreEvent::Opened(v)));
-    let cmds = app.update(Msg::Store(StoreEvent::Images {
-        k: 1,
-        images: vec![('a', square(150)), ('b', square(200)), ('c', square(90))],
-    }));
-    let edited = vec![vss::llv::Segment::new(
-        vss::llv::Point::new(1.0, 1.0),
-        vss::llv::Point::new(50.0, 1.0),
-    )];
-    app.update(Msg::Store(StoreEvent::Lines {
-        k: 1,
-        lines: edited.clone(),
-    }));
-    let Some(Cmd::Pipeline(req)) = cmds.into_iter().next() else {
-        panic!("resume runs the stages")
-    };
-    let out = pipeline::run(
-        &Input {
-            images: &req.images,
-            ambient: req.ambient.as_deref(),
-            lens: None,
-        },
-        &req.params,
-    )
-    .unwrap();
-    app.update(Msg::Pipeline(PipelineResult {
-        generation: req.generation,
-        image_key: req.image_key,
-        params: req.params.clone(),
-        outcome: Ok(Arc::new(out)),
-    }));
-    assert_eq!(app.work.phase, Phase::Review);
-    assert_eq!(
-        app.current
-            .as_ref()
-            .unwrap()
-            .editor
-            .as_ref()
-            .unwrap()
-            .lines(),
-        &edited[..]
-    );
-}
-
-/// A run that fails leaves the older outputs on screen: the views say so,
-/// and neither the save key nor accept writes them as if they were the
-/// panel's values.
-#[test]
-fn a_failed_run_is_stale_and_is_never_saved() {
-    let mut app = reviewed();
-    key(&mut app, '3');
-    code(&mut app, KeyCode::Down); // edges.half_width
-    let cmds = key(&mut app, '+');
-    let Some(Cmd::Pipeline(req)) = cmds.into_iter().next() else {
-        panic!("a parameter step asks for a run");
-    };
     let (s, _) = draw(&app, 80, 24);
-    assert!(s.contains("stale: running"), "{s}");
-    app.update(Msg::Pipeline(PipelineResult {
-        generation: req.generation,
-        image_key: req.image_key,
-        params: req.params.clone(),
-        outcome: Err(vss::llv::LlvError::SizeMismatch {
-            a: (96, 96),
-            b: (0, 0),
-        }
-        .to_string()),
-    }));
+    assert!(s.contains("note 59") && !s.contains("note 0 "), "{s}");
+    press(
+        &mut app,
+        Scope::Global,
+        Action::Global(GlobalAction::LogTop),
+    );
     let (s, _) = draw(&app, 80, 24);
-    assert!(s.contains("stale: last run failed"), "{s}");
-    let save = vss::tui::keymap::KEYMAP
-        .iter()
-        .find(|b| b.action == vss::tui::keymap::Action::SaveOutputs)
-        .unwrap()
-        .key;
-    let KeyCode::Char(c) = save.code else {
-        panic!("a letter saves")
-    };
-    let cmds = app.update(Msg::Key(KeyEvent::new(
-        KeyCode::Char(c),
-        if save.ctrl {
-            KeyModifiers::CONTROL
-        } else {
-            KeyModifiers::NONE
-        },
-    )));
     assert!(
-        !cmds.iter().any(|c| matches!(c, Cmd::Store(_))),
-        "nothing saved: {cmds:?}"
+        s.contains("profile screen test cell") || s.contains("capture failed"),
+        "{s}"
     );
-    assert!(app.log.last().unwrap().text.contains("not saved"));
-    key(&mut app, '1');
-    let cmds = key(&mut app, 'a');
-    assert!(
-        !cmds.iter().any(|c| matches!(c, Cmd::Store(_))),
-        "accept saves nothing: {cmds:?}"
-    );
-    assert_eq!(app.work.phase, Phase::Review, "still reviewing image 1");
+    assert!(!s.contains("note 59"), "{s}");
+}
+
+#[test]
+fn too_small_a_terminal_says_so() {
+    let app = App::new(&profile(), colour());
+    let (s, _) = draw(&app, 40, 10);
+    assert!(s.contains("terminal too small"), "{s}");
+    assert!(s.contains("40 × 10"), "{s}");
 }

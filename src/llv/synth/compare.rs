@@ -193,8 +193,7 @@ pub fn export(dir: &Path, cfg: &ExportConfig, params: &Params) -> Result<Manifes
                     &base.with_extension("pgm"),
                     &yard_lens_image(y, case, i, level),
                 )?;
-                let cdf = crate::formats::cdf::format_cdf(&sc.cdf());
-                write_bytes(&base.with_extension("cdf"), cdf.as_bytes())?;
+                crate::formats::cdf::write_cdf(&base.with_extension("cdf"), &sc.cdf())?;
                 let t = yard_truth(sc, true, y.min_contrast);
                 files::write_truth(&base.with_extension("truth"), &t.edges, &t.dont_care)?;
             }

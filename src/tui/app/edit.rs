@@ -1,171 +1,213 @@
-//! The Edit screen's actions: selecting lines by keyboard (next/previous,
-//! nearest to the cursor, the two lines of a corner) and the manual
-//! operations on them, each recorded in the session's edit log.
+//! The Edit screen's state and keys: a highlighted line (next, previous,
+//! nearest the cursor), a selection (`Space` toggles the highlighted line,
+//! the corner key takes the two lines of a corner), and the operations on
+//! it — connect, extend, delete, undo, redo — each written to the session
+//! at once. Editing an accepted image asks first; the lines an edit made
+//! are highlighted after it; the log says in words what was done.
 
-use super::{App, Level};
-use crate::llv::edit::EditOp;
-use crate::llv::{Point, Segment};
+use super::{Ctx, Pending, PreviewNav};
+use crate::llv::Point;
+use crate::llv::edit::{EditOp, corner_lines, describe, nearest_line, result_lines};
 use crate::tui::event::{Cmd, StoreCmd};
-use crate::tui::keymap::Action;
-use crate::tui::widgets::preview::point_segment_distance;
+use crate::tui::keymap::EditAction;
 
-impl App {
-    pub(super) fn edit_action(&mut self, a: Action) -> Vec<Cmd> {
-        let cursor = self.edit.cursor_point(self.preview_size());
-        let Some(cur) = self.current.as_mut() else {
-            self.log.push(
-                Level::Warn,
-                "no lines to edit: capture and run an image first",
+pub use crate::llv::edit::describe as describe_op;
+
+/// The Edit screen's own state.
+#[derive(Clone, Debug, Default)]
+pub struct EditScreen {
+    /// The line the keys point at.
+    pub highlighted: Option<usize>,
+    /// The lines an operation takes.
+    pub selected: Vec<usize>,
+    /// The lines the last edit made or moved.
+    pub result: Vec<usize>,
+    pub nav: PreviewNav,
+    /// The edit waiting for the answer to "edit an accepted image?".
+    pub waiting: Option<EditAction>,
+}
+
+impl EditScreen {
+    /// Forgets the highlight and selection (the lines changed under them).
+    pub fn clear(&mut self) {
+        self.highlighted = None;
+        self.selected.clear();
+        self.result.clear();
+    }
+
+    /// The cursor as an image point (image centre before it moves).
+    pub fn cursor_point(&self, size: Option<(usize, usize)>) -> Point {
+        let (x, y) = self.nav.cursor_or_centre(size.unwrap_or((1, 1)));
+        Point::new(x as f64, y as f64)
+    }
+
+    pub fn update(&mut self, a: EditAction, ctx: &mut Ctx) -> Vec<Cmd> {
+        let cursor = self.cursor_point(ctx.tracker.preview_size());
+        let Some(cur) = ctx.tracker.current.as_ref() else {
+            ctx.warn("no lines to edit: capture and run an image, or go to one (Survey, 1)");
+            return Vec::new();
+        };
+        let Some(lines) = cur.lines() else {
+            ctx.warn("no lines to edit yet: the pipeline is still running");
+            return Vec::new();
+        };
+        let n = lines.len();
+        let (k, accepted, confirmed) = (cur.k, cur.accepted, cur.edit_confirmed);
+        let op = match a {
+            EditAction::LineNext | EditAction::LinePrev => {
+                if n > 0 {
+                    self.highlighted = Some(match (a, self.highlighted) {
+                        (EditAction::LineNext, Some(i)) => (i + 1) % n,
+                        (EditAction::LinePrev, Some(i)) => (i + n - 1) % n,
+                        (EditAction::LineNext, None) => 0,
+                        _ => n - 1,
+                    });
+                }
+                return Vec::new();
+            }
+            EditAction::LineNearest => {
+                self.highlighted = nearest_line(lines, cursor);
+                return Vec::new();
+            }
+            EditAction::Toggle => {
+                let Some(i) = self.highlighted.filter(|&i| i < n) else {
+                    ctx.warn("highlight a line first: n, p or . (nearest the cursor)");
+                    return Vec::new();
+                };
+                if let Some(pos) = self.selected.iter().position(|&s| s == i) {
+                    self.selected.remove(pos);
+                } else {
+                    self.selected.push(i);
+                }
+                return Vec::new();
+            }
+            EditAction::Corner => {
+                self.selected = corner_lines(lines, cursor);
+                self.highlighted = self.selected.first().copied();
+                if self.selected.len() < 2 {
+                    ctx.warn("no corner of two lines near the cursor");
+                }
+                return Vec::new();
+            }
+            EditAction::ClearSelection => {
+                self.clear();
+                return Vec::new();
+            }
+            EditAction::Connect | EditAction::Extend => {
+                let [i, j] = self.selected[..] else {
+                    ctx.warn("select exactly two lines first (v at a corner, or Space on each)");
+                    return Vec::new();
+                };
+                if a == EditAction::Connect {
+                    Some(EditOp::Connect(i, j))
+                } else {
+                    Some(EditOp::Extend(i, j))
+                }
+            }
+            EditAction::Delete => {
+                let sel = if self.selected.is_empty() {
+                    self.highlighted.into_iter().collect()
+                } else {
+                    self.selected.clone()
+                };
+                if sel.is_empty() {
+                    ctx.warn("select lines first (n, . or Space)");
+                    return Vec::new();
+                }
+                Some(EditOp::Delete(sel))
+            }
+            EditAction::Undo | EditAction::Redo => None,
+        };
+        if accepted && !confirmed {
+            self.waiting = Some(a);
+            ctx.ask(
+                format!(
+                    "Image {k} is accepted. Change its lines? Each edit rewrites its .ldr \
+                     (undo takes it back)."
+                ),
+                Pending::Edit,
             );
+            return Vec::new();
+        }
+        self.apply(op, a, ctx)
+    }
+
+    /// Carries out the edit the operator confirmed.
+    pub fn confirmed(&mut self, ctx: &mut Ctx) -> Vec<Cmd> {
+        if let Some(c) = ctx.tracker.current.as_mut() {
+            c.edit_confirmed = true;
+        }
+        match self.waiting.take() {
+            Some(a) => self.update(a, ctx),
+            None => Vec::new(),
+        }
+    }
+
+    fn apply(&mut self, op: Option<EditOp>, a: EditAction, ctx: &mut Ctx) -> Vec<Cmd> {
+        let Some(cur) = ctx.tracker.current.as_mut() else {
             return Vec::new();
         };
         let k = cur.k;
+        if cur.editor.is_none() {
+            let lines = cur.lines().map(<[_]>::to_vec).unwrap_or_default();
+            cur.editor = Some(crate::llv::edit::LineEditor::new(lines));
+        }
         let Some(ed) = cur.editor.as_mut() else {
-            self.log.push(
-                Level::Warn,
-                "no lines to edit yet: the pipeline is still running",
-            );
             return Vec::new();
         };
-        let lines = ed.lines();
-        let n = lines.len();
-        let sel = &mut self.edit.selected;
-        let op = match a {
-            Action::LineNext | Action::LinePrev => {
-                if n > 0 {
-                    let last = sel.last().copied();
-                    let i = match (a, last) {
-                        (Action::LineNext, Some(i)) => (i + 1) % n,
-                        (Action::LinePrev, Some(i)) => (i + n - 1) % n,
-                        (Action::LineNext, None) => 0,
-                        _ => n - 1,
-                    };
-                    *sel = vec![i];
-                }
-                return Vec::new();
-            }
-            Action::LineNearest => {
-                *sel = nearest_line(lines, cursor).into_iter().collect();
-                return Vec::new();
-            }
-            Action::Mark => {
-                if let Some(i) = nearest_line(lines, cursor) {
-                    if let Some(pos) = sel.iter().position(|&s| s == i) {
-                        sel.remove(pos);
-                    } else {
-                        sel.push(i);
-                    }
-                }
-                return Vec::new();
-            }
-            Action::Corner => {
-                *sel = corner_lines(lines, cursor);
-                if sel.len() < 2 {
-                    self.log
-                        .push(Level::Warn, "no corner of two lines near the cursor");
-                }
-                return Vec::new();
-            }
-            Action::Connect | Action::Extend => {
-                let [i, j] = sel[..] else {
-                    self.log.push(
-                        Level::Warn,
-                        "select exactly two lines first (k at a corner, or Space on each)",
-                    );
-                    return Vec::new();
-                };
-                if a == Action::Connect {
-                    EditOp::Connect(i, j)
+        let Some(op) = op else {
+            // Undo and redo move in the editor's history; the session's
+            // log keeps the edits in effect, so neither counts as an edit.
+            let before = ed.lines().to_vec();
+            let undo = a == EditAction::Undo;
+            let redone = if undo { None } else { ed.next_redo().cloned() };
+            let done = if undo { ed.undo() } else { ed.redo() };
+            self.clear();
+            if !done {
+                ctx.info(if undo {
+                    "nothing to undo"
                 } else {
-                    EditOp::Extend(i, j)
-                }
+                    "nothing to redo"
+                });
+                return Vec::new();
             }
-            Action::Delete => {
-                if sel.is_empty() {
-                    self.log
-                        .push(Level::Warn, "select lines first (n, . or Space)");
-                    return Vec::new();
+            let lines = ed.lines().to_vec();
+            let (cmd, what) = match redone {
+                Some(op) => {
+                    let what = describe(&op, &before);
+                    self.result = result_lines(&op, &lines);
+                    (
+                        StoreCmd::RecordEdit {
+                            k,
+                            what: what.clone(),
+                            lines,
+                        },
+                        format!("redone: {what}"),
+                    )
                 }
-                EditOp::Delete(sel.clone())
-            }
-            Action::Undo | Action::RedoEdit => {
-                let done = if a == Action::Undo {
-                    ed.undo()
-                } else {
-                    ed.redo()
-                };
-                sel.clear();
-                if !done {
-                    self.log.push(Level::Info, "nothing to undo/redo");
-                    return Vec::new();
-                }
-                cur.edits += 1;
-                let what = if a == Action::Undo { "undo" } else { "redo" };
-                return vec![Cmd::Store(StoreCmd::RecordEdit {
-                    k,
-                    what: what.into(),
-                    lines: ed.lines().to_vec(),
-                })];
-            }
-            _ => return Vec::new(),
+                None => (
+                    StoreCmd::UndoEdit { k, lines },
+                    "undone: the last edit".into(),
+                ),
+            };
+            ctx.info(format!("image {k}: {what}"));
+            return vec![Cmd::Store(cmd)];
         };
-        let what = format!("{op:?}");
-        match ed.apply(op) {
+        let what = describe(&op, ed.lines());
+        match ed.apply(op.clone()) {
             Ok(()) => {
-                sel.clear();
+                self.clear();
+                let lines = ed.lines().to_vec();
+                self.result = result_lines(&op, &lines);
+                self.highlighted = self.result.first().copied();
                 cur.edits += 1;
-                self.log.push(Level::Info, format!("edit: {what}"));
-                vec![Cmd::Store(StoreCmd::RecordEdit {
-                    k,
-                    what,
-                    lines: ed.lines().to_vec(),
-                })]
+                ctx.info(format!("image {k}: {what}"));
+                vec![Cmd::Store(StoreCmd::RecordEdit { k, what, lines })]
             }
             Err(e) => {
-                self.log.push(Level::Error, format!("edit refused: {e}"));
+                ctx.error(format!("edit refused: {e}"));
                 Vec::new()
             }
         }
-    }
-}
-
-/// The index of the line nearest to `p`.
-pub fn nearest_line(lines: &[Segment], p: Point) -> Option<usize> {
-    lines
-        .iter()
-        .enumerate()
-        .map(|(i, s)| (i, point_segment_distance(p, s)))
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(i, _)| i)
-}
-
-/// The two different lines whose endpoints are nearest to `p`: the two ends
-/// of the corner the operator points at.
-pub fn corner_lines(lines: &[Segment], p: Point) -> Vec<usize> {
-    let mut ends: Vec<(usize, f64)> = lines
-        .iter()
-        .enumerate()
-        .map(|(i, s)| (i, s.a.dist(p).min(s.b.dist(p))))
-        .collect();
-    ends.sort_by(|a, b| a.1.total_cmp(&b.1));
-    ends.into_iter().take(2).map(|e| e.0).collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn nearest_and_corner() {
-        let ls = [
-            Segment::new(Point::new(0.0, 0.0), Point::new(10.0, 0.0)),
-            Segment::new(Point::new(11.0, 1.0), Point::new(11.0, 20.0)),
-            Segment::new(Point::new(0.0, 30.0), Point::new(20.0, 30.0)),
-        ];
-        assert_eq!(nearest_line(&ls, Point::new(5.0, 28.0)), Some(2));
-        let mut c = corner_lines(&ls, Point::new(10.5, 0.5));
-        c.sort();
-        assert_eq!(c, vec![0, 1]);
-        assert_eq!(nearest_line(&[], Point::new(0.0, 0.0)), None);
     }
 }

@@ -1,21 +1,21 @@
 //! How the App takes the workers' reports: pipeline results (newest
-//! generation only), device events (frames, progress, lost and found
-//! devices, lights) and session results.
+//! generation only), device events (frames, settling and transfer
+//! progress, lost and found devices, lights) and session results.
 
-use super::{App, Level};
+use super::{App, Modal, Pending, Phase};
 use crate::llv::edit::LineEditor;
 use crate::tui::event::{
-    Cmd, DeviceCmd, DeviceEvent, FramePurpose, ImageKey, PipelineResult, StoreEvent,
+    Cmd, DeviceEvent, FramePurpose, ImageKey, PipelineResult, StoreCmd, StoreEvent,
 };
 use crate::tui::text::clean;
 
 impl App {
     pub(super) fn on_pipeline(&mut self, r: PipelineResult) -> Vec<Cmd> {
         // An older run never overwrites a newer one.
-        if r.generation <= self.shown_generation {
+        if r.generation <= self.tracker.shown_generation {
             return Vec::new();
         }
-        let Some(cur) = self.current.as_mut() else {
+        let Some(cur) = self.tracker.current.as_mut() else {
             return Vec::new();
         };
         if r.image_key
@@ -26,7 +26,7 @@ impl App {
         {
             return Vec::new();
         }
-        self.shown_generation = r.generation;
+        self.tracker.shown_generation = r.generation;
         match r.outcome {
             Ok(out) => {
                 // Lines edited by hand in an earlier run of the console win
@@ -36,54 +36,60 @@ impl App {
                 cur.edits = 0;
                 cur.outputs = Some(out);
                 cur.outputs_params = Some(r.params);
+                cur.from_disk = false;
+                cur.in_session = false;
                 cur.failed = None;
-                self.edit.selected.clear();
-                self.pipeline_done()
+                self.screens.edit.clear();
+                self.ctx().pipeline_done();
             }
             Err(e) => {
+                let e = e.to_string();
                 cur.failed = Some(e.clone());
-                self.log.push(Level::Error, format!("pipeline: {e}"));
-                self.pipeline_failed()
+                self.ctx().error(format!(
+                    "pipeline: {e} — the views show the last run that worked (stale)"
+                ));
+                self.ctx().pipeline_failed();
             }
         }
+        Vec::new()
     }
 
     pub(super) fn on_device(&mut self, ev: DeviceEvent) -> Vec<Cmd> {
+        let dev = &mut self.cell.device;
         match ev {
             DeviceEvent::Connected { grabber, relay } => {
                 let (g, r) = (clean(&grabber), clean(&relay));
-                if self.device.lost.take().is_some() {
-                    self.log
-                        .push(Level::Info, format!("devices back: {g}; {r}"));
+                let text = if dev.lost.take().is_some() {
+                    format!("devices back: {g}; {r}")
                 } else {
-                    self.log
-                        .push(Level::Info, format!("grabber {g}; relay board {r}"));
-                }
-                self.device.connected = true;
-                self.device.grabber = g;
-                self.device.relay = r;
+                    format!("grabber {g}; relay board {r}")
+                };
+                dev.connected = true;
+                dev.grabber = g;
+                dev.relay = r;
+                self.ctx().info(text);
                 Vec::new()
             }
             DeviceEvent::Lost { error } => {
                 let e = clean(&error);
-                if self.device.lost.as_deref() != Some(e.as_str()) {
-                    self.log.push(
-                        Level::Error,
-                        format!("device lost: {e} — retrying; saved work is safe"),
-                    );
+                let new = dev.lost.as_deref() != Some(e.as_str());
+                dev.connected = false;
+                dev.lost = Some(e.clone());
+                dev.transfer = None;
+                if new {
+                    self.ctx()
+                        .error(format!("device lost: {e} — retrying; saved work is safe"));
                 }
-                self.device.connected = false;
-                self.device.lost = Some(e);
-                self.device.transfer = None;
+                Vec::new()
+            }
+            DeviceEvent::Settling { .. } => {
+                dev.settling = true;
                 Vec::new()
             }
             DeviceEvent::Progress { done, total } => {
-                let purpose = self
-                    .device
-                    .transfer
-                    .map(|t| t.0)
-                    .unwrap_or(FramePurpose::Snapshot);
-                self.device.transfer = Some((purpose, done, total));
+                let purpose = dev.transfer.map_or(FramePurpose::Snapshot, |t| t.0);
+                dev.transfer = Some((purpose, done, total));
+                dev.settling = false;
                 Vec::new()
             }
             DeviceEvent::Frame {
@@ -91,117 +97,145 @@ impl App {
                 camera,
                 image,
             } => {
-                self.device.transfer = None;
+                dev.transfer = None;
+                dev.settling = false;
                 match purpose {
                     FramePurpose::Survey { k, letter } => {
-                        self.survey_frame(k, letter, camera, image)
+                        self.ctx().survey_frame(k, letter, camera, image)
                     }
-                    FramePurpose::Live | FramePurpose::Snapshot => {
-                        self.live = Some((camera, image));
-                        if self.screen == crate::tui::keymap::ScreenId::Calibrate {
-                            self.calib_frame();
+                    FramePurpose::Live => {
+                        if self.chrome.screen == crate::tui::keymap::ScreenId::Calibrate {
+                            self.screens.calibrate.frame(camera, &image);
                         }
+                        self.cell.live = Some((camera, image));
+                        Vec::new()
+                    }
+                    FramePurpose::Snapshot => {
+                        let (w, h) = image.size();
+                        if self.chrome.screen == crate::tui::keymap::ScreenId::Calibrate {
+                            self.screens.calibrate.frame(camera, &image);
+                        }
+                        self.cell.live = Some((camera, image));
+                        self.ctx()
+                            .info(format!("grabbed a frame of camera {camera}, {w}×{h}"));
                         Vec::new()
                     }
                 }
             }
             DeviceEvent::CaptureFailed { purpose, error } => {
-                self.device.transfer = None;
-                self.log
-                    .push(Level::Error, format!("capture failed: {}", clean(&error)));
+                dev.transfer = None;
+                dev.settling = false;
+                let mut ctx = self.ctx();
+                ctx.error(format!("capture failed: {}", clean(&error)));
                 if let FramePurpose::Survey { .. } = purpose {
-                    self.survey_capture_failed();
+                    ctx.survey_capture_failed();
                 }
                 Vec::new()
             }
             DeviceEvent::Lights { on, mask } => {
-                self.device.lights_on = on.iter().map(|s| clean(s)).collect();
-                self.device.mask = mask;
+                dev.lights_on = on.iter().map(|s| clean(s)).collect();
+                dev.mask = mask;
                 Vec::new()
             }
             DeviceEvent::Note(n) => {
-                self.log.push(Level::Info, clean(&n));
+                self.ctx().info(clean(&n));
                 Vec::new()
             }
         }
-    }
-
-    /// Marks the transfer under way with its purpose (the worker's progress
-    /// messages carry only numbers).
-    pub(crate) fn capture(
-        &mut self,
-        purpose: FramePurpose,
-        camera: u32,
-        lighting: Option<char>,
-    ) -> Cmd {
-        self.device.transfer = Some((purpose, 0, 0));
-        Cmd::Device(DeviceCmd::Capture {
-            purpose,
-            camera,
-            lighting,
-        })
     }
 
     pub(super) fn on_store(&mut self, ev: StoreEvent) -> Vec<Cmd> {
         match ev {
             StoreEvent::Sessions(list) => {
-                self.sessions = list
+                self.session.list = list
                     .into_iter()
-                    .map(|(n, p, s)| (clean(&n), p, clean(&s)))
+                    .map(|mut e| {
+                        e.name = clean(&e.name);
+                        e.summary = clean(&e.summary);
+                        e.damaged = e.damaged.map(|d| clean(&d));
+                        e
+                    })
                     .collect();
-                self.survey.selected = self
-                    .survey
-                    .selected
-                    .min(self.sessions.len().saturating_sub(1));
+                let s = &mut self.screens.survey;
+                s.selected = s.selected.min(self.session.list.len().saturating_sub(1));
                 Vec::new()
             }
-            StoreEvent::Opened(v) => self.session_opened(v),
-            StoreEvent::Updated(v) => {
-                self.session = Some(v);
-                Vec::new()
-            }
-            StoreEvent::Images { k, images } => self.images_loaded(k, images),
-            StoreEvent::Lines { k, lines } => {
-                if let Some(cur) = self.current.as_mut().filter(|c| c.k == k) {
-                    self.log.push(
-                        Level::Info,
-                        format!(
-                            "image {k}: {} hand-edited lines from the session",
-                            lines.len()
-                        ),
-                    );
-                    match cur.editor.as_mut() {
-                        Some(_) if cur.saved_lines.is_none() && cur.outputs.is_some() => {
-                            cur.editor = Some(LineEditor::new(lines));
-                        }
-                        _ => cur.saved_lines = Some(lines),
-                    }
+            StoreEvent::Opened(v) => {
+                self.screens.survey.picking = false;
+                self.screens.survey.row = None;
+                let problems = v.problems();
+                let mut ctx = self.ctx();
+                let cmds = ctx.session_opened(v);
+                if problems > 0 {
+                    ctx.error(format!(
+                        "{problems} damaged or missing file(s) in this session: the checklist \
+                         marks them, 5 lists them"
+                    ));
                 }
+                cmds
+            }
+            StoreEvent::Updated(v) => {
+                self.session.view = Some(v);
                 Vec::new()
             }
+            StoreEvent::Loaded(img) => self.ctx().images_loaded(*img),
             StoreEvent::Cameras(models) => {
-                self.camera_models = models;
+                self.cell.camera_models = models;
                 Vec::new()
             }
             StoreEvent::Saved(what) => {
-                self.log
-                    .push(Level::Info, format!("saved {}", clean(&what)));
+                self.ctx().info(format!("saved {}", clean(&what)));
+                Vec::new()
+            }
+            StoreEvent::Note(what) => {
+                self.ctx().info(clean(&what));
                 Vec::new()
             }
             StoreEvent::Reports(paths) => {
                 for p in paths {
-                    self.log.push(
-                        Level::Info,
-                        format!("report written: {}", clean(&p.display().to_string())),
-                    );
+                    let p = clean(&p.display().to_string());
+                    self.ctx().info(format!("report written: {p}"));
                 }
                 Vec::new()
             }
+            StoreEvent::Locked { dir, holder } => {
+                let holder = clean(&holder);
+                let mut ctx = self.ctx();
+                ctx.error(format!(
+                    "session {} is open in another console that still runs ({holder}). If \
+                     that is your own console in a detached tmux or screen (an SSH drop), go \
+                     back to it: `tmux attach`. Taking it over makes that console's saves fail.",
+                    dir.display()
+                ));
+                ctx.chrome.modal = Some(Modal::confirm(
+                    format!(
+                        "Session held by {holder}, which still runs (try `tmux attach` first). \
+                         Take it over anyway?"
+                    ),
+                    Pending::TakeOver(dir),
+                ));
+                Vec::new()
+            }
+            StoreEvent::LogFile(path) => {
+                let p = clean(&path.display().to_string());
+                self.chrome.log.set_file(path);
+                self.ctx().info(format!("log file: {p}"));
+                Vec::new()
+            }
             StoreEvent::Error(e) => {
-                self.log.push(Level::Error, clean(&e));
-                self.survey_store_error();
+                let mut ctx = self.ctx();
+                ctx.error(clean(&e.to_string()));
+                if ctx.session.work.phase == Phase::Processing {
+                    ctx.session.work.phase = Phase::Setup;
+                }
                 Vec::new()
             }
         }
+    }
+
+    /// The log lines written since the last call, for the log file.
+    pub fn take_log_lines(&mut self) -> Option<Cmd> {
+        let lines = self.chrome.log.take_unwritten();
+        (!lines.is_empty()).then_some(Cmd::Store(StoreCmd::Log(lines)))
     }
 }

@@ -1,11 +1,14 @@
 //! The guided survey: choose or create a session, then per image number
-//! capture every lighting, run the stages, review, accept or redo (asking
-//! first), and go on; resumes where the session's progress says.
+//! capture every lighting, run the stages, review, accept or capture again
+//! (asking first), and go on; resumes where the session's progress says.
+//! Any image of the checklist can be gone back to: its saved frames,
+//! outputs and lines load into the Pipeline and Edit screens.
 
-use super::{App, Level, Loaded, Modal, Pending, PromptPurpose};
+use super::{CellState, Ctx, Loaded, Modal, Pending, PreviewNav, PromptPurpose, Tracker};
+use crate::formats::names::MAX_SESSION_LEN;
 use crate::llv::GreyImage;
-use crate::tui::event::{Cmd, FramePurpose, SessionView, StoreCmd};
-use crate::tui::keymap::Action;
+use crate::tui::event::{Cmd, DeviceCmd, FramePurpose, LoadedImage, SessionView, StoreCmd};
+use crate::tui::keymap::SurveyAction;
 
 /// Where the guided survey stands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -19,8 +22,10 @@ pub enum Phase {
     Capturing,
     /// The stages run.
     Processing,
-    /// Lines shown; accept or redo.
+    /// Lines shown; accept or capture again.
     Review,
+    /// Every planned image is done.
+    Complete,
 }
 
 /// The survey's position.
@@ -32,195 +37,306 @@ pub struct Work {
     pub phase: Phase,
 }
 
-impl App {
-    pub(super) fn survey_action(&mut self, a: Action) -> Vec<Cmd> {
+/// The Survey screen's own state.
+#[derive(Clone, Debug, Default)]
+pub struct SurveyScreen {
+    /// The highlighted session of the list.
+    pub selected: usize,
+    /// The list of sessions is shown over the open session's checklist.
+    pub picking: bool,
+    /// The highlighted image of the checklist (`None`: the one under work).
+    pub row: Option<u32>,
+    pub nav: PreviewNav,
+}
+
+/// The rule of session names, shown before typing one.
+pub const NAME_RULE: &str = "letters, digits, _ and -, starting with a letter or _, at most \
+     32; end with a letter: q1 would name its image 1 q11a.img, which reads as image 11 of q";
+
+impl SurveyScreen {
+    /// The checklist row the keys act on.
+    pub fn row(&self, ctx_work: &Work) -> u32 {
+        self.row.unwrap_or(ctx_work.k)
+    }
+
+    pub fn update(&mut self, a: SurveyAction, ctx: &mut Ctx) -> Vec<Cmd> {
+        let listing = self.picking || ctx.session.view.is_none();
         match a {
-            Action::NewSession => {
-                self.modal = Some(Modal::Prompt {
-                    title: "new session name".into(),
-                    text: String::new(),
-                    purpose: PromptPurpose::SessionName,
-                });
+            SurveyAction::NewSession => {
+                ctx.chrome.modal = Some(Modal::prompt(
+                    "new session name:",
+                    NAME_RULE,
+                    String::new(),
+                    MAX_SESSION_LEN,
+                    PromptPurpose::SessionName,
+                ));
                 Vec::new()
             }
-            Action::SelectUp => {
-                self.survey.selected = self.survey.selected.saturating_sub(1);
-                Vec::new()
-            }
-            Action::SelectDown => {
-                if self.survey.selected + 1 < self.sessions.len() {
-                    self.survey.selected += 1;
-                }
-                Vec::new()
-            }
-            Action::OpenSelected => match self.sessions.get(self.survey.selected) {
-                Some((_, dir, _)) => vec![Cmd::Store(StoreCmd::Open(dir.clone()))],
-                None => {
-                    self.log
-                        .push(Level::Warn, "no session to open: press n to create one");
-                    Vec::new()
-                }
-            },
-            Action::NextStep => match self.work.phase {
-                Phase::NoSession => self.survey_action(if self.sessions.is_empty() {
-                    Action::NewSession
-                } else {
-                    Action::OpenSelected
-                }),
-                Phase::Setup => self.capture_next(),
-                Phase::Review => self.survey_action(Action::Accept),
-                Phase::Capturing | Phase::Processing => Vec::new(),
-            },
-            Action::Accept => {
-                if self.work.phase != Phase::Review {
-                    self.log.push(
-                        Level::Warn,
-                        "nothing to accept yet: capture and run the image first (Enter)",
-                    );
+            SurveyAction::OpenPicker => {
+                if ctx.session.list.is_empty() {
+                    ctx.warn("no session in the survey folder yet: n creates one");
                     return Vec::new();
                 }
-                let Some(cmds) = self.save_outputs() else {
-                    return Vec::new();
+                self.picking = !self.picking || ctx.session.view.is_none();
+                if let Some(v) = &ctx.session.view
+                    && let Some(i) = ctx.session.list.iter().position(|e| e.dir == v.dir)
+                {
+                    self.selected = i;
+                }
+                if self.picking {
+                    ctx.info("choose a session: ↑↓, Enter opens it, o goes back");
+                }
+                Vec::new()
+            }
+            SurveyAction::Up | SurveyAction::Down if listing => {
+                let n = ctx.session.list.len();
+                if a == SurveyAction::Up {
+                    self.selected = self.selected.saturating_sub(1);
+                } else if self.selected + 1 < n {
+                    self.selected += 1;
+                }
+                Vec::new()
+            }
+            SurveyAction::Up | SurveyAction::Down => {
+                let ks = ctx.session.numbers();
+                let now = self.row(&ctx.session.work);
+                let pos = ks.iter().position(|&k| k == now);
+                let next = match (a, pos) {
+                    (SurveyAction::Up, Some(p)) => ks.get(p.saturating_sub(1)),
+                    (SurveyAction::Up, None) => ks.last(),
+                    (_, Some(p)) => ks.get(p + 1).or(ks.last()),
+                    (_, None) => ks.first(),
                 };
-                self.log
-                    .push(Level::Info, format!("image {} accepted", self.work.k));
-                self.work.k += 1;
-                self.work.phase = Phase::Setup;
-                self.follow_plan();
-                cmds
+                self.row = next.copied();
+                Vec::new()
             }
-            Action::Redo => {
-                let k = self.work.k;
-                let captured = self
-                    .current
-                    .as_ref()
-                    .is_some_and(|c| c.k == k && !c.frames.is_empty())
-                    || self
-                        .session
-                        .as_ref()
-                        .and_then(|s| s.images.iter().find(|i| i.k == k))
-                        .is_some_and(|i| !i.captured.is_empty());
-                let k = if captured || k <= 1 { k } else { k - 1 };
-                if self.work.phase == Phase::NoSession {
+            SurveyAction::Enter if listing => self.open_selected(ctx),
+            SurveyAction::Enter => {
+                let row = self.row(&ctx.session.work);
+                if row != ctx.session.work.k {
+                    self.row = None;
+                    return ctx.go_to(row);
+                }
+                match ctx.session.work.phase {
+                    Phase::Setup => ctx.capture_next(),
+                    Phase::Review => {
+                        let k = ctx.session.work.k;
+                        ctx.ask(
+                            format!("Accept image {k} and go on to the next image?"),
+                            Pending::Accept,
+                        );
+                        Vec::new()
+                    }
+                    Phase::Complete => {
+                        let k = ctx.session.work.k;
+                        ctx.ask(
+                            format!(
+                                "Every planned image is done. Start image {k}, beyond the plan?"
+                            ),
+                            Pending::ExtraImage(k),
+                        );
+                        Vec::new()
+                    }
+                    Phase::Capturing | Phase::Processing => {
+                        ctx.info("busy with this image: wait for it, or Esc stops the capture");
+                        Vec::new()
+                    }
+                    Phase::NoSession => Vec::new(),
+                }
+            }
+            SurveyAction::Accept => ctx.accept(false),
+            SurveyAction::Redo => {
+                let k = self.row(&ctx.session.work);
+                self.row = None;
+                ctx.ask_retake(k);
+                Vec::new()
+            }
+            SurveyAction::Camera | SurveyAction::Location => {
+                let w = &mut ctx.session.work;
+                if w.phase != Phase::Setup {
+                    ctx.warn("camera and location are chosen before capturing (Setup)");
                     return Vec::new();
                 }
-                self.modal = Some(Modal::Confirm {
-                    question: format!(
-                        "Redo image {k}? Its saved grey images and outputs will be overwritten."
-                    ),
-                    on_yes: Pending::RedoImage(k),
-                });
-                Vec::new()
-            }
-            Action::CameraNext => {
-                if matches!(self.work.phase, Phase::Setup | Phase::NoSession) {
-                    self.work.camera = self.work.camera % self.cameras + 1;
+                if a == SurveyAction::Camera {
+                    w.camera = w.camera % ctx.cell.cameras + 1;
+                } else {
+                    w.location = w.location % 99 + 1;
                 }
+                let (k, c, l) = (w.k, w.camera, w.location);
+                ctx.info(format!("image {k}: camera {c}, location {l}"));
                 Vec::new()
             }
-            Action::LocationNext => {
-                if matches!(self.work.phase, Phase::Setup | Phase::NoSession) {
-                    self.work.location = self.work.location % 99 + 1;
+            SurveyAction::CancelCapture => {
+                if self.picking {
+                    self.picking = false;
+                    return Vec::new();
                 }
-                Vec::new()
+                if ctx.cell.device.transfer.is_none() && ctx.session.work.phase != Phase::Capturing
+                {
+                    self.row = None;
+                    return Vec::new();
+                }
+                super::App::cancel_transfer(ctx)
             }
-            _ => Vec::new(),
         }
     }
 
+    fn open_selected(&mut self, ctx: &mut Ctx) -> Vec<Cmd> {
+        let Some(e) = ctx.session.list.get(self.selected).cloned() else {
+            ctx.warn("no session to open: n creates one");
+            return Vec::new();
+        };
+        if let Some(why) = &e.damaged {
+            ctx.error(format!(
+                "session {} cannot be opened: {why} — `vss session check {}` lists every \
+                 problem; mend or move the folder, then open it again",
+                e.name,
+                e.dir.display()
+            ));
+            ctx.chrome.overlay = Some(super::Overlay::Message { scroll: 0 });
+            return Vec::new();
+        }
+        if matches!(ctx.session.work.phase, Phase::Capturing | Phase::Processing) {
+            ctx.warn("a capture or run is under way: wait for it before switching sessions");
+            return Vec::new();
+        }
+        match &ctx.session.view {
+            Some(v) if v.dir == e.dir => {
+                self.picking = false;
+                Vec::new()
+            }
+            Some(v) => {
+                let q = format!("Leave session {} and open session {}?", v.name, e.name);
+                ctx.ask(q, Pending::Switch(e.dir));
+                self.picking = false;
+                Vec::new()
+            }
+            None => {
+                self.picking = false;
+                vec![Cmd::Store(StoreCmd::Open(e.dir))]
+            }
+        }
+    }
+}
+
+/// Lighting letters of the image under work not captured yet.
+pub fn missing_letters(cell: &CellState, work: &Work, tracker: &Tracker) -> Vec<char> {
+    let have: Vec<char> = match &tracker.current {
+        Some(c) if c.k == work.k => c.frames.iter().map(|f| f.0).collect(),
+        _ => Vec::new(),
+    };
+    cell.letters
+        .iter()
+        .copied()
+        .filter(|l| !have.contains(l))
+        .collect()
+}
+
+impl Ctx<'_> {
     /// Lighting letters of the survey image not captured yet.
     pub fn missing_letters(&self) -> Vec<char> {
-        let have: Vec<char> = match &self.current {
-            Some(c) if c.k == self.work.k => c.frames.iter().map(|f| f.0).collect(),
-            _ => Vec::new(),
-        };
-        self.letters
-            .iter()
-            .copied()
-            .filter(|l| !have.contains(l))
-            .collect()
+        missing_letters(self.cell, &self.session.work, self.tracker)
     }
 
-    fn capture_next(&mut self) -> Vec<Cmd> {
-        if self.session.is_none() {
+    /// Marks the transfer under way with its purpose (the worker's progress
+    /// messages carry only numbers).
+    pub fn capture(&mut self, purpose: FramePurpose, camera: u32, lighting: Option<char>) -> Cmd {
+        self.cell.device.transfer = Some((purpose, 0, 0));
+        self.cell.device.settling = lighting.is_some();
+        Cmd::Device(DeviceCmd::Capture {
+            purpose,
+            camera,
+            lighting,
+        })
+    }
+
+    pub fn capture_next(&mut self) -> Vec<Cmd> {
+        if self.session.view.is_none() {
             return Vec::new();
         }
         match self.missing_letters().first() {
             Some(&letter) => {
-                self.work.phase = Phase::Capturing;
-                let k = self.work.k;
-                vec![self.capture(
-                    FramePurpose::Survey { k, letter },
-                    self.work.camera,
-                    Some(letter),
-                )]
+                self.session.work.phase = Phase::Capturing;
+                let (k, cam) = (self.session.work.k, self.session.work.camera);
+                vec![self.capture(FramePurpose::Survey { k, letter }, cam, Some(letter))]
             }
             None => {
-                self.work.phase = Phase::Processing;
-                self.request_pipeline().into_iter().collect()
+                self.session.work.phase = Phase::Processing;
+                self.tracker.request(self.cell).into_iter().collect()
             }
         }
     }
 
-    pub(super) fn survey_frame(
+    pub fn survey_frame(
         &mut self,
         k: u32,
         letter: char,
         camera: u32,
         image: GreyImage,
     ) -> Vec<Cmd> {
-        let version = self.next_version();
-        let cur = match &mut self.current {
+        let version = self.tracker.next_version();
+        let accepted = self.session.accepted(k);
+        let cur = match &mut self.tracker.current {
             Some(c) if c.k == k => c,
-            slot => slot.insert(Loaded::new(k, camera)),
+            slot => {
+                let mut l = Loaded::new(k, camera);
+                l.accepted = accepted;
+                slot.insert(l)
+            }
         };
         cur.camera = camera;
         cur.version = version;
         cur.frames.retain(|f| f.0 != letter);
+        cur.damaged.retain(|d| d.0 != letter);
         cur.frames.push((letter, image.clone()));
+        // Frames newer than the outputs: those, and hand edits of them, are
+        // an older capture's.
+        cur.outputs = None;
+        cur.outputs_params = None;
+        cur.editor = None;
+        cur.saved_lines = None;
+        self.info(format!("image {k}: lighting {letter} captured"));
         let mut cmds = vec![Cmd::Store(StoreCmd::SaveImage {
             k,
             letter,
             camera,
-            location: self.work.location,
+            location: self.session.work.location,
             image,
         })];
-        if self.work.phase == Phase::Capturing && k == self.work.k {
+        if self.session.work.phase == Phase::Capturing && k == self.session.work.k {
             cmds.extend(self.capture_next());
         }
         cmds
     }
 
-    pub(super) fn survey_capture_failed(&mut self) {
-        if self.work.phase == Phase::Capturing {
-            self.work.phase = Phase::Setup;
+    pub fn survey_capture_failed(&mut self) {
+        if self.session.work.phase == Phase::Capturing {
+            self.session.work.phase = Phase::Setup;
         }
     }
 
-    pub(super) fn survey_store_error(&mut self) {}
-
-    pub(super) fn pipeline_done(&mut self) -> Vec<Cmd> {
-        if self.work.phase == Phase::Processing {
-            self.work.phase = Phase::Review;
-            if let Some(out) = self.current.as_ref().and_then(|c| c.outputs.as_ref()) {
-                self.log.push(
-                    Level::Info,
-                    format!(
-                        "image {}: {} lines — a accepts, r redoes",
-                        self.work.k,
-                        out.lines.len()
-                    ),
-                );
-            }
+    pub fn pipeline_done(&mut self) {
+        let k = self.session.work.k;
+        if self.session.work.phase == Phase::Processing
+            && self.tracker.current.as_ref().is_some_and(|c| c.k == k)
+        {
+            self.session.work.phase = Phase::Review;
+            let n = self
+                .tracker
+                .current
+                .as_ref()
+                .and_then(|c| c.lines())
+                .map_or(0, <[_]>::len);
+            self.info(format!(
+                "image {k}: {n} lines — a accepts, R captures again, 3 tunes, 4 edits"
+            ));
         }
-        Vec::new()
     }
 
-    pub(super) fn pipeline_failed(&mut self) -> Vec<Cmd> {
-        if self.work.phase == Phase::Processing {
-            self.work.phase = Phase::Setup;
+    pub fn pipeline_failed(&mut self) {
+        if self.session.work.phase == Phase::Processing {
+            self.session.work.phase = Phase::Setup;
         }
-        Vec::new()
     }
 
     /// Sets the camera and location of the image about to be captured to
@@ -228,97 +344,304 @@ impl App {
     /// image being redone), as the checklist shows them; an image with no
     /// record keeps the current ones.
     fn follow_plan(&mut self) {
-        let k = self.work.k;
-        if let Some(i) = self
-            .session
-            .as_ref()
-            .and_then(|s| s.images.iter().find(|i| i.k == k))
-        {
-            self.work.camera = i.camera.max(1);
-            self.work.location = i.location.max(1);
+        let k = self.session.work.k;
+        if let Some((c, l)) = self.session.image(k).map(|i| (i.camera, i.location)) {
+            self.session.work.camera = c.max(1);
+            self.session.work.location = l.max(1);
         }
     }
 
-    pub(super) fn session_opened(&mut self, v: SessionView) -> Vec<Cmd> {
-        self.log.push(
-            Level::Info,
-            format!("session {} open in {}", v.name, v.dir.display()),
-        );
-        let (k, resume) = match v.next {
-            Some((k, _)) => (
-                k,
-                v.images.iter().any(|i| i.k == k && !i.captured.is_empty()),
+    pub fn session_opened(&mut self, v: SessionView) -> Vec<Cmd> {
+        self.info(format!("session {} open in {}", v.name, v.dir.display()));
+        let last = v
+            .images
+            .iter()
+            .filter(|i| !i.captured.is_empty())
+            .map(|i| i.k)
+            .max();
+        let (k, phase) = match v.next {
+            Some((k, _)) => (k, Phase::Setup),
+            None => (
+                v.images.iter().map(|i| i.k).max().unwrap_or(0) + 1,
+                if v.images.is_empty() {
+                    Phase::Setup
+                } else {
+                    Phase::Complete
+                },
             ),
-            None => (v.images.iter().map(|i| i.k).max().unwrap_or(0) + 1, false),
         };
-        self.work = Work {
+        let resume = v.images.iter().any(|i| i.k == k && !i.captured.is_empty());
+        self.session.work = Work {
             k,
-            camera: self.work.camera.max(1),
-            location: self.work.location.max(1),
-            phase: Phase::Setup,
+            camera: self.session.work.camera.max(1),
+            location: self.session.work.location.max(1),
+            phase,
         };
-        if resume {
-            self.log.push(Level::Info, format!("resuming at image {k}"));
+        if phase == Phase::Complete {
+            self.info(format!(
+                "survey complete: 5 writes the report; ↑↓ Enter goes back to an image, \
+                 Enter on no image starts image {k} beyond the plan"
+            ));
         }
-        self.session = Some(v);
+        self.session.view = Some(v);
         self.follow_plan();
-        self.current = None;
-        if resume {
-            vec![Cmd::Store(StoreCmd::Load(k))]
-        } else {
-            Vec::new()
+        self.tracker.current = None;
+        // The image the survey goes on with, or the last one worked on, so
+        // the Pipeline and Edit screens show it at once.
+        match (resume, last) {
+            (true, _) => {
+                self.info(format!("resuming at image {k}"));
+                vec![Cmd::Store(StoreCmd::Load(k))]
+            }
+            (false, Some(l)) => vec![Cmd::Store(StoreCmd::Load(l))],
+            (false, None) => Vec::new(),
         }
     }
 
-    pub(super) fn images_loaded(&mut self, k: u32, images: Vec<(char, GreyImage)>) -> Vec<Cmd> {
-        if images.is_empty() {
+    /// An image read back from the session: its good frames, and its
+    /// saved outputs and lines when they are current.
+    pub fn images_loaded(&mut self, img: LoadedImage) -> Vec<Cmd> {
+        let k = img.k;
+        let work_k = self.session.work.k;
+        for (l, why) in &img.damaged {
+            self.error(format!(
+                "image {k} lighting {l}: {why} — R captures it again"
+            ));
+        }
+        if img.images.is_empty() && img.damaged.is_empty() {
             return Vec::new();
         }
-        let version = self.next_version();
-        let camera = if k == self.work.k {
-            self.work.camera
+        let version = self.tracker.next_version();
+        let camera = if k == work_k {
+            self.session.work.camera
         } else {
-            1
+            self.session.image(k).map_or(1, |i| i.camera.max(1))
         };
         let mut l = Loaded::new(k, camera);
-        l.frames = images;
+        l.frames = img.images;
+        l.damaged = img.damaged;
         l.version = version;
-        self.current = Some(l);
-        if k == self.work.k && self.work.phase == Phase::Setup && self.missing_letters().is_empty()
-        {
-            self.work.phase = Phase::Processing;
+        l.accepted = img.accepted;
+        let complete = self.cell.letters.iter().all(|c| l.frame(*c).is_some());
+        let mut cmds = Vec::new();
+        match img.saved {
+            Some(saved) if complete => {
+                if saved.params != self.tracker.params {
+                    self.info(format!(
+                        "image {k}: the parameter panel now shows the values its outputs were made with"
+                    ));
+                    self.tracker.params = saved.params.clone();
+                }
+                let lines = img.lines.unwrap_or_else(|| saved.outputs.lines.clone());
+                l.editor = Some(crate::llv::edit::LineEditor::new(lines));
+                l.outputs = Some(std::sync::Arc::new(saved.outputs));
+                l.outputs_params = Some(saved.params);
+                l.from_disk = true;
+                l.in_session = true;
+                // Nothing runs: what is shown is what the session holds.
+                self.tracker.shown_generation = self.tracker.generation;
+                self.tracker.current = Some(l);
+                if k == work_k && self.session.work.phase == Phase::Setup {
+                    self.session.work.phase = Phase::Review;
+                }
+                self.info(format!("image {k}: saved outputs and lines loaded"));
+            }
+            _ => {
+                l.saved_lines = img.lines;
+                self.tracker.current = Some(l);
+                if complete {
+                    if k == work_k && self.session.work.phase == Phase::Setup {
+                        self.session.work.phase = Phase::Processing;
+                    }
+                    cmds.extend(self.tracker.request(self.cell));
+                }
+            }
         }
-        self.request_pipeline().into_iter().collect()
+        cmds
     }
 
-    pub(super) fn redo_confirmed(&mut self, k: u32) -> Vec<Cmd> {
-        if self.current.as_ref().is_some_and(|c| c.k == k) {
-            self.current = None;
+    /// Makes image `k` the one the survey works on, loading what the
+    /// session holds of it.
+    pub fn go_to(&mut self, k: u32) -> Vec<Cmd> {
+        if matches!(
+            self.session.work.phase,
+            Phase::Capturing | Phase::Processing
+        ) {
+            self.warn("busy with the image under work: wait for it, or Esc stops the capture");
+            return Vec::new();
         }
-        self.work.k = k;
-        self.work.phase = Phase::Setup;
+        self.session.work.k = k;
+        self.session.work.phase = Phase::Setup;
         self.follow_plan();
-        self.log.push(
-            Level::Info,
-            format!("image {k} will be captured again: Enter starts"),
-        );
-        vec![Cmd::Store(StoreCmd::Redo(k))]
-    }
-}
-
-impl Loaded {
-    pub fn new(k: u32, camera: u32) -> Loaded {
-        Loaded {
-            k,
-            camera,
-            frames: Vec::new(),
-            version: 0,
-            outputs: None,
-            outputs_params: None,
-            editor: None,
-            edits: 0,
-            saved_lines: None,
-            failed: None,
+        self.info(format!("image {k}"));
+        let captured = self
+            .session
+            .image(k)
+            .is_some_and(|i| !i.captured.is_empty());
+        match &self.tracker.current {
+            Some(c) if c.k == k && c.outputs.is_some() => {
+                self.session.work.phase = Phase::Review;
+                Vec::new()
+            }
+            _ if captured => vec![Cmd::Store(StoreCmd::Load(k))],
+            _ => Vec::new(),
         }
+    }
+
+    /// Asks before capturing image `k` again: only its damaged lightings,
+    /// or all of them.
+    pub fn ask_retake(&mut self, k: u32) {
+        if matches!(
+            self.session.work.phase,
+            Phase::Capturing | Phase::Processing | Phase::NoSession
+        ) {
+            self.warn("nothing to capture again now");
+            return;
+        }
+        let damaged: Vec<(char, String)> = self
+            .session
+            .image(k)
+            .map(|i| i.damaged.clone())
+            .unwrap_or_default();
+        let all = Pending::Retake {
+            k,
+            letters: Vec::new(),
+        };
+        if damaged.is_empty() {
+            self.ask(
+                format!(
+                    "Capture image {k} again under every lighting? Its saved grey images and \
+                     outputs are replaced as the new captures come in."
+                ),
+                all,
+            );
+            return;
+        }
+        let letters: Vec<char> = damaged.iter().map(|d| d.0).collect();
+        let list: String = letters.iter().collect();
+        let why: Vec<String> = damaged.iter().map(|(l, w)| format!("{l}: {w}")).collect();
+        self.chrome.modal = Some(Modal::Confirm {
+            question: format!(
+                "Image {k}: lighting {list} damaged ({}). y retakes only {list}, a every \
+                 lighting, n nothing.",
+                why.join("; ")
+            ),
+            on_yes: Pending::Retake { k, letters },
+            on_all: Some(all),
+        });
+    }
+
+    /// Captures image `k` again: every lighting (`letters` empty), or only
+    /// the damaged ones.
+    pub fn retake(&mut self, k: u32, letters: Vec<char>) -> Vec<Cmd> {
+        self.session.work.k = k;
+        self.session.work.phase = Phase::Setup;
+        self.follow_plan();
+        if letters.is_empty() {
+            let mut l = Loaded::new(k, self.session.work.camera);
+            l.accepted = self.session.accepted(k);
+            l.version = self.tracker.next_version();
+            self.tracker.current = Some(l);
+            self.info(format!("image {k} will be captured again: Enter starts"));
+            return vec![Cmd::Store(StoreCmd::Redo(k))];
+        }
+        let list: String = letters.iter().collect();
+        self.info(format!(
+            "image {k}: Enter captures lighting {list} again; the others are kept"
+        ));
+        match self.tracker.current.as_mut() {
+            Some(c) if c.k == k => {
+                c.frames.retain(|f| !letters.contains(&f.0));
+                c.outputs = None;
+                Vec::new()
+            }
+            _ => vec![Cmd::Store(StoreCmd::Load(k))],
+        }
+    }
+
+    /// Accepts the image under review: saves its outputs when they differ
+    /// from the session's (asking first when that replaces accepted ones)
+    /// and goes on to the next image the survey needs.
+    pub fn accept(&mut self, confirmed: bool) -> Vec<Cmd> {
+        let k = self.session.work.k;
+        let cur = self.tracker.current.as_ref().filter(|c| c.k == k);
+        if self.session.work.phase != Phase::Review || cur.is_none() {
+            self.warn("nothing to accept: capture and run an image first (Enter)");
+            return Vec::new();
+        }
+        // Outputs the session already holds (hand edits are written as they
+        // are made): nothing to save, nothing to ask.
+        let unchanged = cur.is_some_and(|c| {
+            c.in_session && c.outputs_params.as_ref() == Some(&self.tracker.params)
+        });
+        let mut cmds = Vec::new();
+        if !unchanged {
+            if cur.is_some_and(|c| c.accepted) && !confirmed {
+                self.ask(
+                    format!(
+                        "Image {k} is accepted. Replace its saved outputs (and the hand edits \
+                         of its .ldr) with the ones on screen, and go on?"
+                    ),
+                    Pending::Accept,
+                );
+                return Vec::new();
+            }
+            match self.save_outputs(true) {
+                Some(c) => cmds = c,
+                None => return Vec::new(),
+            }
+        }
+        self.info(format!("image {k} accepted"));
+        self.next_image(k);
+        if let Some(n) = self.session.image(self.session.work.k)
+            && !n.captured.is_empty()
+            && self.session.work.phase == Phase::Setup
+        {
+            cmds.push(Cmd::Store(StoreCmd::Load(n.k)));
+        }
+        cmds
+    }
+
+    /// Moves the survey on from image `done` to the first image the
+    /// checklist still needs, or announces the end of the plan.
+    fn next_image(&mut self, done: u32) {
+        let next = self.session.view.as_ref().and_then(|v| {
+            v.images
+                .iter()
+                .filter(|i| i.k != done)
+                .find(|i| !(i.outputs && !i.stale && i.damaged.is_empty()))
+                .map(|i| i.k)
+        });
+        let planned = self.session.view.as_ref().map_or(0, |v| v.images.len());
+        match next {
+            Some(k) => {
+                self.session.work.k = k;
+                self.session.work.phase = Phase::Setup;
+                self.follow_plan();
+            }
+            None if planned > 0 => {
+                let max = self.session.numbers().into_iter().max().unwrap_or(done);
+                self.session.work.k = max.max(done) + 1;
+                self.session.work.phase = Phase::Complete;
+                self.warn(format!(
+                    "survey complete: all {planned} planned images done — 5 writes the report"
+                ));
+            }
+            None => {
+                self.session.work.k = done + 1;
+                self.session.work.phase = Phase::Setup;
+            }
+        }
+    }
+
+    /// Starts an image beyond the plan (the operator said so).
+    pub fn extra_image(&mut self, k: u32) -> Vec<Cmd> {
+        self.session.work.k = k;
+        self.session.work.phase = Phase::Setup;
+        self.info(format!(
+            "image {k}, beyond the plan: camera {} location {} — Enter captures",
+            self.session.work.camera, self.session.work.location
+        ));
+        Vec::new()
     }
 }

@@ -3,42 +3,19 @@
 //! one key) and what the grabber and relay board report.
 
 use ratatui::buffer::Buffer;
-use ratatui::crossterm::event::KeyEvent;
 use ratatui::layout::Rect;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Paragraph, Widget, Wrap};
 
-use super::{block, gauge_text, split_panel};
+use super::{block, block2, gauge_text, split_panel};
 use crate::tui::app::App;
-use crate::tui::keymap::{self, Action, Scope, ScreenId};
-use crate::tui::widgets::preview::{Layer, Preview};
-
-/// The Capture screen's own state: the highlighted light and the camera.
-#[derive(Clone, Debug)]
-pub struct CaptureScreen {
-    pub light: usize,
-    pub camera: u32,
-}
-
-impl Default for CaptureScreen {
-    fn default() -> Self {
-        CaptureScreen {
-            light: 0,
-            camera: 1,
-        }
-    }
-}
-
-impl CaptureScreen {
-    pub fn handle_key(&mut self, key: KeyEvent) -> Option<Action> {
-        keymap::lookup(Scope::Screen(ScreenId::Capture), &key)
-    }
-}
+use crate::tui::widgets::preview::{Layer, Preview, stretch_of};
 
 pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
     let (panel, right) = split_panel(area, 32);
-    let d = &app.device;
+    let d = &app.cell.device;
+    let cap = &app.screens.capture;
     let mut lines = vec![
         Line::styled("grabber", t.title()),
         if let Some(e) = &d.lost {
@@ -52,14 +29,14 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         Line::raw(format!(" {} mask {:#06x}", d.relay, d.mask)),
         Line::raw(format!(
             "camera {} (c)  live {} (v)",
-            app.capture.camera,
+            cap.camera,
             if d.live { "ON" } else { "off" }
         )),
-        Line::styled("lights (↑↓ Space, o off)", t.title()),
+        Line::styled("lights (↑↓ Space, 0 all off)", t.title()),
     ];
-    for (i, (name, relay)) in app.lights.iter().enumerate() {
+    for (i, (name, relay)) in app.cell.lights.iter().enumerate() {
         let on = d.lights_on.contains(name);
-        let st = if i == app.capture.light {
+        let st = if i == cap.light {
             t.selected()
         } else {
             Default::default()
@@ -70,7 +47,7 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         ));
     }
     lines.push(Line::styled("lightings (Shift+letter)", t.title()));
-    for (l, on) in &app.lighting_on {
+    for (l, on) in &app.cell.lighting_on {
         let now = {
             let mut a = on.clone();
             let mut b = d.lights_on.clone();
@@ -92,24 +69,45 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         ]));
     }
     if let Some((_, done, total)) = d.transfer {
-        lines.push(Line::raw(gauge_text(
-            done,
-            total,
-            panel.width.saturating_sub(2) as usize,
-        )));
+        lines.push(Line::raw(if d.settling && done == 0 {
+            "lights settling…".to_string()
+        } else {
+            gauge_text(done, total, panel.width.saturating_sub(2) as usize)
+        }));
     }
     Paragraph::new(lines)
         .wrap(Wrap { trim: false })
         .block(block(app, "devices"))
         .render(panel, buf);
-    let title = match &app.live {
-        Some((cam, img)) => format!("camera {cam} {}×{}", img.width(), img.height()),
-        None => "no picture: v live, g grab".into(),
+    let b = match &app.cell.live {
+        Some((cam, img)) => {
+            let s = stretch_of(img);
+            block2(
+                app,
+                &format!("camera {cam} {}×{}", img.width(), img.height()),
+                &format!(
+                    "grey {}–{} stretched · {}",
+                    s.lo,
+                    s.hi,
+                    cap.nav.position(img.size())
+                ),
+            )
+        }
+        None => block(app, "no picture: v live, g grab"),
     };
-    let b = block(app, &title);
     let inner = b.inner(right);
     b.render(right, buf);
-    if let Some((_, img)) = &app.live {
-        Preview::new(Layer::Grey(img), app.look.mode, app.look.colour).render(inner, buf);
+    if let Some((_, img)) = &app.cell.live {
+        let mut p = Preview::new(
+            Layer::Grey(img),
+            app.chrome.look.mode,
+            app.chrome.look.colour,
+        );
+        p.palette.c256 = app.chrome.look.c256;
+        p.view = cap.nav.view;
+        if cap.nav.cursor.is_some() {
+            p.cursor = Some(cap.nav.cursor_or_centre(img.size()));
+        }
+        p.render(inner, buf);
     }
 }

@@ -1,115 +1,140 @@
-//! The Edit screen: the lines over the grey image with the selection
-//! highlighted, the selected lines' figures, and the edit keys (connect,
-//! extend, delete, undo/redo) that go into the session's log.
+//! The Edit screen: the lines over the grey image — the highlighted line,
+//! the selection and the last edit's result each in their own colour —
+//! the figures of the highlighted and selected lines, and the edits of
+//! this image in words.
 
 use ratatui::buffer::Buffer;
-use ratatui::crossterm::event::KeyEvent;
-use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::layout::Rect;
 use ratatui::text::Line;
 use ratatui::widgets::{Paragraph, Widget, Wrap};
 
-use super::{PreviewNav, block, split_panel};
-use crate::llv::Point;
+use super::{block, block2, split_panel};
+use crate::llv::Segment;
 use crate::tui::app::App;
-use crate::tui::keymap::{self, Action, Scope, ScreenId};
-use crate::tui::widgets::preview::{Layer, Preview};
+use crate::tui::widgets::preview::{Layer, Preview, stretch_of};
 
-/// The Edit screen's own state: selected line indices, zoom and cursor.
-#[derive(Clone, Debug, Default)]
-pub struct EditScreen {
-    pub selected: Vec<usize>,
-    pub nav: PreviewNav,
-}
-
-impl EditScreen {
-    pub fn handle_key(&mut self, key: KeyEvent, size: Option<(usize, usize)>) -> Option<Action> {
-        let a = keymap::lookup(Scope::Screen(ScreenId::Edit), &key)?;
-        if self.nav.apply(a, size) {
-            None
-        } else {
-            Some(a)
-        }
-    }
-
-    /// The cursor as an image point (image centre before it moves).
-    pub fn cursor_point(&self, size: Option<(usize, usize)>) -> Point {
-        let (x, y) = self.nav.cursor_or_centre(size.unwrap_or((1, 1)));
-        Point::new(x as f64, y as f64)
-    }
+fn describe_line(i: usize, s: &Segment) -> String {
+    format!(
+        "#{i} ({:.0},{:.0})-({:.0},{:.0}) {:.0}px",
+        s.a.x,
+        s.a.y,
+        s.b.x,
+        s.b.y,
+        s.length()
+    )
 }
 
 pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
     let (panel, right) = split_panel(area, 30);
-    let cur = app.current.as_ref();
-    let lines = cur.and_then(|c| c.editor.as_ref()).map(|e| e.lines());
+    let cur = app.tracker.current.as_ref();
+    let lines = cur.and_then(|c| c.lines());
+    let ed = &app.screens.edit;
     let mut info = Vec::new();
     match (cur, lines) {
         (Some(c), Some(ls)) => {
+            let state = if c.accepted {
+                "accepted"
+            } else {
+                "not accepted"
+            };
             info.push(Line::styled(
-                format!("image {}: {} lines", c.k, ls.len()),
+                format!("image {}: {} lines, {state}", c.k, ls.len()),
                 t.title(),
             ));
-            info.push(Line::raw(format!("edits this run {}", c.edits)));
-            let (x, y) = app
-                .edit
-                .nav
-                .cursor_or_centre(app.preview_size().unwrap_or((1, 1)));
+            let size = app.tracker.preview_size().unwrap_or((1, 1));
+            let (x, y) = ed.nav.cursor_or_centre(size);
             info.push(Line::raw(format!("cursor {x} {y}")));
-            info.push(Line::styled("selected", t.title()));
-            if app.edit.selected.is_empty() {
-                info.push(Line::styled(" none (n . k Space)", t.dim()));
+            info.push(Line::styled("highlighted (n p . Tab)", t.title()));
+            match ed.highlighted.and_then(|i| ls.get(i).map(|s| (i, s))) {
+                Some((i, s)) => info.push(Line::styled(describe_line(i, s), t.warn())),
+                None => info.push(Line::styled(" none", t.dim())),
             }
-            for &i in app.edit.selected.iter().take(6) {
+            info.push(Line::styled("selected (Space, v corner)", t.title()));
+            if ed.selected.is_empty() {
+                info.push(Line::styled(" none", t.dim()));
+            }
+            for &i in ed.selected.iter().take(4) {
                 if let Some(s) = ls.get(i) {
-                    info.push(Line::raw(format!(
-                        "#{i} ({:.0},{:.0})-({:.0},{:.0}) {:.0}px",
-                        s.a.x,
-                        s.a.y,
-                        s.b.x,
-                        s.b.y,
-                        s.length()
-                    )));
+                    info.push(Line::raw(describe_line(i, s)));
                 }
             }
-            if let Some(ed) = c.editor.as_ref() {
-                let log = ed.log();
-                if !log.is_empty() {
-                    info.push(Line::styled("log", t.title()));
-                    for op in log.iter().rev().take(4) {
-                        info.push(Line::raw(format!(" {op:?}")));
-                    }
+            let edits: Vec<_> = app
+                .chrome
+                .log
+                .entries()
+                .rev()
+                .filter(|e| {
+                    e.text.starts_with(&format!("image {}: ", c.k))
+                        && ["connected", "extended", "deleted", "undone", "redone"]
+                            .iter()
+                            .any(|w| e.text.contains(w))
+                })
+                .take(3)
+                .collect();
+            if !edits.is_empty() {
+                info.push(Line::styled("last edits", t.title()));
+                for e in edits {
+                    let text = e.text.split_once(": ").map_or(&e.text[..], |x| x.1);
+                    info.push(Line::raw(format!(" {text}")));
                 }
             }
         }
         _ => info.push(Line::raw(
-            "No lines yet: capture and run an image (Survey, 1).",
+            "No lines yet: capture and run an image, or go to one (Survey, 1).",
         )),
     }
     Paragraph::new(info)
         .wrap(Wrap { trim: true })
         .block(block(app, "lines"))
         .render(panel, buf);
-    let [view, _] = Layout::vertical([Constraint::Min(1), Constraint::Length(0)]).areas(right);
-    let title = match app.outputs_stale() {
-        Some(why) => format!("lines over grey — {why}"),
-        None => "lines over grey".to_string(),
+    let (Some(c), Some(ls)) = (cur, lines) else {
+        block(app, "lines over grey").render(right, buf);
+        return;
     };
-    let b = block(app, &title);
-    let inner = b.inner(view);
-    b.render(view, buf);
-    if let (Some(c), Some(ls)) = (cur, lines)
-        && let Some((_, grey)) = c.frames.first()
-    {
-        let bg = c
-            .outputs
-            .as_ref()
-            .and_then(|o| o.corrected.first())
-            .unwrap_or(grey);
-        let mut p = Preview::new(Layer::LinesOver(bg, ls), app.look.mode, app.look.colour);
-        p.view = app.edit.nav.view;
-        p.selected = &app.edit.selected;
-        p.cursor = Some(app.edit.nav.cursor_or_centre(grey.size()));
-        p.render(inner, buf);
-    }
+    let Some((letter, grey)) = c.frames.first() else {
+        block(app, "lines over grey").render(right, buf);
+        return;
+    };
+    let bg = c
+        .outputs
+        .as_ref()
+        .and_then(|o| o.corrected.first())
+        .unwrap_or(grey);
+    let s = stretch_of(bg);
+    let stale = app
+        .tracker
+        .stale()
+        .map(|w| format!("{w} · "))
+        .unwrap_or_default();
+    let title = format!(
+        "{stale}image {}{letter} · lines over grey {}",
+        c.k,
+        ls.len()
+    );
+    let size = grey.size();
+    let b = block2(
+        app,
+        &title,
+        &format!(
+            "grey {}–{} stretched · {}",
+            s.lo,
+            s.hi,
+            ed.nav.position(size)
+        ),
+    );
+    let inner = b.inner(right);
+    b.render(right, buf);
+    let mut p = Preview::new(
+        Layer::LinesOver(bg, ls),
+        app.chrome.look.mode,
+        app.chrome.look.colour,
+    );
+    p.palette.c256 = app.chrome.look.c256;
+    p.view = ed.nav.view;
+    p.selected = &ed.selected;
+    p.highlighted = ed.highlighted;
+    p.result = &ed.result;
+    p.cursor = Some(ed.nav.cursor_or_centre(grey.size()));
+    p.render(inner, buf);
 }

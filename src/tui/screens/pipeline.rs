@@ -1,113 +1,39 @@
 //! The Pipeline screen: the stage outputs one at a time or side by side,
-//! the parameter panel (arrows, `+`/`-`, typed values; each change re-runs
-//! only the affected stages off the UI thread), counts and per-stage times,
-//! and a zoomable preview with a cursor reporting pixel, grey and response.
+//! each titled with its image, lighting and what it shows (and "stale"
+//! when the outputs are not the panel's); the parameter panel (values that
+//! differ from the profile marked `*`, "more" where the list runs past
+//! the box), counts and per-stage times; a cursor reporting pixel, grey
+//! and responses, and where the view is.
 
 use ratatui::buffer::Buffer;
-use ratatui::crossterm::event::KeyEvent;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{Paragraph, Widget};
+use ratatui::widgets::{Paragraph, Widget, Wrap};
 
-use super::{PreviewNav, block, split_panel};
-use crate::llv::params::{PARAMS, ParamSpec};
-use crate::tui::app::{App, Loaded, fmt_value};
-use crate::tui::keymap::{self, Action, Scope, ScreenId};
-use crate::tui::widgets::preview::{Layer, Preview};
-
-/// The stage views, in Tab order.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum StageView {
-    Grey,
-    Corrected,
-    EdgesH,
-    EdgesV,
-    LinesRaw,
-    Lines,
-    Overlay,
-}
-
-impl StageView {
-    pub const ALL: [StageView; 7] = [
-        StageView::Grey,
-        StageView::Corrected,
-        StageView::EdgesH,
-        StageView::EdgesV,
-        StageView::LinesRaw,
-        StageView::Lines,
-        StageView::Overlay,
-    ];
-    pub fn title(self) -> &'static str {
-        match self {
-            StageView::Grey => "grey",
-            StageView::Corrected => "corrected",
-            StageView::EdgesH => "edges H",
-            StageView::EdgesV => "edges V",
-            StageView::LinesRaw => "raw lines",
-            StageView::Lines => "connected lines",
-            StageView::Overlay => "lines over grey",
-        }
-    }
-    fn index(self) -> usize {
-        Self::ALL.iter().position(|&v| v == self).unwrap_or(0)
-    }
-}
-
-/// The Pipeline screen's own state.
-#[derive(Clone, Debug)]
-pub struct PipelineScreen {
-    /// Index into [`PARAMS`].
-    pub param: usize,
-    pub view: StageView,
-    pub side_by_side: bool,
-    pub nav: PreviewNav,
-}
-
-impl Default for PipelineScreen {
-    fn default() -> Self {
-        PipelineScreen {
-            param: 0,
-            view: StageView::Overlay,
-            side_by_side: false,
-            nav: PreviewNav::default(),
-        }
-    }
-}
-
-impl PipelineScreen {
-    pub fn param_spec(&self) -> &'static ParamSpec {
-        PARAMS.get(self.param).unwrap_or(&PARAMS[0])
-    }
-
-    /// Handles the screen's own keys (selection, views, zoom, cursor);
-    /// returns what the App must do.
-    pub fn handle_key(&mut self, key: KeyEvent, size: Option<(usize, usize)>) -> Option<Action> {
-        let a = keymap::lookup(Scope::Screen(ScreenId::Pipeline), &key)?;
-        let n = StageView::ALL.len();
-        match a {
-            Action::ParamPrev => self.param = self.param.saturating_sub(1),
-            Action::ParamNext => self.param = (self.param + 1).min(PARAMS.len() - 1),
-            Action::ViewNext => self.view = StageView::ALL[(self.view.index() + 1) % n],
-            Action::ViewPrev => self.view = StageView::ALL[(self.view.index() + n - 1) % n],
-            Action::SideBySide => self.side_by_side = !self.side_by_side,
-            other if self.nav.apply(other, size) => {}
-            other => return Some(other),
-        }
-        None
-    }
-}
+use super::{block, block2, signed, split_panel, window};
+use crate::llv::GreyImage;
+use crate::llv::params::{PARAMS, fmt_value};
+use crate::tui::app::{App, GreySource, Loaded, StageView};
+use crate::tui::widgets::preview::{Layer, Preview, stretch_of};
 
 pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     let (panel, right) = split_panel(area, 32);
     params_panel(app, panel, buf);
     let [views, info] = Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(right);
-    let Some(cur) = app.current.as_ref().filter(|c| !c.frames.is_empty()) else {
-        Paragraph::new("No image yet: capture one on the Survey screen (1).")
+    let Some(cur) = app
+        .tracker
+        .current
+        .as_ref()
+        .filter(|c| !c.frames.is_empty())
+    else {
+        Paragraph::new("No image yet: capture one, or go to one, on the Survey screen (1).")
+            .wrap(Wrap { trim: true })
             .block(block(app, "preview"))
             .render(views, buf);
         return;
     };
-    if app.pipeline.side_by_side {
+    let grey = grey_image(app, cur);
+    if app.screens.pipeline.side_by_side {
         let cols = if views.width >= 120 { 4 } else { 3 };
         let rows = StageView::ALL.len().div_ceil(cols);
         let row_areas =
@@ -117,28 +43,129 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
                 Layout::horizontal(vec![Constraint::Ratio(1, cols as u32); cols]).split(*ra);
             for (c, ca) in cells.iter().enumerate() {
                 if let Some(v) = StageView::ALL.get(r * cols + c) {
-                    stage_view(app, cur, *v, *ca, buf);
+                    stage_view(app, cur, &grey, *v, *ca, true, buf);
                 }
             }
         }
     } else {
-        stage_view(app, cur, app.pipeline.view, views, buf);
+        stage_view(
+            app,
+            cur,
+            &grey,
+            app.screens.pipeline.view,
+            views,
+            false,
+            buf,
+        );
     }
     cursor_line(app, cur, info, buf);
 }
 
-fn stage_view(app: &App, cur: &Loaded, v: StageView, area: Rect, buf: &mut Buffer) {
-    let grey = &cur.frames[0].1;
+/// The image the grey views show: a lighting's frame, or the combined
+/// response as grey. `None` when it is not there (the response of saved
+/// outputs before a run).
+pub struct GreyView<'a> {
+    pub image: std::borrow::Cow<'a, GreyImage>,
+    pub name: String,
+    pub letter: Option<char>,
+}
+
+fn grey_image<'a>(app: &App, cur: &'a Loaded) -> GreyView<'a> {
+    let letters = &app.cell.letters;
+    let first = || {
+        let (l, g) = &cur.frames[0];
+        GreyView {
+            image: std::borrow::Cow::Borrowed(g),
+            name: format!("lighting {l}"),
+            letter: Some(*l),
+        }
+    };
+    match app.screens.pipeline.grey {
+        GreySource::Lighting(i) => {
+            let Some(&l) = letters.get(i) else {
+                return first();
+            };
+            match cur.frame(l) {
+                Some(g) => GreyView {
+                    image: std::borrow::Cow::Borrowed(g),
+                    name: app.screens.pipeline.grey_name(&app.cell),
+                    letter: Some(l),
+                },
+                None => first(),
+            }
+        }
+        GreySource::Combined => match cur.outputs.as_deref().and_then(combined) {
+            Some(g) => GreyView {
+                image: std::borrow::Cow::Owned(g),
+                name: "combined response".into(),
+                letter: None,
+            },
+            None => GreyView {
+                name: "lighting a (no response yet: change a value to run)".into(),
+                ..first()
+            },
+        },
+    }
+}
+
+/// `sqrt(H² + V²)` of the combined responses as a grey image (its
+/// percentile stretch maps it to the whole ramp).
+fn combined(o: &crate::llv::pipeline::StageOutputs) -> Option<GreyImage> {
+    let (h, v) = (&o.response_h, &o.response_v);
+    if h.width == 0 || h.width != v.width || h.height != v.height {
+        return None;
+    }
+    let mag: Vec<f32> = h
+        .data
+        .iter()
+        .zip(&v.data)
+        .map(|(a, b)| {
+            let (a, b) = (
+                if a.is_finite() { *a } else { 0.0 },
+                if b.is_finite() { *b } else { 0.0 },
+            );
+            (a * a + b * b).sqrt()
+        })
+        .collect();
+    let max = mag.iter().copied().fold(0.0f32, f32::max).max(1e-6);
+    let data = mag
+        .iter()
+        .map(|m| (m / max * 255.0).round() as u8)
+        .collect();
+    GreyImage::new(h.width, h.height, data).ok()
+}
+
+fn stage_view(
+    app: &App,
+    cur: &Loaded,
+    grey: &GreyView,
+    v: StageView,
+    area: Rect,
+    small: bool,
+    buf: &mut Buffer,
+) {
     let out = cur.outputs.as_deref();
+    let img: &GreyImage = &grey.image;
+    // The corrected image of the lighting shown (lit lightings only, in
+    // the order the frame rule gives the pipeline its images).
+    let corrected = |o: &'_ crate::llv::pipeline::StageOutputs| -> Option<usize> {
+        let l = grey.letter?;
+        let lit = app.cell.rule.lit_letters(cur.frames.iter().map(|f| f.0));
+        lit.iter()
+            .position(|c| *c == l)
+            .filter(|&i| i < o.corrected.len())
+    };
     let layer = match (v, out) {
-        (StageView::Grey, _) => Some(Layer::Grey(grey)),
-        (StageView::Corrected, Some(o)) => Some(Layer::Grey(o.corrected.first().unwrap_or(grey))),
+        (StageView::Grey, _) => Some(Layer::Grey(img)),
+        (StageView::Corrected, Some(o)) => {
+            Some(Layer::Grey(corrected(o).map_or(img, |i| &o.corrected[i])))
+        }
         (StageView::EdgesH, Some(o)) => Some(Layer::Edges(&o.edges_h)),
         (StageView::EdgesV, Some(o)) => Some(Layer::Edges(&o.edges_v)),
         (StageView::LinesRaw, Some(o)) => Some(Layer::Lines(&o.lines_raw)),
         (StageView::Lines, Some(o)) => Some(Layer::Lines(&o.lines)),
         (StageView::Overlay, Some(o)) => Some(Layer::LinesOver(
-            o.corrected.first().unwrap_or(grey),
+            corrected(o).map_or(img, |i| &o.corrected[i]),
             &o.lines,
         )),
         _ => None,
@@ -150,54 +177,104 @@ fn stage_view(app: &App, cur: &Loaded, v: StageView, area: Rect, buf: &mut Buffe
         (StageView::Lines | StageView::Overlay, Some(o)) => format!(" {}", o.lines.len()),
         _ => String::new(),
     };
-    let stale = match (v, app.outputs_stale()) {
-        (StageView::Grey, _) | (_, None) => String::new(),
-        (_, Some(why)) => format!(" — {why}"),
+    let shows_grey = matches!(
+        v,
+        StageView::Grey | StageView::Corrected | StageView::Overlay
+    );
+    let bottom = if shows_grey {
+        let s = match &layer {
+            Some(Layer::Grey(g) | Layer::LinesOver(g, _)) => stretch_of(g),
+            _ => stretch_of(img),
+        };
+        let not_corrected =
+            v == StageView::Corrected && out.is_some_and(|o| corrected(o).is_none());
+        format!(
+            "{}{} · grey {}–{} stretched",
+            grey.name,
+            if not_corrected {
+                " (not corrected)"
+            } else {
+                ""
+            },
+            s.lo,
+            s.hi
+        )
+    } else {
+        String::new()
     };
-    let b = block(app, &format!("{}{count}{stale}", v.title()));
+    let stale = match (v, app.tracker.stale()) {
+        (StageView::Grey, _) | (_, None) => String::new(),
+        (_, Some(why)) => format!("{why} · "),
+    };
+    let letter = match (shows_grey, grey.letter) {
+        (true, Some(l)) => l.to_string(),
+        _ => String::new(),
+    };
+    let top = if small {
+        // Side by side: what the view is, and whether it is stale.
+        let stale = if stale.is_empty() { "" } else { "STALE " };
+        format!("{stale}{}{count}", v.title())
+    } else {
+        format!("{stale}image {}{letter} · {}{count}", cur.k, v.title())
+    };
+    let b = if bottom.is_empty() || small {
+        block(app, &top)
+    } else {
+        block2(app, &top, &bottom)
+    };
     let inner = b.inner(area);
     b.render(area, buf);
     match layer {
         Some(layer) => {
-            let mut p = Preview::new(layer, app.look.mode, app.look.colour);
+            let mut p = Preview::new(layer, app.chrome.look.mode, app.chrome.look.colour);
+            p.palette.c256 = app.chrome.look.c256;
             // Edge and line layers keep the grey image's frame, so the
             // cursor and zoom line up across views.
-            p.view = app.pipeline.nav.view;
-            let size = grey.size();
+            let nav = &app.screens.pipeline.nav;
+            p.view = nav.view;
+            let size = cur.frames[0].1.size();
             p.frame = Some(size);
-            p.cursor = Some(app.pipeline.nav.cursor_or_centre(size));
+            p.cursor = Some(nav.cursor_or_centre(size));
             p.render(inner, buf);
         }
-        None => Paragraph::new("running…").render(inner, buf),
+        None => Paragraph::new(if cur.failed.is_some() {
+            "the last run failed: see the message below (!)"
+        } else {
+            "running…"
+        })
+        .render(inner, buf),
     }
 }
 
 fn params_panel(app: &App, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
     let inner_h = area.height.saturating_sub(2) as usize;
-    let stats_rows = 7usize.min(inner_h / 2);
+    let inner_w = area.width.saturating_sub(2) as usize;
+    let sel = app.screens.pipeline.param;
+    let doc_rows = super::chrome::wrap(app.screens.pipeline.param_spec().doc, inner_w).len();
+    let stats_rows = (5 + doc_rows).min(inner_h / 2);
     let room = inner_h.saturating_sub(stats_rows).max(1);
-    let sel = app.pipeline.param;
-    let skip = (sel + 1).saturating_sub(room);
-    let mut lines: Vec<Line> = PARAMS
+    let params = &app.tracker.params;
+    let rows: Vec<Line> = PARAMS
         .iter()
         .enumerate()
-        .skip(skip)
-        .take(room)
         .map(|(i, sp)| {
-            let v = app.params.get(sp.key).map(fmt_value).unwrap_or_default();
-            let w = (area.width as usize)
-                .saturating_sub(3 + sp.key.len())
-                .max(v.len());
-            let text = format!("{} {v:>w$}", sp.key);
+            let v = params.get(sp.key).map(fmt_value).unwrap_or_default();
+            let changed = params.get(sp.key) != app.tracker.profile_params.get(sp.key);
+            let mark = if changed { '*' } else { ' ' };
+            let w = inner_w.saturating_sub(2 + sp.key.len()).max(v.len());
+            let text = format!("{} {v:>w$}{mark}", sp.key);
             if i == sel {
                 Line::styled(text, t.selected())
+            } else if changed {
+                Line::styled(text, t.warn())
             } else {
                 Line::raw(text)
             }
         })
         .collect();
-    let cur = app.current.as_ref();
+    let mut lines = window(rows, sel, room, t);
+    let cur = app.tracker.current.as_ref();
     match cur.and_then(|c| c.outputs.as_ref()) {
         Some(o) => {
             let ms = |us: u64| us as f64 / 1000.0;
@@ -213,52 +290,64 @@ fn params_panel(app: &App, area: Rect, buf: &mut Buffer) {
                 format!("lines {} raw {}", o.lines.len(), o.lines_raw.len()),
                 t.title(),
             ));
-            lines.push(Line::raw(format!(
-                "ms lens {:.1} edges {:.1}",
-                ms(o.timings.lens_us),
-                ms(o.timings.edges_us)
-            )));
-            lines.push(Line::raw(format!(
-                "   lines {:.1} connect {:.1}",
-                ms(o.timings.lines_us),
-                ms(o.timings.connect_us)
-            )));
+            if cur.is_some_and(|c| c.from_disk) {
+                lines.push(Line::styled("(saved outputs, not run)", t.dim()));
+            } else {
+                lines.push(Line::raw(format!(
+                    "ms lens {:.1} edges {:.1}",
+                    ms(o.timings.lens_us),
+                    ms(o.timings.edges_us)
+                )));
+                lines.push(Line::raw(format!(
+                    "   lines {:.1} connect {:.1}",
+                    ms(o.timings.lines_us),
+                    ms(o.timings.connect_us)
+                )));
+            }
         }
         None => lines.push(Line::styled("no outputs yet", t.dim())),
     }
-    let sp = app.pipeline.param_spec();
-    lines.push(Line::from(vec![
-        Span::styled(format!("{} ", sp.range_text()), t.dim()),
-        Span::styled(sp.unit, t.dim()),
-    ]));
+    let sp = app.screens.pipeline.param_spec();
+    let default = app
+        .tracker
+        .profile_params
+        .get(sp.key)
+        .map(fmt_value)
+        .unwrap_or_default();
+    lines.push(Line::from(vec![Span::styled(
+        format!("{} {} · profile {default}", sp.range_text(), sp.unit),
+        t.dim(),
+    )]));
     lines.push(Line::styled(sp.doc, t.dim()));
-    let title = if app.pipeline_busy() {
+    let title = if app.tracker.busy() {
         "parameters (running)"
     } else {
-        "parameters"
+        "parameters (* changed)"
     };
     Paragraph::new(lines)
-        .wrap(ratatui::widgets::Wrap { trim: true })
+        .wrap(Wrap { trim: true })
         .block(block(app, title))
         .render(area, buf);
 }
 
 fn cursor_line(app: &App, cur: &Loaded, area: Rect, buf: &mut Buffer) {
     let grey = &cur.frames[0].1;
-    let (x, y) = app.pipeline.nav.cursor_or_centre(grey.size());
+    let size = grey.size();
+    let nav = &app.screens.pipeline.nav;
+    let (x, y) = nav.cursor_or_centre(size);
     let g = grey.get(x, y).map_or("-".into(), |v| v.to_string());
     let resp = |r: Option<&crate::llv::edges::Response>| -> String {
         r.and_then(|r| r.get(x, y))
             .filter(|v| v.is_finite())
-            .map_or("-".into(), |v| format!("{v:+.1}"))
+            .map_or("-".into(), signed)
     };
     let out = cur.outputs.as_deref();
     let text = format!(
-        "x{x} y{y} grey {g} H{} V{} zoom {} [{}]",
+        "x{x} y{y} grey {g} H {} V {} · ×{} {}",
         resp(out.map(|o| &o.response_h)),
         resp(out.map(|o| &o.response_v)),
-        app.pipeline.nav.view.zoom,
-        app.look_name()
+        nav.view.zoom,
+        nav.position(size),
     );
     Paragraph::new(text).render(area, buf);
 }

@@ -1,196 +1,335 @@
-//! The Survey screen: the session list (no session yet), then the
-//! checklist of image numbers and lightings, the step the survey is at, and
-//! a preview of the current image.
+//! The Survey screen: the session list (no session yet, or `o`), damaged
+//! sessions among them; then the checklist of image numbers and lightings
+//! (any row can be chosen and gone to), the step the survey is at, and a
+//! preview of the image under work.
 
 use ratatui::buffer::Buffer;
-use ratatui::crossterm::event::KeyEvent;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Paragraph, Widget, Wrap};
 
-use super::{block, gauge_text, split_panel};
+use super::{block, block2, gauge_text, split_panel, window};
 use crate::tui::app::{App, Phase};
 use crate::tui::event::FramePurpose;
-use crate::tui::keymap::{self, Action, Scope, ScreenId};
-use crate::tui::widgets::preview::{Layer, Preview};
+use crate::tui::widgets::preview::{Layer, Preview, stretch_of};
 
-/// What the Survey screen remembers itself: the highlighted session.
-#[derive(Clone, Debug, Default)]
-pub struct SurveyScreen {
-    pub selected: usize,
-}
-
-impl SurveyScreen {
-    pub fn handle_key(&mut self, key: KeyEvent) -> Option<Action> {
-        keymap::lookup(Scope::Screen(ScreenId::Survey), &key)
-    }
-}
+/// Where the checklist's first image row is, inside the panel (rows).
+pub const CHECKLIST_HEAD: u16 = 3;
 
 pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     let (panel, right) = split_panel(area, 34);
-    if app.session.is_none() {
+    if app.session.view.is_none() || app.screens.survey.picking {
         sessions(app, panel, buf);
     } else {
         checklist(app, panel, buf);
     }
-    let [step, prev] = Layout::vertical([Constraint::Length(4), Constraint::Min(1)]).areas(right);
+    let [step, prev] = Layout::vertical([Constraint::Length(5), Constraint::Min(1)]).areas(right);
     step_box(app, step, buf);
-    let b = block(app, "image");
-    let inner = b.inner(prev);
-    b.render(prev, buf);
-    let cur = app
-        .current
-        .as_ref()
-        .filter(|c| c.k == app.work.k || app.work.phase == Phase::Setup);
-    if let Some(c) = cur
-        && let Some((_, img)) = c.frames.last()
-    {
-        let layer = match (&c.outputs, app.work.phase) {
-            (Some(o), Phase::Review) => Layer::LinesOver(img, &o.lines),
-            _ => Layer::Grey(img),
-        };
-        Preview::new(layer, app.look.mode, app.look.colour).render(inner, buf);
-    } else {
-        Paragraph::new("no image yet").render(inner, buf);
+    preview(app, prev, buf);
+}
+
+fn preview(app: &App, area: Rect, buf: &mut Buffer) {
+    let cur = app.tracker.current.as_ref();
+    let Some((c, (letter, img))) = cur.and_then(|c| first_frame(app, c).map(|f| (c, f))) else {
+        Paragraph::new("no image yet")
+            .block(block(app, "image"))
+            .render(area, buf);
+        return;
+    };
+    let s = stretch_of(img);
+    let review = c.k == app.session.work.k && app.session.work.phase == Phase::Review;
+    let lines = c.lines().filter(|_| review);
+    let what = if lines.is_some() { " + lines" } else { "" };
+    let title = format!("image {}{letter}{what}", c.k);
+    let b = block2(app, &title, &format!("grey {}–{} stretched", s.lo, s.hi));
+    let inner = b.inner(area);
+    b.render(area, buf);
+    let layer = match lines {
+        Some(ls) => Layer::LinesOver(img, ls),
+        None => Layer::Grey(img),
+    };
+    let mut p = Preview::new(layer, app.chrome.look.mode, app.chrome.look.colour);
+    p.palette.c256 = app.chrome.look.c256;
+    let nav = &app.screens.survey.nav;
+    p.view = nav.view;
+    if nav.cursor.is_some() {
+        p.cursor = Some(nav.cursor_or_centre(img.size()));
     }
+    p.render(inner, buf);
+}
+
+/// The first lighting captured, in profile order (the last one may be the
+/// dark ambient frame).
+fn first_frame<'a>(
+    app: &App,
+    c: &'a crate::tui::app::Loaded,
+) -> Option<(char, &'a crate::llv::GreyImage)> {
+    app.cell
+        .letters
+        .iter()
+        .find_map(|l| c.frame(*l).map(|g| (*l, g)))
 }
 
 fn sessions(app: &App, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
-    let mut lines = vec![Line::raw("Sessions in the survey folder:")];
-    if app.sessions.is_empty() {
-        lines.push(Line::styled("  (none yet)", t.dim()));
-    }
-    for (i, (name, _, summary)) in app.sessions.iter().enumerate() {
-        let st = if i == app.survey.selected {
+    let inner_h = area.height.saturating_sub(2) as usize;
+    let mut rows: Vec<Line> = Vec::new();
+    for (i, e) in app.session.list.iter().enumerate() {
+        let st = if i == app.screens.survey.selected {
             t.selected()
+        } else if e.damaged.is_some() {
+            t.error()
         } else {
             Default::default()
         };
-        lines.push(Line::styled(format!(" {name:<12} {summary}"), st));
+        let text = match &e.damaged {
+            Some(why) => format!(" {:<10} DAMAGED: {why}", e.name),
+            None => format!(" {:<10} {}", e.name, e.summary),
+        };
+        let w = area.width.saturating_sub(2) as usize;
+        let text: String = if text.chars().count() > w {
+            text.chars().take(w.saturating_sub(1)).collect::<String>() + "…"
+        } else {
+            text
+        };
+        rows.push(Line::styled(text, st));
     }
+    let mut lines = vec![Line::raw("Sessions in the survey folder:")];
+    if rows.is_empty() {
+        lines.push(Line::styled("  (none yet)", t.dim()));
+    }
+    let room = inner_h.saturating_sub(4);
+    lines.extend(window(rows, app.screens.survey.selected, room, t));
     lines.push(Line::raw(""));
     lines.push(Line::from(vec![
+        Span::styled("↑↓ Enter", t.key()),
+        Span::raw(" open · "),
         Span::styled("n", t.key()),
-        Span::raw(" new session"),
+        Span::raw(" new"),
     ]));
-    lines.push(Line::from(vec![
-        Span::styled("o", t.key()),
-        Span::raw(" open the chosen one (↑↓)"),
-    ]));
+    if app.screens.survey.picking {
+        lines.push(Line::from(vec![
+            Span::styled("Esc", t.key()),
+            Span::raw(" back to the checklist"),
+        ]));
+    }
+    let title = if app.screens.survey.picking {
+        "open another session"
+    } else {
+        "choose a session"
+    };
     Paragraph::new(lines)
-        .block(block(app, "choose a session"))
+        .block(block(app, title))
         .render(area, buf);
+}
+
+/// One checklist row: `> 1  1   1 abcde done e2`.
+fn row_text(app: &App, k: u32) -> (String, bool) {
+    let Some(v) = &app.session.view else {
+        return (String::new(), false);
+    };
+    let st = v.images.iter().find(|i| i.k == k);
+    let cur = app.tracker.current.as_ref().filter(|c| c.k == k);
+    let captured: Vec<char> = match (cur, st) {
+        (Some(c), _) => c.frames.iter().map(|f| f.0).collect(),
+        (_, Some(i)) => i.captured.clone(),
+        _ => Vec::new(),
+    };
+    let damaged: Vec<char> = st
+        .map(|i| i.damaged.iter().map(|d| d.0).collect())
+        .unwrap_or_default();
+    let marks: String = v
+        .letters
+        .iter()
+        .map(|l| {
+            if damaged.contains(l) && cur.is_none_or(|c| c.frame(*l).is_none()) {
+                '!'
+            } else if captured.contains(l) {
+                *l
+            } else {
+                '.'
+            }
+        })
+        .collect();
+    let w = &app.session.work;
+    let (cam, loc) = match st {
+        Some(i) if k != w.k || w.phase != Phase::Setup => (i.camera, i.location),
+        _ => (w.camera, w.location),
+    };
+    let bad = st.is_some_and(|i| i.outputs_damaged.is_some()) || marks.contains('!');
+    let out = match st {
+        Some(i) if i.outputs_damaged.is_some() => "DAMAGED".to_string(),
+        Some(i) if i.stale => "stale".into(),
+        Some(i) if i.outputs && i.edits > 0 => format!("done e{}", i.edits),
+        Some(i) if i.outputs => "done".into(),
+        _ => "-".into(),
+    };
+    let here = if k == w.k && w.phase != Phase::Complete {
+        '>'
+    } else {
+        ' '
+    };
+    (
+        format!("{here}{k:>3} {cam:>3} {loc:>3} {marks:<6} {out}"),
+        bad,
+    )
 }
 
 fn checklist(app: &App, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
-    let Some(s) = &app.session else { return };
-    let letters: String = s.letters.iter().collect();
+    let Some(v) = &app.session.view else { return };
+    let done = v
+        .images
+        .iter()
+        .filter(|i| i.outputs && !i.stale && i.damaged.is_empty() && i.outputs_damaged.is_none())
+        .count();
+    let problems = v.problems();
     let mut lines = vec![
-        Line::styled(format!("session {}", s.name), t.title()),
-        Line::raw(format!("lightings {letters}")),
-        Line::raw("img cam loc lights  out"),
-    ];
-    let mut ks: Vec<u32> = s.images.iter().map(|i| i.k).collect();
-    if !ks.contains(&app.work.k) {
-        ks.push(app.work.k);
-    }
-    ks.sort_unstable();
-    let room = area.height.saturating_sub(2 + 3) as usize;
-    // Keep the current image visible on a small terminal.
-    let pos = ks.iter().position(|&k| k == app.work.k).unwrap_or(0);
-    let skip = (pos + 1).saturating_sub(room);
-    for &k in ks.iter().skip(skip).take(room) {
-        let st = s.images.iter().find(|i| i.k == k);
-        let captured: Vec<char> = match (&app.current, st) {
-            (Some(c), _) if c.k == k => c.frames.iter().map(|f| f.0).collect(),
-            (_, Some(i)) => i.captured.clone(),
-            _ => Vec::new(),
-        };
-        let marks: String = s
-            .letters
-            .iter()
-            .map(|l| if captured.contains(l) { *l } else { '.' })
-            .collect();
-        let (cam, loc) = st.map_or((app.work.camera, app.work.location), |i| {
-            (i.camera, i.location)
-        });
-        let out = match st {
-            Some(i) if i.stale => "stale",
-            Some(i) if i.outputs => "done",
-            _ => "-",
-        };
-        let line = format!("{k:>3} {cam:>3} {loc:>3} {marks:<7} {out}");
-        let style = if k == app.work.k {
-            t.selected()
-        } else if out == "done" {
-            t.ok()
+        Line::styled(
+            format!("lightings {}", v.letters.iter().collect::<String>()),
+            t.dim(),
+        ),
+        if problems > 0 {
+            Line::styled(format!("{problems} damaged or missing file(s)"), t.error())
         } else {
-            Default::default()
-        };
-        lines.push(Line::styled(line, style));
-    }
+            Line::styled(format!("{done} of {} done", v.images.len()), t.ok())
+        },
+        Line::raw(" img cam loc lights out"),
+    ];
+    let ks = app.session.numbers();
+    let sel = app.screens.survey.row(&app.session.work);
+    let rows: Vec<Line> = ks
+        .iter()
+        .map(|&k| {
+            let (text, bad) = row_text(app, k);
+            let style = if k == sel {
+                t.selected()
+            } else if bad {
+                t.error()
+            } else if text.contains("done") {
+                t.ok()
+            } else {
+                Default::default()
+            };
+            Line::styled(text, style)
+        })
+        .collect();
+    let room = area.height.saturating_sub(2 + CHECKLIST_HEAD) as usize;
+    let focus = ks.iter().position(|&k| k == sel).unwrap_or(0);
+    lines.extend(window(rows, focus, room, t));
     Paragraph::new(lines)
-        .block(block(app, "checklist"))
+        .block(block(app, &format!("session {}", v.name)))
         .render(area, buf);
 }
 
 fn step_box(app: &App, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
-    let w = &app.work;
-    let text: Vec<Line> = match w.phase {
-        Phase::NoSession => vec![Line::raw("Create a session (n) or open one (o).")],
-        Phase::Setup => {
-            let missing: String = app.missing_letters().iter().collect();
-            vec![
-                Line::raw(format!(
-                    "Image {}: camera {} (c), location {} (p)",
-                    w.k, w.camera, w.location
-                )),
+    let w = &app.session.work;
+    let key = |k: &'static str| Span::styled(k, t.key());
+    let sel = app.screens.survey.row(w);
+    let text: Vec<Line> = if app.session.view.is_some() && sel != w.k && !app.screens.survey.picking
+    {
+        vec![
+            Line::raw(format!("Image {sel} chosen in the checklist.")),
+            Line::from(vec![
+                key("Enter"),
+                Span::raw(format!(" goes to image {sel}, ")),
+                key("R"),
+                Span::raw(" captures it again"),
+            ]),
+            Line::from(vec![
+                key("Esc"),
+                Span::raw(format!(" back to image {}", w.k)),
+            ]),
+        ]
+    } else {
+        match w.phase {
+            Phase::NoSession => vec![Line::from(vec![
+                Span::raw("Create a session ("),
+                key("n"),
+                Span::raw(") or open one ("),
+                key("↑↓ Enter"),
+                Span::raw(")."),
+            ])],
+            Phase::Setup => {
+                let missing: String = app.missing_letters().iter().collect();
+                let again = app
+                    .tracker
+                    .current
+                    .as_ref()
+                    .is_some_and(|c| c.k == w.k && !c.damaged.is_empty());
+                vec![
+                    Line::raw(format!(
+                        "Image {}: camera {} (c), location {} (p)",
+                        w.k, w.camera, w.location
+                    )),
+                    Line::from(vec![
+                        key("Enter"),
+                        Span::raw(if missing.is_empty() {
+                            " runs the stages".to_string()
+                        } else if again {
+                            format!(" captures lighting {missing} again")
+                        } else {
+                            format!(" captures lightings {missing}")
+                        }),
+                    ]),
+                ]
+            }
+            Phase::Capturing => {
+                let now = match app.cell.device.transfer {
+                    Some((FramePurpose::Survey { letter, .. }, 0, _))
+                        if app.cell.device.settling =>
+                    {
+                        format!("lighting {letter}: lights settling…")
+                    }
+                    Some((FramePurpose::Survey { letter, .. }, d, n)) => {
+                        format!("lighting {letter} {}", gauge_text(d, n, 26))
+                    }
+                    _ => "switching lights…".into(),
+                };
+                let total = app.cell.letters.len();
+                let have = total - app.missing_letters().len();
+                vec![
+                    Line::raw(format!("Image {}: capturing {}/{total}", w.k, have + 1)),
+                    Line::raw(now),
+                    Line::from(vec![key("Esc"), Span::raw(" stops")]),
+                ]
+            }
+            Phase::Processing => vec![Line::raw(format!("Image {}: running the stages…", w.k))],
+            Phase::Review => {
+                let cur = app.tracker.current.as_ref();
+                let (n, raw) = cur
+                    .and_then(|c| c.outputs.as_ref())
+                    .map_or((0, 0), |o| (o.lines.len(), o.lines_raw.len()));
+                let n = cur.and_then(|c| c.lines()).map_or(n, <[_]>::len);
+                vec![
+                    Line::raw(format!("Image {}: {n} lines ({raw} before CONNECT)", w.k)),
+                    Line::from(vec![
+                        key("a"),
+                        Span::raw(" accepts ("),
+                        key("Enter"),
+                        Span::raw(" asks) · "),
+                        key("R"),
+                        Span::raw(" again"),
+                    ]),
+                    Line::from(vec![
+                        key("3"),
+                        Span::raw(" tune · "),
+                        key("4"),
+                        Span::raw(" edit"),
+                    ]),
+                ]
+            }
+            Phase::Complete => vec![
+                Line::styled("Survey complete.", t.ok()),
+                Line::from(vec![key("5"), Span::raw(" writes the report (e)")]),
                 Line::from(vec![
-                    Span::styled("Enter", t.key()),
-                    Span::raw(if missing.is_empty() {
-                        " runs the stages".to_string()
-                    } else {
-                        format!(" captures lightings {missing}")
-                    }),
+                    key("↑↓ Enter"),
+                    Span::raw(" goes back to an image; "),
+                    key("Enter"),
+                    Span::raw(format!(" alone: image {} beyond the plan", w.k)),
                 ]),
-            ]
-        }
-        Phase::Capturing => {
-            let now = match app.device.transfer {
-                Some((FramePurpose::Survey { letter, .. }, d, n)) => {
-                    format!("lighting {letter} {}", gauge_text(d, n, 30))
-                }
-                _ => "switching lights…".into(),
-            };
-            vec![
-                Line::raw(format!("Image {}: capturing", w.k)),
-                Line::raw(now),
-                Line::styled("Esc cancels", t.dim()),
-            ]
-        }
-        Phase::Processing => vec![Line::raw(format!("Image {}: running the stages…", w.k))],
-        Phase::Review => {
-            let (n, raw) = app
-                .current
-                .as_ref()
-                .and_then(|c| c.outputs.as_ref())
-                .map_or((0, 0), |o| (o.lines.len(), o.lines_raw.len()));
-            vec![
-                Line::raw(format!("Image {}: {n} lines ({raw} before CONNECT)", w.k)),
-                Line::from(vec![
-                    Span::styled("a", t.key()),
-                    Span::raw(" accept   "),
-                    Span::styled("r", t.key()),
-                    Span::raw(" redo   "),
-                    Span::styled("3", t.key()),
-                    Span::raw(" tune   "),
-                    Span::styled("4", t.key()),
-                    Span::raw(" edit"),
-                ]),
-            ]
+            ],
         }
     };
     Paragraph::new(text)

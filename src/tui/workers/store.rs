@@ -1,10 +1,11 @@
 //! The store worker: owns the open [`Session`] (and its lock) and does all
-//! the disk work the console asks for — list, create, open (resume), save
-//! images and outputs, record edits, read images back, export the reports —
+//! the disk work the console asks for — list (damaged sessions too),
+//! create, open (resume, or take over a lock), save images and outputs,
+//! record edits, read an image back, export the reports, append the log —
 //! reporting each result or error as a message. On quit the UI waits for it
 //! to finish what is queued, so nothing the operator saw saved is lost.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -14,10 +15,54 @@ use crate::formats;
 use crate::formats::img::ImgFile;
 use crate::llv::lens::CameraModel;
 use crate::profile::Profile;
-use crate::report::{self, ImageReport};
-use crate::session::manifest::TimingsRecord;
-use crate::session::{OutputSet, OutputState, Session, SessionError, Step};
-use crate::tui::event::{FileState, ImageState, Msg, SessionView, StoreCmd, StoreEvent};
+use crate::report;
+use crate::session::{CheckReport, Session, SessionError};
+use crate::tui::event::{Msg, SessionEntry, StoreCmd, StoreEvent};
+
+mod load;
+mod logfile;
+mod view;
+
+pub use view::view;
+
+/// What the store worker can fail at; each says what and what to do.
+#[derive(Debug, thiserror::Error)]
+pub enum StoreError {
+    #[error("no session open: create or open one on the Survey screen (1)")]
+    NoSession,
+    #[error("{what}: {source}")]
+    Session {
+        what: String,
+        #[source]
+        source: SessionError,
+    },
+    #[error("report NOT written: {why}{old}")]
+    Report { why: String, old: String },
+    #[error("log file {}: {source} — messages are still in the log pane (m)", path.display())]
+    Log {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error(
+        "session {} is still held by {holder} after asking it to end; nothing changed",
+        dir.display()
+    )]
+    TakeOver { dir: PathBuf, holder: String },
+    #[error("the profile names no .cdf for camera {camera}: add it to [survey] cdf")]
+    NoCdf { camera: u32 },
+    #[error("{} NOT written: {source}", path.display())]
+    Cdf {
+        path: PathBuf,
+        #[source]
+        source: formats::FormatError,
+    },
+}
+
+fn session_err(what: impl Into<String>) -> impl FnOnce(SessionError) -> StoreError {
+    let what = what.into();
+    move |source| StoreError::Session { what, source }
+}
 
 /// The UI's handle on the store worker.
 pub struct StoreHandle {
@@ -56,6 +101,10 @@ pub struct Store {
     profile: Profile,
     ui: Sender<Msg>,
     session: Option<Session>,
+    /// The last full check of the open session's files, kept up to date
+    /// as files are rewritten.
+    check: Option<CheckReport>,
+    log: logfile::LogFile,
 }
 
 impl Store {
@@ -64,14 +113,24 @@ impl Store {
             profile,
             ui,
             session: None,
+            check: None,
+            log: logfile::LogFile::default(),
         }
     }
 
     fn run(mut self, rx: Receiver<StoreCmd>) {
-        self.reply(StoreEvent::Cameras(self.camera_models()));
+        self.cameras();
+        if let Some(p) = logfile::state_path() {
+            self.use_log(p);
+        }
         while let Ok(cmd) = rx.recv() {
             self.handle(cmd);
         }
+    }
+
+    /// Reports the camera models of the profile's `.cdf` files.
+    pub fn cameras(&self) {
+        self.reply(StoreEvent::Cameras(self.camera_models()));
     }
 
     fn reply(&self, e: StoreEvent) {
@@ -85,41 +144,49 @@ impl Store {
         }
     }
 
-    fn try_handle(&mut self, cmd: StoreCmd) -> Result<(), String> {
+    fn try_handle(&mut self, cmd: StoreCmd) -> Result<(), StoreError> {
         match cmd {
             StoreCmd::List => {
                 let list = self.list();
                 self.reply(StoreEvent::Sessions(list));
             }
+            StoreCmd::Log(lines) => {
+                let path = self.log.path().map(Path::to_path_buf);
+                if let Err(source) = self.log.append(&lines)
+                    && let Some(path) = path
+                {
+                    return Err(StoreError::Log { path, source });
+                }
+            }
             StoreCmd::Create(name) => {
-                self.session = None;
-                let s = Session::create(&self.survey_dir(), &name, &self.profile)
-                    .map_err(|e| format!("cannot create session {name}: {e}"))?;
+                self.close();
+                let s = Session::create(&self.profile.survey.dir, &name, &self.profile)
+                    .map_err(session_err(format!("cannot create session {name}")))?;
                 self.opened(s);
             }
             StoreCmd::Open(dir) => {
-                self.session = None;
+                self.close();
                 let s = match Session::open(&dir) {
                     Ok(s) => s,
-                    Err(e @ SessionError::Locked { .. }) => {
-                        let stale = Session::inspect(&dir)
-                            .ok()
-                            .and_then(|s| s.lock_holder())
-                            .is_some_and(|h| h.is_stale());
-                        if !stale {
-                            return Err(e.to_string());
-                        }
-                        send(
-                            &self.ui,
-                            Msg::Store(StoreEvent::Saved(format!(
-                                "(took over the stale lock of {})",
-                                dir.display()
-                            ))),
-                        );
-                        Session::open_take_over(&dir).map_err(|e| e.to_string())?
+                    Err(SessionError::Locked { stale: true, .. }) => {
+                        self.reply(StoreEvent::Note(format!(
+                            "took over the lock of {}: its holder is gone",
+                            dir.display()
+                        )));
+                        Session::open_take_over(&dir)
+                            .map_err(session_err(format!("cannot open {}", dir.display())))?
                     }
-                    Err(e) => return Err(e.to_string()),
+                    Err(SessionError::Locked { holder, .. }) => {
+                        self.reply(StoreEvent::Locked { dir, holder });
+                        return Ok(());
+                    }
+                    Err(e) => return Err(session_err(format!("cannot open {}", dir.display()))(e)),
                 };
+                self.opened(s);
+            }
+            StoreCmd::TakeOver(dir) => {
+                self.close();
+                let s = self.take_over(&dir)?;
                 self.opened(s);
             }
             StoreCmd::SaveImage {
@@ -135,128 +202,226 @@ impl Store {
                     .manifest()
                     .image(k)
                     .map(|r| (r.camera, r.location, r.cdf.is_some()));
+                let what = format!("image {k} lighting {letter} NOT saved");
                 if known.is_none_or(|(c, l, has_cdf)| {
                     c != camera || l != location || (!has_cdf && cdf.is_some())
                 }) {
                     s.set_image_info(k, camera, location, cdf.as_deref())
-                        .map_err(|e| e.to_string())?;
+                        .map_err(session_err(what.clone()))?;
                 }
                 let file = s.file_name(k, Some(letter), "img");
                 let stem = file.trim_end_matches(".img").to_string();
                 s.save_image(k, letter, &ImgFile::new(image).with_comment(stem))
-                    .map_err(|e| e.to_string())?;
+                    .map_err(session_err(what))?;
+                self.forget_problems(std::slice::from_ref(&file));
                 self.reply(StoreEvent::Saved(file));
-                self.updated(false);
+                self.updated();
             }
             StoreCmd::SaveOutputs { k, outputs, params } => {
                 let s = self.session_mut()?;
-                let t = &outputs.timings;
-                let set = OutputSet {
-                    corrected: &outputs.corrected,
-                    edges_h: Some(&outputs.edges_h),
-                    edges_v: Some(&outputs.edges_v),
-                    lines_raw: Some(&outputs.lines_raw),
-                    lines: Some(&outputs.lines),
-                    timings: TimingsRecord {
-                        lens_us: t.lens_us,
-                        edges_us: t.edges_us,
-                        lines_us: t.lines_us,
-                        connect_us: t.connect_us,
-                    },
-                };
-                s.save_output_set(k, &set, &params)
-                    .map_err(|e| e.to_string())?;
+                s.save_outputs(k, &outputs, &params)
+                    .map_err(session_err(format!("outputs of image {k} NOT saved")))?;
+                let files: Vec<String> = ["hpo", "vpo", "lex", "ldr"]
+                    .iter()
+                    .map(|e| s.file_name(k, None, e))
+                    .collect();
+                self.forget_problems(&files);
                 let what = format!("outputs of image {k} (.hpo .vpo .lex .ldr)");
                 self.reply(StoreEvent::Saved(what));
-                self.updated(false);
+                self.updated();
             }
             StoreCmd::RecordEdit { k, what, lines } => {
                 let s = self.session_mut()?;
-                s.record_edit(k, &what, &lines).map_err(|e| e.to_string())?;
+                s.record_edit(k, &what, &lines)
+                    .map_err(session_err(format!("edit of image {k} NOT saved")))?;
                 let file = s.file_name(k, None, "ldr");
-                self.reply(StoreEvent::Saved(format!("{file} after {what}")));
-                self.updated(false);
+                self.forget_problems(std::slice::from_ref(&file));
+                self.reply(StoreEvent::Saved(file));
+                self.updated();
+            }
+            StoreCmd::UndoEdit { k, lines } => {
+                let s = self.session_mut()?;
+                s.undo_edit(k, &lines)
+                    .map_err(session_err(format!("undo of image {k} NOT saved")))?;
+                let file = s.file_name(k, None, "ldr");
+                self.reply(StoreEvent::Saved(format!("{file} (edit taken back)")));
+                self.updated();
             }
             StoreCmd::Load(k) => {
-                let s = self.session_mut()?;
-                let imgs = s.load_images(k).map_err(|e| e.to_string())?;
-                let images = imgs.into_iter().map(|(l, f)| (l, f.image)).collect();
-                let edited = s.manifest().image(k).is_some_and(|r| !r.edit.is_empty());
-                let lines = if edited { s.load_lines(k).ok() } else { None };
-                self.reply(StoreEvent::Images { k, images });
-                if let Some(lines) = lines {
-                    self.reply(StoreEvent::Lines { k, lines });
-                }
+                let s = self.session.as_ref().ok_or(StoreError::NoSession)?;
+                let img = load::image(s, k);
+                self.reply(StoreEvent::Loaded(Box::new(img)));
             }
             StoreCmd::Redo(k) => {
                 self.session_mut()?;
-                self.reply(StoreEvent::Saved(format!(
-                    "nothing yet: image {k}'s files are replaced as its new captures come in"
+                self.reply(StoreEvent::Note(format!(
+                    "image {k}: its files are replaced as the new captures come in"
                 )));
             }
             StoreCmd::Export => {
                 let paths = self.export()?;
                 self.reply(StoreEvent::Reports(paths));
-                self.updated(false);
+                self.updated();
             }
-            StoreCmd::Refresh => self.updated(true),
+            StoreCmd::Refresh => {
+                if let Some(s) = &self.session {
+                    self.check = Some(s.check());
+                }
+                self.updated();
+            }
+            StoreCmd::WriteCdf {
+                camera,
+                calibration,
+            } => {
+                let path = self
+                    .profile
+                    .cdf_path(camera)
+                    .ok_or(StoreError::NoCdf { camera })?;
+                crate::calib::write_intrinsics(&path, &calibration).map_err(|source| {
+                    StoreError::Cdf {
+                        path: path.clone(),
+                        source,
+                    }
+                })?;
+                self.reply(StoreEvent::Note(format!(
+                    "camera {camera}: wrote {} (RMS {:.3} px over {} views)",
+                    path.display(),
+                    calibration.rms,
+                    calibration.views.len()
+                )));
+                self.cameras();
+            }
         }
         Ok(())
     }
 
-    fn session_mut(&mut self) -> Result<&mut Session, String> {
-        self.session
-            .as_mut()
-            .ok_or_else(|| "no session open: create or open one on the Survey screen".to_string())
+    fn session_mut(&mut self) -> Result<&mut Session, StoreError> {
+        self.session.as_mut().ok_or(StoreError::NoSession)
+    }
+
+    /// Closes the open session (its lock released); the log goes back to
+    /// the state folder.
+    fn close(&mut self) {
+        if self.session.take().is_some()
+            && let Some(p) = logfile::state_path()
+        {
+            self.use_log(p);
+        }
+        self.check = None;
     }
 
     fn opened(&mut self, s: Session) {
-        let v = view(&s, false);
+        let check = s.check();
+        let v = view(&s, Some(&check), true);
+        let log = s.path(&format!("{}.log", s.name()));
         self.session = Some(s);
+        self.check = Some(check);
+        self.use_log(log);
         self.reply(StoreEvent::Opened(v));
         let list = self.list();
         self.reply(StoreEvent::Sessions(list));
     }
 
-    fn updated(&self, check: bool) {
-        if let Some(s) = &self.session {
-            self.reply(StoreEvent::Updated(view(s, check)));
+    fn use_log(&mut self, path: PathBuf) {
+        match self.log.open(&path) {
+            Ok(()) => self.reply(StoreEvent::LogFile(path)),
+            Err(source) => self.reply(StoreEvent::Error(StoreError::Log { path, source })),
         }
     }
 
-    /// Sessions under the survey folder: name, folder, checklist summary.
-    fn list(&self) -> Vec<(String, PathBuf, String)> {
-        let Ok(rd) = std::fs::read_dir(self.survey_dir()) else {
+    fn updated(&self) {
+        if let Some(s) = &self.session {
+            self.reply(StoreEvent::Updated(view(s, self.check.as_ref(), false)));
+        }
+    }
+
+    /// Drops what the last check found about files just written anew.
+    fn forget_problems(&mut self, files: &[String]) {
+        if let Some(c) = self.check.as_mut() {
+            c.problems
+                .retain(|p| !files.iter().any(|f| view::names_file(p, f)));
+        }
+    }
+
+    /// Sessions under the survey folder: name, folder, checklist summary;
+    /// a folder whose manifest does not read is listed with why.
+    fn list(&self) -> Vec<SessionEntry> {
+        let Ok(rd) = std::fs::read_dir(&self.profile.survey.dir) else {
             return Vec::new();
         };
-        let mut out: Vec<_> = rd
+        let mut out: Vec<SessionEntry> = rd
             .flatten()
             .filter(|e| e.path().is_dir())
             .filter_map(|e| {
                 let dir = e.path();
-                let s = Session::inspect(&dir).ok()?;
-                let p = s.progress();
-                let (done, all) = p.done();
-                let busy = s
-                    .lock_holder()
-                    .map_or(String::new(), |h| format!(" (in use by {})", h.user));
-                Some((
-                    s.name().as_str().to_string(),
-                    dir,
-                    format!("{done}/{all} done{busy}"),
-                ))
+                let folder = e.file_name().to_string_lossy().into_owned();
+                match Session::inspect(&dir) {
+                    Ok(s) => {
+                        let (done, all) = s.progress().done();
+                        let busy = s
+                            .lock_holder()
+                            .map_or(String::new(), |h| format!(" (in use by {})", h.user));
+                        Some(SessionEntry {
+                            name: s.name().as_str().to_string(),
+                            dir,
+                            summary: format!("{done}/{all} done{busy}"),
+                            damaged: None,
+                        })
+                    }
+                    Err(SessionError::NotASession { .. }) => None,
+                    Err(e) => Some(SessionEntry {
+                        name: folder,
+                        dir,
+                        summary: "DAMAGED".into(),
+                        damaged: Some(e.to_string()),
+                    }),
+                }
             })
             .collect();
-        out.sort();
+        out.sort_by(|a, b| a.name.cmp(&b.name));
         out
     }
 
-    /// Where sessions live: the profile's `survey.dir`. A relative one is
-    /// taken from the folder the console was started in (where an operator
-    /// expects their survey), not the profile's folder (which may be the
-    /// installed, shared `profiles/`).
-    fn survey_dir(&self) -> PathBuf {
-        self.profile.survey.dir.clone()
+    /// Opens a session held by a console that still runs on this host, by
+    /// asking that console to end (SIGTERM: it finishes its saves and
+    /// releases the lock, as on a hang-up); a holder on another host is
+    /// taken over as the lock allows.
+    fn take_over(&self, dir: &Path) -> Result<Session, StoreError> {
+        let err = session_err(format!("cannot take over {}", dir.display()));
+        let holder = Session::inspect(dir).ok().and_then(|s| s.lock_holder());
+        let local = holder
+            .as_ref()
+            .is_some_and(|h| h.host == crate::session::lock::LockInfo::current().host);
+        if let (true, Some(h)) = (local, holder.as_ref()) {
+            self.reply(StoreEvent::Note(format!(
+                "asking process {} to end and release session {}…",
+                h.pid,
+                dir.display()
+            )));
+            let _ = std::process::Command::new("kill")
+                .args(["-TERM", &h.pid.to_string()])
+                .status();
+            let end = Instant::now() + Duration::from_secs(15);
+            loop {
+                match Session::open(dir) {
+                    Ok(s) => return Ok(s),
+                    Err(SessionError::Locked { stale: true, .. }) => {
+                        return Session::open_take_over(dir).map_err(err);
+                    }
+                    Err(SessionError::Locked { holder, .. }) if Instant::now() > end => {
+                        return Err(StoreError::TakeOver {
+                            dir: dir.to_path_buf(),
+                            holder,
+                        });
+                    }
+                    Err(SessionError::Locked { .. }) => {
+                        std::thread::sleep(Duration::from_millis(100));
+                    }
+                    Err(e) => return Err(err(e)),
+                }
+            }
+        }
+        Session::open_take_over(dir).map_err(err)
     }
 
     fn cdf_path(&self, camera: u32) -> Option<PathBuf> {
@@ -272,154 +437,31 @@ impl Store {
             .collect()
     }
 
-    /// Writes the survey report `NAME.ps` and one `NAMEk.svg` per image
-    /// with outputs.
-    fn export(&mut self) -> Result<Vec<PathBuf>, String> {
-        let s = self.session.as_ref().ok_or("no session open")?;
-        let mut reports = Vec::new();
-        for rec in &s.manifest().image {
-            let k = rec.number;
-            if rec.outputs.is_none() {
-                continue;
-            }
-            reports.push(image_report(s, k)?);
-        }
-        if reports.is_empty() {
-            return Err(
-                "nothing to report yet: no image of the session has outputs (accept one first)"
-                    .into(),
-            );
-        }
-        let name = s.name().as_str().to_string();
-        let mut paths = Vec::new();
-        let ps = s.path(&format!("{name}.ps"));
-        let text = report::ps::survey_report(&format!("Survey {name}"), &reports);
-        crate::fsutil::write_atomic(&ps, text.as_bytes())
-            .map_err(|e| format!("{}: {e}", ps.display()))?;
-        paths.push(ps);
-        for (r, rec) in reports
-            .iter()
-            .zip(s.manifest().image.iter().filter(|r| r.outputs.is_some()))
-        {
-            let svg = s.path(&format!("{name}{}.svg", rec.number));
-            crate::fsutil::write_atomic(&svg, report::svg::image_svg(r).as_bytes())
-                .map_err(|e| format!("{}: {e}", svg.display()))?;
-            paths.push(svg);
-        }
-        Ok(paths)
-    }
-}
-
-/// Everything the report shows of image `k`, read from the session's files.
-fn image_report(s: &Session, k: u32) -> Result<ImageReport, String> {
-    let greys: Vec<(String, crate::llv::GreyImage)> = s
-        .load_images(k)
-        .map_err(|e| e.to_string())?
-        .into_iter()
-        .map(|(l, f)| (s.file_name(k, Some(l), "img"), f.image))
-        .collect();
-    let (width, height) = greys.first().map_or((0, 0), |g| g.1.size());
-    let edges = |ext: &str| formats::edgefile::read_edges(&s.path(&s.file_name(k, None, ext))).ok();
-    let lines_raw = formats::lines::read_lines(&s.path(&s.file_name(k, None, "lex"))).ok();
-    let lines = s.load_lines(k).ok();
-    let mut notes = Vec::new();
-    if let Some(o) = s.manifest().image(k).and_then(|r| r.outputs.as_ref()) {
-        notes.push(format!(
-            "edges H {} V {}, lines {} raw {}",
-            o.counts.edges_h, o.counts.edges_v, o.counts.lines, o.counts.lines_raw
-        ));
-        notes.push(format!(
-            "times (ms): lens {:.1} edges {:.1} lines {:.1} connect {:.1}",
-            o.timings.lens_us as f64 / 1e3,
-            o.timings.edges_us as f64 / 1e3,
-            o.timings.lines_us as f64 / 1e3,
-            o.timings.connect_us as f64 / 1e3
-        ));
-        for sp in crate::llv::params::PARAMS {
-            if let Some(v) = o.params.get(sp.key) {
-                notes.push(format!("{} = {}", sp.key, crate::tui::app::fmt_value(v)));
-            }
-        }
-        notes.push(format!("made {} by vss {}", o.made, o.version));
-    }
-    Ok(ImageReport {
-        title: format!("{}{k}", s.name()),
-        width,
-        height,
-        greys,
-        edges_h: edges("hpo"),
-        edges_v: edges("vpo"),
-        lines_raw,
-        lines,
-        notes,
-    })
-}
-
-/// The console's picture of a session. With `check`, every file is read
-/// and parsed (slower: on request only).
-pub fn view(s: &Session, check: bool) -> SessionView {
-    let p = s.progress();
-    let images = p
-        .images
-        .iter()
-        .map(|i| ImageState {
-            k: i.number,
-            camera: i.camera,
-            location: i.location,
-            captured: i.captured.clone(),
-            outputs: i.outputs != OutputState::Missing,
-            stale: matches!(i.outputs, OutputState::Stale(_)),
-            edits: i.edits,
-        })
-        .collect();
-    let next = p.next_step().map(|st| match st {
-        Step::Capture { image, letter } => (image, Some(letter)),
-        Step::Process { image } => (image, None),
-    });
-    let report = check.then(|| s.check());
-    let name = s.name().as_str().to_string();
-    let mut names: Vec<String> = vec![format!("{name}.ses"), format!("{name}.toml")];
-    names.extend(
-        s.manifest()
-            .files()
-            .into_iter()
-            .map(|(_, f, _)| f.to_string()),
-    );
-    if let Ok(rd) = std::fs::read_dir(s.dir()) {
-        let mut extra: Vec<String> = rd
-            .flatten()
-            .map(|e| e.file_name().to_string_lossy().into_owned())
-            .filter(|n| n.ends_with(".ps") || n.ends_with(".svg"))
-            .collect();
-        extra.sort();
-        names.extend(extra);
-    }
-    names.dedup();
-    let files = names
-        .into_iter()
-        .map(|n| {
-            let path = s.path(&n);
-            let problem = report
-                .as_ref()
-                .and_then(|r| r.problems.iter().find(|p| p.contains(&n)).cloned());
-            let (state, ok) = match (std::fs::metadata(&path), problem) {
-                (Err(_), _) => ("missing".to_string(), false),
-                (Ok(_), Some(p)) => (p, false),
-                (Ok(m), None) => (format!("ok {:.1} KiB", m.len() as f64 / 1024.0), true),
+    /// Writes the survey report `NAME.ps` and one `NAMEk.svg` per image in
+    /// the session folder, through the one report writer (`vss report`
+    /// writes the same pages). A failure says which file on disk is old.
+    fn export(&mut self) -> Result<Vec<PathBuf>, StoreError> {
+        let s = self.session.as_ref().ok_or(StoreError::NoSession)?;
+        let targets = report::survey::Targets::in_session(s);
+        let ps = targets.ps.clone().unwrap_or_default();
+        report::survey::write(s, None, &targets).map_err(|e| {
+            let old = match std::fs::metadata(&ps).and_then(|m| m.modified()) {
+                Ok(t) => {
+                    let secs = t
+                        .duration_since(std::time::UNIX_EPOCH)
+                        .map_or(0, |d| d.as_secs());
+                    format!(
+                        "; {} on disk is the OLD report, written {}",
+                        ps.display(),
+                        crate::session::stamp::rfc3339(secs)
+                    )
+                }
+                Err(_) => format!("; there is no {} yet", ps.display()),
             };
-            FileState {
-                name: crate::tui::text::clean(&n),
-                state: crate::tui::text::clean(&state),
-                ok,
+            StoreError::Report {
+                why: e.to_string(),
+                old,
             }
         })
-        .collect();
-    SessionView {
-        name,
-        dir: s.dir().to_path_buf(),
-        letters: s.letters(),
-        images,
-        next,
-        files,
     }
 }

@@ -1,0 +1,90 @@
+//! The Capture screen's state and keys: the camera, the highlighted light,
+//! live view, single grabs, each light or lighting configuration switched.
+
+use super::{Ctx, PreviewNav};
+use crate::tui::event::{Cmd, DeviceCmd, FramePurpose};
+use crate::tui::keymap::CaptureAction;
+
+/// The Capture screen's own state.
+#[derive(Clone, Debug)]
+pub struct CaptureScreen {
+    /// The highlighted light.
+    pub light: usize,
+    pub camera: u32,
+    pub nav: PreviewNav,
+}
+
+impl Default for CaptureScreen {
+    fn default() -> Self {
+        CaptureScreen {
+            light: 0,
+            camera: 1,
+            nav: PreviewNav::default(),
+        }
+    }
+}
+
+impl CaptureScreen {
+    pub fn update(&mut self, a: CaptureAction, ctx: &mut Ctx) -> Vec<Cmd> {
+        match a {
+            CaptureAction::Camera => {
+                self.camera = self.camera % ctx.cell.cameras + 1;
+                ctx.info(format!("camera {}", self.camera));
+                if ctx.cell.device.live {
+                    return vec![Cmd::Device(DeviceCmd::Live {
+                        on: true,
+                        camera: self.camera,
+                    })];
+                }
+                Vec::new()
+            }
+            CaptureAction::ToggleLive => {
+                ctx.cell.device.live = !ctx.cell.device.live;
+                vec![Cmd::Device(DeviceCmd::Live {
+                    on: ctx.cell.device.live,
+                    camera: self.camera,
+                })]
+            }
+            CaptureAction::Grab => {
+                ctx.info(format!("grabbing a frame of camera {}", self.camera));
+                vec![ctx.capture(FramePurpose::Snapshot, self.camera, None)]
+            }
+            CaptureAction::LightPrev => {
+                self.light = self.light.saturating_sub(1);
+                Vec::new()
+            }
+            CaptureAction::LightNext => {
+                if self.light + 1 < ctx.cell.lights.len() {
+                    self.light += 1;
+                }
+                Vec::new()
+            }
+            CaptureAction::LightToggle => {
+                let Some((name, relay)) = ctx.cell.lights.get(self.light).cloned() else {
+                    return Vec::new();
+                };
+                let on = !ctx.cell.device.lights_on.contains(&name);
+                ctx.info(format!("light {name} {}", if on { "on" } else { "off" }));
+                vec![Cmd::Device(DeviceCmd::SetLight { relay, on })]
+            }
+            CaptureAction::LightsOff => {
+                ctx.info("all lights off");
+                vec![Cmd::Device(DeviceCmd::AllOff)]
+            }
+            CaptureAction::Lighting(i) => match ctx.cell.letters.get(i as usize) {
+                Some(&l) => {
+                    ctx.info(format!("lighting {l}"));
+                    vec![Cmd::Device(DeviceCmd::Lighting(l))]
+                }
+                None => {
+                    ctx.warn(format!(
+                        "the profile has no lighting configuration {}",
+                        (b'a' + i) as char
+                    ));
+                    Vec::new()
+                }
+            },
+            CaptureAction::Cancel => super::App::cancel_transfer(ctx),
+        }
+    }
+}

@@ -1,0 +1,85 @@
+//! What the console knows of the cell: the profile's lightings, lights and
+//! cameras, the camera models, and what the devices last reported (who
+//! answers, the lights on, a transfer under way, the live picture).
+
+use crate::llv::GreyImage;
+use crate::llv::lens::CameraModel;
+use crate::profile::Profile;
+use crate::session::input::FrameRule;
+use crate::tui::event::FramePurpose;
+use crate::tui::text::clean;
+
+/// What the devices last reported.
+#[derive(Clone, Debug, Default)]
+pub struct DeviceState {
+    pub connected: bool,
+    pub grabber: String,
+    pub relay: String,
+    pub lost: Option<String>,
+    pub lights_on: Vec<String>,
+    pub mask: u32,
+    /// A frame coming in: what for, bytes done and total.
+    pub transfer: Option<(FramePurpose, usize, usize)>,
+    /// The lights are settling before a freeze (nothing transferred yet).
+    pub settling: bool,
+    pub live: bool,
+}
+
+#[derive(Debug)]
+pub struct CellState {
+    pub profile_name: String,
+    /// Lighting letters of the profile, and which one is ambient (no light on).
+    pub letters: Vec<char>,
+    pub ambient: Option<char>,
+    /// Which frames are lit and which is ambient: the session code's rule.
+    pub rule: FrameRule,
+    /// Light names and relay channels, in profile order.
+    pub lights: Vec<(String, u32)>,
+    /// Lighting configuration letter → names of the lights on.
+    pub lighting_on: Vec<(char, Vec<String>)>,
+    pub cameras: u32,
+    pub camera_models: Vec<Option<CameraModel>>,
+    /// The profile's `.cdf` of each camera (index 0 is camera 1).
+    pub cdf_paths: Vec<Option<std::path::PathBuf>>,
+    pub device: DeviceState,
+    /// The latest frame of the live view or a single grab (camera, image).
+    pub live: Option<(u32, GreyImage)>,
+}
+
+impl CellState {
+    pub fn new(profile: &Profile) -> CellState {
+        let rule = FrameRule::of_profile(profile);
+        let ambient = rule.ambient();
+        CellState {
+            rule,
+            profile_name: clean(&profile.name),
+            letters: profile.lighting.iter().map(|l| l.letter).collect(),
+            ambient,
+            lights: profile
+                .lights
+                .iter()
+                .map(|l| (clean(&l.name), l.relay))
+                .collect(),
+            lighting_on: profile
+                .lighting
+                .iter()
+                .map(|l| (l.letter, l.on.iter().map(|s| clean(s)).collect()))
+                .collect(),
+            cameras: profile.survey.cameras.max(1),
+            camera_models: Vec::new(),
+            cdf_paths: (1..=profile.survey.cameras.max(1))
+                .map(|k| profile.cdf_path(k))
+                .collect(),
+            device: DeviceState::default(),
+            live: None,
+        }
+    }
+
+    /// The camera model of camera `cam` (1-based), if its `.cdf` has one.
+    pub fn camera_model(&self, cam: u32) -> Option<CameraModel> {
+        self.camera_models
+            .get(cam.checked_sub(1)? as usize)
+            .copied()
+            .flatten()
+    }
+}

@@ -1,0 +1,96 @@
+//! The frame around every screen: which screen is shown, the message log
+//! and how its pane is shown and scrolled, the help and message windows,
+//! the open question or text field, and whether to quit.
+
+use super::log::Log;
+use super::modal::Modal;
+use crate::tui::keymap::{GlobalAction, ScreenId, ViewerAction};
+use crate::tui::mode::Look;
+
+/// How the log pane is shown.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LogView {
+    Hidden,
+    Line,
+    Expanded,
+}
+
+/// A window over the screen that takes the keys until closed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Overlay {
+    /// The key table and the checklist's marks, scrolled by `scroll` rows.
+    Help { scroll: usize },
+    /// The newest message in full.
+    Message { scroll: usize },
+}
+
+#[derive(Debug)]
+pub struct Chrome {
+    pub look: Look,
+    pub screen: ScreenId,
+    pub log: Log,
+    pub log_view: LogView,
+    /// Rows the expanded log pane is scrolled back from its newest message.
+    pub log_scroll: usize,
+    pub overlay: Option<Overlay>,
+    pub modal: Option<Modal>,
+    /// The terminal's size (columns, rows), from the last resize.
+    pub size: (u16, u16),
+    pub quit: bool,
+}
+
+impl Chrome {
+    pub fn new(look: Look) -> Chrome {
+        Chrome {
+            look,
+            screen: ScreenId::Survey,
+            log: Log::default(),
+            log_view: LogView::Line,
+            log_scroll: 0,
+            overlay: None,
+            modal: None,
+            size: (80, 24),
+            quit: false,
+        }
+    }
+
+    pub fn cycle_log(&mut self) {
+        self.log_view = match self.log_view {
+            LogView::Hidden => LogView::Line,
+            LogView::Line => LogView::Expanded,
+            LogView::Expanded => LogView::Hidden,
+        };
+        self.log_scroll = 0;
+    }
+
+    /// PgUp/PgDn/Home/End: scroll the log pane, expanding it first.
+    pub fn scroll_log(&mut self, g: GlobalAction) {
+        if self.log_view != LogView::Expanded {
+            self.log_view = LogView::Expanded;
+        }
+        let page = (self.size.1 as usize / 2).saturating_sub(3).max(1);
+        self.log_scroll = match g {
+            GlobalAction::LogUp => self.log_scroll + page,
+            GlobalAction::LogDown => self.log_scroll.saturating_sub(page),
+            // The drawing clamps to the first row.
+            GlobalAction::LogTop => usize::MAX / 2,
+            _ => 0,
+        };
+    }
+
+    /// Scrolls or closes the help or message window.
+    pub fn viewer(&mut self, v: ViewerAction) {
+        let page = (self.size.1 as usize).saturating_sub(6).max(1);
+        let Some(Overlay::Help { scroll } | Overlay::Message { scroll }) = self.overlay.as_mut()
+        else {
+            return;
+        };
+        match v {
+            ViewerAction::Up => *scroll = scroll.saturating_sub(1),
+            ViewerAction::Down => *scroll += 1,
+            ViewerAction::PageUp => *scroll = scroll.saturating_sub(page),
+            ViewerAction::PageDown => *scroll += page,
+            ViewerAction::Close => self.overlay = None,
+        }
+    }
+}

@@ -1,0 +1,301 @@
+//! Questions and text fields over the current screen: a yes/no question
+//! whose "yes" is a [`Pending`] action, and a one-line text field with the
+//! readline keys (← → Home End, Ctrl-A/E/U/W, Backspace, Delete), its rule
+//! shown before typing, its length limit enforced while typing, and the
+//! typed text kept after an error.
+
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+
+use super::{App, Level};
+use crate::tui::event::{Cmd, StoreCmd};
+use crate::tui::keymap::ModalAction;
+
+/// What a confirmed question does.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Pending {
+    Quit,
+    /// Capture image `k` again: only `letters`, or every lighting when empty.
+    Retake {
+        k: u32,
+        letters: Vec<char>,
+    },
+    /// Accept the image under review (save its outputs, go on).
+    Accept,
+    /// Save the outputs on screen over an image's accepted ones.
+    SaveOutputs,
+    /// Leave the open session for the one in this folder.
+    Switch(std::path::PathBuf),
+    /// Take the lock of a session held by a console that still runs.
+    TakeOver(std::path::PathBuf),
+    /// Start an image beyond the survey's plan.
+    ExtraImage(u32),
+    /// Go on with the edit of an accepted image's lines.
+    Edit,
+    /// Write the calibration shown into its camera's `.cdf`.
+    CalibWrite,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PromptPurpose {
+    SessionName,
+    ParamValue(&'static str),
+}
+
+/// A one-line text field.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prompt {
+    pub title: String,
+    /// What may be typed, shown before typing.
+    pub rule: String,
+    pub text: String,
+    /// Cursor position, in characters.
+    pub cursor: usize,
+    /// The longest text accepted (characters).
+    pub max: usize,
+    pub purpose: PromptPurpose,
+    /// Why the last Enter was refused (the text stays for correcting).
+    pub error: Option<String>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Modal {
+    Prompt(Prompt),
+    Confirm {
+        question: String,
+        on_yes: Pending,
+        /// What `a` ("all") does, where the question offers it.
+        on_all: Option<Pending>,
+    },
+}
+
+impl Modal {
+    pub fn confirm(question: impl Into<String>, on_yes: Pending) -> Modal {
+        Modal::Confirm {
+            question: question.into(),
+            on_yes,
+            on_all: None,
+        }
+    }
+
+    pub fn prompt(
+        title: impl Into<String>,
+        rule: impl Into<String>,
+        text: String,
+        max: usize,
+        purpose: PromptPurpose,
+    ) -> Modal {
+        let cursor = text.chars().count();
+        Modal::Prompt(Prompt {
+            title: title.into(),
+            rule: rule.into(),
+            text,
+            cursor,
+            max,
+            purpose,
+            error: None,
+        })
+    }
+}
+
+impl Prompt {
+    fn byte(&self, char_index: usize) -> usize {
+        self.text
+            .char_indices()
+            .nth(char_index)
+            .map_or(self.text.len(), |(i, _)| i)
+    }
+
+    /// Types one character at the cursor (refused past the limit).
+    pub fn insert(&mut self, c: char) -> bool {
+        if self.text.chars().count() >= self.max || c.is_control() {
+            return false;
+        }
+        let at = self.byte(self.cursor);
+        self.text.insert(at, c);
+        self.cursor += 1;
+        self.error = None;
+        true
+    }
+
+    /// A readline key.
+    pub fn edit(&mut self, a: ModalAction) {
+        let n = self.text.chars().count();
+        match a {
+            ModalAction::Left => self.cursor = self.cursor.saturating_sub(1),
+            ModalAction::Right => self.cursor = (self.cursor + 1).min(n),
+            ModalAction::Home => self.cursor = 0,
+            ModalAction::End => self.cursor = n,
+            ModalAction::DeleteBack if self.cursor > 0 => {
+                let (a, b) = (self.byte(self.cursor - 1), self.byte(self.cursor));
+                self.text.replace_range(a..b, "");
+                self.cursor -= 1;
+            }
+            ModalAction::DeleteForward if self.cursor < n => {
+                let (a, b) = (self.byte(self.cursor), self.byte(self.cursor + 1));
+                self.text.replace_range(a..b, "");
+            }
+            ModalAction::KillLine => {
+                let b = self.byte(self.cursor);
+                self.text.replace_range(..b, "");
+                self.cursor = 0;
+            }
+            ModalAction::KillWord => {
+                let chars: Vec<char> = self.text.chars().collect();
+                let mut i = self.cursor;
+                while i > 0 && chars[i - 1].is_whitespace() {
+                    i -= 1;
+                }
+                while i > 0 && !chars[i - 1].is_whitespace() {
+                    i -= 1;
+                }
+                let (a, b) = (self.byte(i), self.byte(self.cursor));
+                self.text.replace_range(a..b, "");
+                self.cursor = i;
+            }
+            ModalAction::DeleteBack
+            | ModalAction::DeleteForward
+            | ModalAction::All
+            | ModalAction::Yes
+            | ModalAction::No
+            | ModalAction::Submit
+            | ModalAction::Cancel
+            | ModalAction::Up
+            | ModalAction::Down => {}
+        }
+        self.error = None;
+    }
+}
+
+impl App {
+    /// A printable key typed into the open text field.
+    pub(super) fn prompt_typed(&mut self, key: &KeyEvent) {
+        let Some(Modal::Prompt(p)) = self.chrome.modal.as_mut() else {
+            return;
+        };
+        if let KeyCode::Char(c) = key.code
+            && !key.modifiers.contains(KeyModifiers::CONTROL)
+            && !p.insert(c)
+            && !c.is_control()
+        {
+            p.error = Some(format!("at most {} characters", p.max));
+        }
+    }
+
+    pub(super) fn modal_action(&mut self, a: ModalAction) -> Vec<Cmd> {
+        match a {
+            ModalAction::Yes | ModalAction::No => self.answer(Some(a == ModalAction::Yes)),
+            ModalAction::All => self.answer(None),
+            ModalAction::Submit => self.submit(),
+            ModalAction::Cancel => {
+                self.chrome.modal = None;
+                Vec::new()
+            }
+            ModalAction::Up | ModalAction::Down => Vec::new(),
+            ModalAction::Left
+            | ModalAction::Right
+            | ModalAction::Home
+            | ModalAction::End
+            | ModalAction::DeleteBack
+            | ModalAction::DeleteForward
+            | ModalAction::KillLine
+            | ModalAction::KillWord => {
+                if let Some(Modal::Prompt(p)) = self.chrome.modal.as_mut() {
+                    p.edit(a);
+                }
+                Vec::new()
+            }
+        }
+    }
+
+    /// The answer to the open question: yes, no, or (`None`) "all".
+    pub(super) fn answer(&mut self, yes: Option<bool>) -> Vec<Cmd> {
+        let Some(Modal::Confirm { on_yes, on_all, .. }) = self.chrome.modal.take() else {
+            return Vec::new();
+        };
+        let pending = match yes {
+            Some(true) => on_yes,
+            Some(false) => {
+                self.chrome.log.push(Level::Info, "nothing changed");
+                return Vec::new();
+            }
+            None => match on_all {
+                Some(p) => p,
+                None => return Vec::new(),
+            },
+        };
+        self.run_pending(pending)
+    }
+
+    fn run_pending(&mut self, p: Pending) -> Vec<Cmd> {
+        match p {
+            Pending::Quit => {
+                self.chrome.quit = true;
+                vec![Cmd::Device(crate::tui::event::DeviceCmd::Cancel)]
+            }
+            Pending::Retake { k, letters } => self.ctx().retake(k, letters),
+            Pending::Accept => self.ctx().accept(true),
+            Pending::SaveOutputs => self.ctx().save_outputs(true).unwrap_or_default(),
+            Pending::Switch(dir) => vec![Cmd::Store(StoreCmd::Open(dir))],
+            Pending::TakeOver(dir) => vec![Cmd::Store(StoreCmd::TakeOver(dir))],
+            Pending::ExtraImage(k) => self.ctx().extra_image(k),
+            Pending::Edit => {
+                let (s, mut ctx) = self.parts();
+                s.edit.confirmed(&mut ctx)
+            }
+            Pending::CalibWrite => self.screens.calibrate.confirmed(),
+        }
+    }
+
+    fn submit(&mut self) -> Vec<Cmd> {
+        let Some(Modal::Prompt(mut p)) = self.chrome.modal.take() else {
+            return Vec::new();
+        };
+        let result = match p.purpose {
+            PromptPurpose::SessionName => {
+                match crate::formats::names::SessionName::new(p.text.trim()) {
+                    Ok(n) => {
+                        let name = n.as_str();
+                        let stem = name.trim_end_matches(|c: char| c.is_ascii_digit());
+                        if stem.len() < name.len() {
+                            let digits = &name[stem.len()..];
+                            self.chrome.log.push(
+                                Level::Warn,
+                                format!(
+                                    "session name {name} ends in a digit: its image 1 is \
+                                     {name}1a.img, which also reads as session {stem} image \
+                                     {digits}1 — a letter at the end avoids that"
+                                ),
+                            );
+                        }
+                        Ok(vec![Cmd::Store(StoreCmd::Create(n.as_str().to_string()))])
+                    }
+                    Err(e) => Err(format!("session name refused: {e}")),
+                }
+            }
+            PromptPurpose::ParamValue(key) => {
+                let mut params = self.tracker.params.clone();
+                match params.set_str(&format!("{key}={}", p.text.trim())) {
+                    Ok(()) => {
+                        let v = params.get(key).unwrap_or_default();
+                        self.chrome.log.push(
+                            Level::Info,
+                            format!("{key} = {}", crate::llv::params::fmt_value(v)),
+                        );
+                        Ok(self.ctx().set_params(params))
+                    }
+                    Err(e) => Err(e.to_string()),
+                }
+            }
+        };
+        match result {
+            Ok(cmds) => cmds,
+            Err(e) => {
+                // The field stays open with the text, to correct it.
+                self.chrome.log.push(Level::Error, e.clone());
+                p.error = Some(e);
+                self.chrome.modal = Some(Modal::Prompt(p));
+                Vec::new()
+            }
+        }
+    }
+}

@@ -1,0 +1,42 @@
+//! The open session as the store worker last described it, the sessions
+//! of the survey folder (damaged ones included, with why), and where the
+//! guided survey stands.
+
+use super::survey::Work;
+pub use crate::tui::event::SessionEntry;
+use crate::tui::event::{ImageState, SessionView};
+
+#[derive(Debug, Default)]
+pub struct SessionState {
+    pub view: Option<SessionView>,
+    pub list: Vec<SessionEntry>,
+    pub work: Work,
+}
+
+impl SessionState {
+    /// The checklist row of image `k`.
+    pub fn image(&self, k: u32) -> Option<&ImageState> {
+        self.view.as_ref()?.images.iter().find(|i| i.k == k)
+    }
+
+    /// The image numbers the checklist shows: the session's, and the one
+    /// under work.
+    pub fn numbers(&self) -> Vec<u32> {
+        let mut ks: Vec<u32> = self
+            .view
+            .as_ref()
+            .map(|v| v.images.iter().map(|i| i.k).collect())
+            .unwrap_or_default();
+        let beyond = self.work.phase == super::Phase::Complete;
+        if self.view.is_some() && self.work.k > 0 && !beyond && !ks.contains(&self.work.k) {
+            ks.push(self.work.k);
+        }
+        ks.sort_unstable();
+        ks
+    }
+
+    /// Whether image `k` has accepted, current outputs.
+    pub fn accepted(&self, k: u32) -> bool {
+        self.image(k).is_some_and(|i| i.outputs && !i.stale)
+    }
+}

@@ -1,0 +1,252 @@
+//! The image under work and its pipeline runs: the panel's parameter
+//! values, the grey images of one image number with what the stages made
+//! of them (a run's outputs, or the session's saved files), the line
+//! editor, and the generation counters that keep an older run from ever
+//! replacing a newer one. What is saved is always what the panel shows.
+
+use std::sync::Arc;
+
+use super::{Ctx, Pending};
+use crate::llv::edit::LineEditor;
+use crate::llv::pipeline::StageOutputs;
+use crate::llv::{GreyImage, Params, Segment};
+use crate::session::input::PipelineInput;
+use crate::tui::event::{Cmd, ImageKey, PipelineRequest, StoreCmd};
+
+/// The grey images of one image number and what the pipeline made of them.
+#[derive(Debug)]
+pub struct Loaded {
+    pub k: u32,
+    pub camera: u32,
+    /// Captured frames by lighting letter, in capture order.
+    pub frames: Vec<(char, GreyImage)>,
+    pub version: u64,
+    pub outputs: Option<Arc<StageOutputs>>,
+    /// The parameters behind `outputs`.
+    pub outputs_params: Option<Params>,
+    /// The outputs were read from the session's files, not run.
+    pub from_disk: bool,
+    /// The outputs on screen are the ones the session holds (loaded, or
+    /// saved since they were made); hand edits are written as they are made.
+    pub in_session: bool,
+    pub editor: Option<LineEditor>,
+    /// Edits made in this run of the console (for the Edit screen).
+    pub edits: usize,
+    /// Hand-edited lines read back from the session (resume), used instead
+    /// of the first pipeline result's lines.
+    pub saved_lines: Option<Vec<Segment>>,
+    /// Why the newest run failed (`None` after a run that worked): the
+    /// outputs shown are then an older run's.
+    pub failed: Option<String>,
+    /// The session holds accepted outputs of this image: replacing them asks.
+    pub accepted: bool,
+    /// The operator said yes to changing this accepted image's lines.
+    pub edit_confirmed: bool,
+    /// Lightings whose saved grey image is damaged, with why.
+    pub damaged: Vec<(char, String)>,
+    /// The pipeline input made of `frames` (and for which version of them).
+    pub input: Option<(u64, Arc<PipelineInput>)>,
+}
+
+impl Loaded {
+    pub fn new(k: u32, camera: u32) -> Loaded {
+        Loaded {
+            k,
+            camera,
+            frames: Vec::new(),
+            version: 0,
+            outputs: None,
+            outputs_params: None,
+            from_disk: false,
+            in_session: false,
+            editor: None,
+            edits: 0,
+            saved_lines: None,
+            failed: None,
+            accepted: false,
+            edit_confirmed: false,
+            damaged: Vec::new(),
+            input: None,
+        }
+    }
+
+    /// The frame of lighting `letter`.
+    pub fn frame(&self, letter: char) -> Option<&GreyImage> {
+        self.frames.iter().find(|f| f.0 == letter).map(|f| &f.1)
+    }
+
+    /// The lines as they stand (edited, or the run's).
+    pub fn lines(&self) -> Option<&[Segment]> {
+        match (&self.editor, &self.outputs) {
+            (Some(e), _) => Some(e.lines()),
+            (None, Some(o)) => Some(&o.lines),
+            (None, None) => None,
+        }
+    }
+}
+
+#[derive(Debug)]
+pub struct Tracker {
+    /// The panel's values: every run asks for these.
+    pub params: Params,
+    /// The profile's values, to mark the ones the operator changed.
+    pub profile_params: Params,
+    pub current: Option<Loaded>,
+    /// Generation of the newest pipeline request, and of the result shown.
+    pub generation: u64,
+    pub shown_generation: u64,
+    version_counter: u64,
+}
+
+impl Tracker {
+    pub fn new(params: Params) -> Tracker {
+        Tracker {
+            profile_params: params.clone(),
+            params,
+            current: None,
+            generation: 0,
+            shown_generation: 0,
+            version_counter: 0,
+        }
+    }
+
+    pub fn next_version(&mut self) -> u64 {
+        self.version_counter += 1;
+        self.version_counter
+    }
+
+    /// Whether a pipeline run is still out.
+    pub fn busy(&self) -> bool {
+        self.generation > self.shown_generation && self.current.is_some()
+    }
+
+    /// The size of the image the Pipeline and Edit previews show.
+    pub fn preview_size(&self) -> Option<(usize, usize)> {
+        let c = self.current.as_ref()?;
+        c.frames.first().map(|(_, g)| g.size())
+    }
+
+    /// Why the outputs on screen are not those of the panel's values (a run
+    /// still out, the newest run failed, other values), for view titles;
+    /// `None` when they are.
+    pub fn stale(&self) -> Option<&'static str> {
+        let cur = self.current.as_ref()?;
+        if cur.failed.is_some() {
+            Some("stale: last run failed")
+        } else if self.busy() {
+            Some("stale: running")
+        } else if cur.outputs.is_some() && cur.outputs_params.as_ref() != Some(&self.params) {
+            Some("stale: other values")
+        } else {
+            None
+        }
+    }
+
+    /// A pipeline request for the current image (`None` when there is none):
+    /// its frames split by the profile's rule, as the session code splits
+    /// them.
+    pub fn request(&mut self, cell: &super::CellState) -> Option<Cmd> {
+        let cur = self.current.as_mut()?;
+        if cur.frames.is_empty() {
+            return None;
+        }
+        let camera = cell.camera_model(cur.camera);
+        let input = match &cur.input {
+            Some((v, input)) if *v == cur.version && input.camera == camera => input.clone(),
+            _ => {
+                let input = Arc::new(
+                    cell.rule
+                        .split(cur.frames.iter().cloned())
+                        .with_camera(camera),
+                );
+                cur.input = Some((cur.version, input.clone()));
+                input
+            }
+        };
+        let (k, version) = (cur.k, cur.version);
+        self.generation += 1;
+        Some(Cmd::Pipeline(PipelineRequest {
+            generation: self.generation,
+            image_key: ImageKey { k, version },
+            input,
+            params: self.params.clone(),
+        }))
+    }
+}
+
+impl Ctx<'_> {
+    /// Takes new parameter values and re-runs the pipeline on the current image.
+    pub fn set_params(&mut self, p: Params) -> Vec<Cmd> {
+        self.tracker.params = p;
+        self.tracker.request(self.cell).into_iter().collect()
+    }
+
+    /// The commands that save the outputs on screen, or `None` (said in the
+    /// log, or asked first) when there is nothing to save, they were not
+    /// made with the panel's values, or they would replace accepted outputs
+    /// and `confirmed` is false.
+    pub fn save_outputs(&mut self, confirmed: bool) -> Option<Vec<Cmd>> {
+        let busy = self.tracker.busy();
+        let Some(cur) = self.tracker.current.as_ref() else {
+            self.warn("nothing to save: no image processed yet");
+            return None;
+        };
+        let (Some(out), Some(params)) = (cur.outputs.clone(), cur.outputs_params.clone()) else {
+            self.warn("nothing to save: the pipeline has not finished");
+            return None;
+        };
+        if let Some(e) = cur.failed.clone() {
+            self.error(format!(
+                "not saved: the last run failed ({e}); the outputs on screen were made with \
+                 other values than the panel's — change a value to run again"
+            ));
+            return None;
+        }
+        if params != self.tracker.params || busy {
+            self.warn(
+                "not saved: the outputs on screen were not made with the panel's values yet \
+                 (a run is still out) — try again when it has finished",
+            );
+            return None;
+        }
+        if self.session.view.is_none() {
+            self.warn("no session open: outputs are not saved");
+            return None;
+        }
+        let k = cur.k;
+        if cur.accepted && !confirmed {
+            self.ask(
+                format!(
+                    "Image {k} is accepted. Replace its saved outputs (.hpo .vpo .lex .ldr, \
+                     and the hand edits in its .ldr) with the ones on screen?"
+                ),
+                Pending::SaveOutputs,
+            );
+            return None;
+        }
+        // A new .ldr replaces the edited one and clears the session's edit
+        // log, so manual edits made since are recorded again on top.
+        let edited = cur
+            .editor
+            .as_ref()
+            .map(|e| e.lines().to_vec())
+            .filter(|l| *l != out.lines);
+        let mut cmds = vec![Cmd::Store(StoreCmd::SaveOutputs {
+            k,
+            outputs: out,
+            params,
+        })];
+        if let Some(lines) = edited {
+            cmds.push(Cmd::Store(StoreCmd::RecordEdit {
+                k,
+                what: "manual edits kept over the new outputs".into(),
+                lines,
+            }));
+        }
+        if let Some(c) = self.tracker.current.as_mut() {
+            c.accepted = true;
+            c.in_session = true;
+        }
+        Some(cmds)
+    }
+}

@@ -1,0 +1,461 @@
+//! The frame around every screen: the top bar (screen keys, session,
+//! profile), the newest message wrapped over up to three rows or the
+//! expanded log pane (wrapped, scrollable, the whole run), the hints row(s)
+//! with what the devices and the pipeline are doing, questions and text
+//! fields, the help window (every key, the checklist's marks) and the
+//! message window. Nothing is cut at the terminal width without a way to
+//! read the rest.
+
+use ratatui::buffer::Buffer;
+use ratatui::layout::Rect;
+use ratatui::style::{Modifier, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Clear, Paragraph, Widget, Wrap};
+
+use super::{block, gauge_text};
+use crate::tui::app::{App, Modal, Overlay};
+use crate::tui::keymap::{self, Scope, ScreenId, has_picture};
+
+/// Most rows the newest message takes at the bottom.
+pub const MESSAGE_ROWS: usize = 3;
+
+/// `text` wrapped to `width` columns.
+pub fn wrap(text: &str, width: usize) -> Vec<String> {
+    textwrap::wrap(text, width.max(1))
+        .into_iter()
+        .map(|c| c.into_owned())
+        .collect()
+}
+
+fn newest(app: &App) -> Option<String> {
+    app.chrome
+        .log
+        .last()
+        .map(|e| format!("{} {}", e.time, e.text))
+}
+
+/// Rows the newest message needs (1 to [`MESSAGE_ROWS`]).
+pub fn message_rows(app: &App, width: u16) -> u16 {
+    newest(app).map_or(1, |m| wrap(&m, width as usize).len().clamp(1, MESSAGE_ROWS)) as u16
+}
+
+pub fn top_bar(app: &App, area: Rect, buf: &mut Buffer) {
+    let t = app.theme();
+    let bar = if app.ascii() { '|' } else { '│' };
+    let right = format!(" {bar} {} ", app.cell.profile_name);
+    let session = app
+        .session
+        .view
+        .as_ref()
+        .map(|s| format!(" {bar} {}", s.name))
+        .unwrap_or_default();
+    let tabs = |short: bool| -> Vec<Span<'static>> {
+        let mut spans = vec![Span::styled("vss", t.title())];
+        for (i, s) in ScreenId::ALL.iter().enumerate() {
+            let current = *s == app.chrome.screen;
+            let label = if short && !current {
+                format!(" {}", i + 1)
+            } else {
+                format!(" {} {}", i + 1, s.short())
+            };
+            let st = if current { t.selected() } else { Style::new() };
+            spans.push(Span::styled(label, st));
+        }
+        spans
+    };
+    let width = |spans: &[Span]| spans.iter().map(|s| s.width()).sum::<usize>();
+    let mut spans = tabs(false);
+    let need = width(&spans) + session.chars().count() + right.chars().count();
+    if need > area.width as usize {
+        spans = tabs(true);
+    }
+    spans.push(Span::styled(session, t.title()));
+    let used = width(&spans);
+    let room = (area.width as usize).saturating_sub(used);
+    let right: String = if right.chars().count() > room {
+        right.chars().take(room).collect()
+    } else {
+        format!("{right:>room$}")
+    };
+    spans.push(Span::styled(right, t.dim()));
+    Line::from(spans).render(area, buf);
+}
+
+/// The newest message, wrapped; a longer one ends with how to read it all.
+pub fn message(app: &App, area: Rect, buf: &mut Buffer) {
+    if area.height == 0 {
+        return;
+    }
+    let t = app.theme();
+    let Some(e) = app.chrome.log.last() else {
+        return;
+    };
+    let text = format!("{} {}", e.time, e.text);
+    let mut rows = wrap(&text, area.width as usize);
+    let max = area.height as usize;
+    if rows.len() > max {
+        rows.truncate(max);
+        let more = " … ! shows all";
+        let w = area.width as usize;
+        if let Some(last) = rows.last_mut() {
+            let keep = w.saturating_sub(more.chars().count());
+            *last = last.chars().take(keep).collect::<String>() + more;
+        }
+    }
+    let lines: Vec<Line> = rows
+        .into_iter()
+        .map(|r| Line::styled(r, t.level(e.level)))
+        .collect();
+    Paragraph::new(lines).render(area, buf);
+}
+
+/// The whole run's messages, wrapped, newest at the bottom, scrolled by
+/// PgUp/PgDn/Home/End.
+pub fn log_pane(app: &App, area: Rect, buf: &mut Buffer) {
+    let t = app.theme();
+    let n = app.chrome.log.len();
+    let file = app
+        .chrome
+        .log
+        .file()
+        .map(|p| format!(" · {}", p.display()))
+        .unwrap_or_default();
+    let b = block(app, &format!("log: {n} messages{file}"));
+    let inner = b.inner(area);
+    b.render(area, buf);
+    let h = inner.height as usize;
+    let w = inner.width as usize;
+    let want = app.chrome.log_scroll.saturating_add(h);
+    // Wrapped rows from the newest back, as many as the view needs.
+    let mut rows: Vec<Line> = Vec::new();
+    for e in app.chrome.log.entries().rev() {
+        let mut wrapped: Vec<Line> = wrap(&format!("{} {}", e.time, e.text), w)
+            .into_iter()
+            .map(|r| Line::styled(r, t.level(e.level)))
+            .collect();
+        wrapped.reverse();
+        rows.extend(wrapped);
+        if rows.len() >= want {
+            break;
+        }
+    }
+    rows.reverse();
+    let total = rows.len();
+    let scroll = app.chrome.log_scroll.min(total.saturating_sub(h));
+    let end = total - scroll;
+    let start = end.saturating_sub(h);
+    let mut shown: Vec<Line> = rows[start..end].to_vec();
+    if scroll > 0
+        && let Some(last) = shown.last_mut()
+    {
+        *last = Line::styled(format!("  ↓ {scroll} more rows (End: newest)"), t.dim());
+    }
+    Paragraph::new(shown).render(inner, buf);
+}
+
+/// What the devices and the pipeline are doing, then the hints.
+fn hint_spans(app: &App) -> Vec<Span<'static>> {
+    let t = app.theme();
+    let d = &app.cell.device;
+    let mut spans = Vec::new();
+    if let Some(lost) = &d.lost {
+        let short: String = lost.chars().take(30).collect();
+        spans.push(Span::styled(format!("DEVICE LOST: {short} "), t.error()));
+    } else if !d.connected {
+        spans.push(Span::styled("connecting… ", t.warn()));
+    }
+    if let Some((_, done, total)) = d.transfer {
+        let what = if d.settling && done == 0 {
+            "lights settling".to_string()
+        } else {
+            format!("transfer {}", gauge_text(done, total, 16))
+        };
+        spans.push(Span::styled(format!("{what} "), t.warn()));
+    }
+    if app.tracker.busy() {
+        spans.push(Span::styled("running… ", t.warn()));
+    }
+    let scope = app.scope();
+    let mut hints = keymap::hints(scope);
+    if let Scope::Screen(s) = scope {
+        if has_picture(s) {
+            hints.extend(keymap::hints(Scope::Picture));
+        }
+        hints.extend(keymap::hints(Scope::Global));
+    }
+    for (k, d) in hints {
+        spans.push(Span::styled(k, t.key()));
+        spans.push(Span::raw(format!(" {d}  ")));
+    }
+    spans
+}
+
+/// The hints laid out in rows of `width`: a key and its label stay
+/// together.
+fn hint_layout(app: &App, width: usize) -> Vec<Vec<Span<'static>>> {
+    let mut rows: Vec<Vec<Span>> = vec![Vec::new()];
+    let mut used = 0;
+    let mut it = hint_spans(app).into_iter().peekable();
+    while let Some(s) = it.next() {
+        let mut group = vec![s];
+        if group[0].style.add_modifier.contains(Modifier::BOLD)
+            && let Some(next) = it.next_if(|n| n.style == Style::new())
+        {
+            group.push(next);
+        }
+        let w: usize = group.iter().map(|s| s.width()).sum();
+        if used + w > width && used > 0 {
+            rows.push(Vec::new());
+            used = 0;
+        }
+        used += w;
+        if let Some(r) = rows.last_mut() {
+            r.extend(group);
+        }
+    }
+    rows
+}
+
+/// Rows the hints need at `width` (at most three).
+pub fn hint_rows(app: &App, width: u16) -> u16 {
+    hint_layout(app, width as usize).len().clamp(1, 3) as u16
+}
+
+pub fn hints(app: &App, area: Rect, buf: &mut Buffer) {
+    let lines: Vec<Line> = hint_layout(app, area.width as usize)
+        .into_iter()
+        .map(Line::from)
+        .collect();
+    Paragraph::new(lines).render(area, buf);
+}
+
+pub fn modal_box(app: &App, m: &Modal, area: Rect, buf: &mut Buffer) {
+    let t = app.theme();
+    let w = area.width.min(70);
+    let inner_w = w.saturating_sub(2) as usize;
+    let (title, lines): (&str, Vec<Line>) = match m {
+        Modal::Prompt(p) => {
+            let mut lines: Vec<Line> = wrap(&p.rule, inner_w)
+                .into_iter()
+                .map(|r| Line::styled(r, t.dim()))
+                .collect();
+            let chars: Vec<char> = p.text.chars().collect();
+            let before: String = chars[..p.cursor.min(chars.len())].iter().collect();
+            let at: String = chars.get(p.cursor).map_or(" ".into(), |c| c.to_string());
+            let after: String = chars.iter().skip(p.cursor + 1).collect();
+            lines.push(Line::from(vec![
+                Span::styled(format!("{} ", p.title), t.title()),
+                Span::raw(before),
+                Span::styled(at, Style::new().add_modifier(Modifier::REVERSED)),
+                Span::raw(after),
+            ]));
+            lines.push(Line::styled(
+                format!("{}/{} characters", chars.len(), p.max),
+                t.dim(),
+            ));
+            if let Some(e) = &p.error {
+                lines.extend(
+                    wrap(e, inner_w)
+                        .into_iter()
+                        .map(|r| Line::styled(r, t.error())),
+                );
+            }
+            ("Enter accepts · Esc cancels · ←→ Home End C-u C-w", lines)
+        }
+        Modal::Confirm {
+            question, on_all, ..
+        } => {
+            let mut lines: Vec<Line> = wrap(question, inner_w)
+                .into_iter()
+                .map(|r| Line::styled(r, t.warn()))
+                .collect();
+            let mut keys = vec![
+                Span::styled("y", t.key()),
+                Span::raw(" yes   "),
+                Span::styled("n", t.key()),
+                Span::raw(" no"),
+            ];
+            if on_all.is_some() {
+                keys.push(Span::raw("   "));
+                keys.push(Span::styled("a", t.key()));
+                keys.push(Span::raw(" all"));
+            }
+            lines.push(Line::from(keys));
+            ("question", lines)
+        }
+    };
+    let h = (lines.len() as u16 + 2).min(area.height);
+    let r = Rect::new(
+        area.x + (area.width - w) / 2,
+        area.y + area.height.saturating_sub(h) / 2,
+        w,
+        h,
+    );
+    Clear.render(r, buf);
+    Paragraph::new(lines)
+        .wrap(Wrap { trim: false })
+        .block(block(app, title))
+        .render(r, buf);
+}
+
+/// The marks of the checklist, for the help window.
+pub const LEGEND: &[(&str, &str)] = &[
+    (">", "the image the survey is at"),
+    ("abcde", "lightings captured (one letter each)"),
+    (".", "a lighting not captured yet"),
+    (
+        "!",
+        "a lighting whose saved image is damaged (R retakes it)",
+    ),
+    ("-", "no outputs yet"),
+    ("done", "outputs saved and current"),
+    ("stale", "outputs made from images changed since"),
+    ("DAMAGED", "an output file does not read"),
+    ("eN", "N hand edits in effect"),
+];
+
+fn help_lines(app: &App, width: usize) -> Vec<Line<'static>> {
+    let t = app.theme();
+    let screen = app.chrome.screen;
+    let mut sections: Vec<(String, Scope)> =
+        vec![(format!("{} screen", screen.title()), Scope::Screen(screen))];
+    for (title, scope) in keymap::scopes() {
+        let own = matches!(scope, Scope::Screen(_));
+        let pic = scope == Scope::Picture && !has_picture(screen);
+        if !own && !pic {
+            sections.push((title, scope));
+        }
+    }
+    let key_w = 11;
+    let desc_w = width.saturating_sub(key_w + 1).max(10);
+    let mut lines = Vec::new();
+    for (title, scope) in sections {
+        lines.push(Line::styled(title, t.title()));
+        for (k, d) in keymap::describe(scope) {
+            for (i, part) in wrap(d, desc_w).into_iter().enumerate() {
+                let key = if i == 0 { k.clone() } else { String::new() };
+                lines.push(Line::from(vec![
+                    Span::styled(format!("{key:>key_w$} "), t.key()),
+                    Span::raw(part),
+                ]));
+            }
+        }
+    }
+    lines.push(Line::styled("The checklist's marks", t.title()));
+    for (m, d) in LEGEND {
+        lines.push(Line::from(vec![
+            Span::styled(format!("{m:>key_w$} "), t.key()),
+            Span::raw(*d),
+        ]));
+    }
+    lines.push(Line::styled(
+        "The mouse, where the terminal sends it: a click chooses a checklist row or a \
+         line, the wheel scrolls lists and zooms pictures; Shift+drag selects text.",
+        t.dim(),
+    ));
+    lines
+}
+
+pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
+    let t = app.theme();
+    let r = Rect::new(
+        area.x + 1,
+        area.y + 1,
+        area.width.saturating_sub(2),
+        area.height.saturating_sub(2),
+    );
+    Clear.render(r, buf);
+    let inner_w = r.width.saturating_sub(2) as usize;
+    let (name, lines, scroll) = match o {
+        Overlay::Help { scroll } => ("help", help_lines(app, inner_w), scroll),
+        Overlay::Message { scroll } => {
+            let mut lines: Vec<Line> = Vec::new();
+            let mut entry = |e: &crate::tui::app::LogEntry, what: &str| {
+                if !lines.is_empty() {
+                    lines.push(Line::raw(""));
+                }
+                lines.push(Line::styled(
+                    format!("{what} {} {}", e.time, e.level.word()),
+                    t.title(),
+                ));
+                lines.extend(
+                    wrap(&e.text, inner_w)
+                        .into_iter()
+                        .map(|r| Line::styled(r, t.level(e.level))),
+                );
+            };
+            let last = app.chrome.log.last();
+            if let Some(e) = last {
+                entry(e, "newest,");
+            }
+            // An error that a later note pushed off the message row.
+            let trouble = app
+                .chrome
+                .log
+                .entries()
+                .rev()
+                .find(|e| e.level != crate::tui::app::Level::Info);
+            if let Some(e) = trouble.filter(|e| Some(*e) != last) {
+                entry(e, "last problem,");
+            }
+            if let Some(f) = app.chrome.log.file() {
+                lines.push(Line::raw(""));
+                lines.extend(
+                    wrap(
+                        &format!("Every message of this run is in {}", f.display()),
+                        inner_w,
+                    )
+                    .into_iter()
+                    .map(|r| Line::styled(r, t.dim())),
+                );
+            }
+            lines.push(Line::styled("m shows the whole log", t.dim()));
+            ("last message", lines, scroll)
+        }
+    };
+    let h = r.height.saturating_sub(2) as usize;
+    let total = lines.len();
+    let scroll = scroll.min(total.saturating_sub(h));
+    let title = if total > h {
+        format!(
+            "{name}: rows {}–{} of {total} · ↑↓ PgUp/PgDn scroll · Esc closes",
+            scroll + 1,
+            (scroll + h).min(total)
+        )
+    } else {
+        format!("{name} · Esc closes")
+    };
+    let shown: Vec<Line> = lines.into_iter().skip(scroll).take(h).collect();
+    Paragraph::new(shown)
+        .block(block(app, &title))
+        .render(r, buf);
+}
+
+/// Replaces every non-ASCII symbol with an ASCII look-alike, for terminals
+/// without Unicode (the ASCII preview mode promises plain ASCII output).
+pub fn asciify(area: Rect, buf: &mut Buffer) {
+    for y in area.top()..area.bottom() {
+        for x in area.left()..area.right() {
+            let Some(cell) = buf.cell_mut((x, y)) else {
+                continue;
+            };
+            if cell.symbol().is_ascii() {
+                continue;
+            }
+            let c = match cell.symbol().chars().next().unwrap_or(' ') {
+                '—' | '–' | '─' | '━' => '-',
+                '│' | '┃' => '|',
+                '…' | '·' => '.',
+                '×' => 'x',
+                '←' => '<',
+                '→' => '>',
+                '↑' => '^',
+                '↓' => 'v',
+                '°' => 'o',
+                '┌' | '┐' | '└' | '┘' | '├' | '┤' | '┬' | '┴' | '┼' => '+',
+                _ => '?',
+            };
+            cell.set_char(c);
+        }
+    }
+}

@@ -1,0 +1,72 @@
+//! Reading one image of a session back for the console: each lighting's
+//! grey image on its own (a damaged one is reported, the others still
+//! load), and the saved outputs and lines when they are current and read.
+
+use crate::formats;
+use crate::llv::pipeline::StageOutputs;
+use crate::session::{OutputState, Session};
+use crate::tui::event::{LoadedImage, SavedOutputs};
+
+pub fn image(s: &Session, k: u32) -> LoadedImage {
+    let mut out = LoadedImage {
+        k,
+        ..LoadedImage::default()
+    };
+    let Some(rec) = s.manifest().image(k) else {
+        return out;
+    };
+    for g in &rec.grey {
+        match formats::img::read_img(&s.path(&g.file)) {
+            Ok(f) => out.images.push((g.letter, f.image)),
+            Err(e) => out.damaged.push((g.letter, e.to_string())),
+        }
+    }
+    let state = crate::session::progress::output_state(rec);
+    out.accepted = state == OutputState::Done && out.damaged.is_empty();
+    out.lines = s.load_lines(k).ok();
+    if state == OutputState::Done
+        && out.damaged.is_empty()
+        && let Some(o) = rec.outputs.as_ref()
+        && let Some(outputs) = saved(s, k, o)
+    {
+        out.saved = Some(SavedOutputs {
+            outputs,
+            params: o.params.clone(),
+        });
+    } else {
+        out.accepted = false;
+    }
+    out
+}
+
+/// The outputs of image `k` from its files (`None` if one does not read).
+fn saved(s: &Session, k: u32, o: &crate::session::manifest::OutputRecord) -> Option<StageOutputs> {
+    let path = |ext: &str| s.path(&s.file_name(k, None, ext));
+    let edges_h = formats::edgefile::read_edges(&path("hpo")).ok()?;
+    let edges_v = formats::edgefile::read_edges(&path("vpo")).ok()?;
+    let mut lines_raw = formats::lines::read_lines(&path("lex")).ok()?;
+    if let Some(a) = &o.lex_attributes {
+        a.apply(&mut lines_raw);
+    }
+    let lines = s.load_lines(k).ok()?;
+    let mut corrected = Vec::new();
+    let mut imc: Vec<&str> = o
+        .files
+        .iter()
+        .map(|f| f.file.as_str())
+        .filter(|f| f.ends_with(".imc"))
+        .collect();
+    imc.sort_unstable();
+    for f in imc {
+        corrected.push(formats::img::read_img(&s.path(f)).ok()?.image);
+    }
+    Some(StageOutputs {
+        corrected,
+        edges_h,
+        edges_v,
+        lines_raw,
+        lines,
+        params: o.params.clone(),
+        ..StageOutputs::default()
+    })
+}

@@ -1,0 +1,107 @@
+//! The console's log file: every message of the run appended as it comes,
+//! flushed to disk, so it outlives a crash or a dropped connection. It is
+//! `NAME.log` in the open session's folder, or `vss/console.log` in the
+//! XDG state folder (`$XDG_STATE_HOME`, else `~/.local/state`) while no
+//! session is open. The file is opened once and written through that
+//! handle; an existing path that is not a plain file (a symlink) is refused.
+
+use std::fs::{File, OpenOptions};
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Default)]
+pub struct LogFile {
+    file: Option<(PathBuf, File)>,
+}
+
+/// The log file while no session is open.
+pub fn state_path() -> Option<PathBuf> {
+    let base = std::env::var_os("XDG_STATE_HOME")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| {
+            std::env::var_os("HOME")
+                .filter(|v| !v.is_empty())
+                .map(|h| PathBuf::from(h).join(".local/state"))
+        })?;
+    Some(base.join("vss").join("console.log"))
+}
+
+impl LogFile {
+    pub fn path(&self) -> Option<&Path> {
+        self.file.as_ref().map(|(p, _)| p.as_path())
+    }
+
+    /// Starts writing to `path` (its folder made if missing).
+    pub fn open(&mut self, path: &Path) -> io::Result<()> {
+        if self.path() == Some(path) {
+            return Ok(());
+        }
+        self.file = None;
+        if let Some(dir) = path.parent() {
+            std::fs::create_dir_all(dir)?;
+        }
+        let f = match std::fs::symlink_metadata(path) {
+            Err(e) if e.kind() == io::ErrorKind::NotFound => OpenOptions::new()
+                .append(true)
+                .create_new(true)
+                .open(path)?,
+            Err(e) => return Err(e),
+            Ok(m) if m.file_type().is_file() => OpenOptions::new().append(true).open(path)?,
+            Ok(_) => {
+                return Err(io::Error::other(
+                    "not a plain file (a symlink or a folder): not written through",
+                ));
+            }
+        };
+        let mut f = f;
+        writeln!(
+            f,
+            "--- vss console {} (process {}) ---",
+            crate::session::stamp::now_rfc3339(),
+            std::process::id()
+        )?;
+        f.sync_data()?;
+        self.file = Some((path.to_path_buf(), f));
+        Ok(())
+    }
+
+    /// Appends lines and flushes them to disk.
+    pub fn append(&mut self, lines: &[String]) -> io::Result<()> {
+        let Some((_, f)) = self.file.as_mut() else {
+            return Ok(());
+        };
+        let mut text = String::new();
+        for l in lines {
+            text.push_str(l);
+            text.push('\n');
+        }
+        f.write_all(text.as_bytes())?;
+        f.sync_data()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn appends_and_refuses_symlinks() {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join("a/console.log");
+        let mut l = LogFile::default();
+        l.open(&p).unwrap();
+        l.append(&["one".into(), "two".into()]).unwrap();
+        let mut again = LogFile::default();
+        again.open(&p).unwrap();
+        again.append(&["three".into()]).unwrap();
+        let text = std::fs::read_to_string(&p).unwrap();
+        assert!(
+            text.contains("one\ntwo\n") && text.ends_with("three\n"),
+            "{text}"
+        );
+        let link = d.path().join("link.log");
+        std::os::unix::fs::symlink(&p, &link).unwrap();
+        assert!(LogFile::default().open(&link).is_err());
+    }
+}
