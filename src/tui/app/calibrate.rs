@@ -133,6 +133,7 @@ impl CalibrateScreen {
                     Some(i) => {
                         let (_, v) = self.kept.remove(i);
                         self.result = None;
+                        self.refused = None;
                         ctx.info(format!("camera {cam}: {} dropped", v.name));
                     }
                     None => ctx.info(format!("camera {cam}: no view kept")),
@@ -142,6 +143,7 @@ impl CalibrateScreen {
             CalibrateAction::Centre => {
                 self.centre_stated = !self.centre_stated;
                 self.result = None;
+                self.refused = None;
                 Vec::new()
             }
             CalibrateAction::Solve => {
@@ -171,6 +173,7 @@ impl CalibrateScreen {
                 };
                 self.kept.push((cam, view));
                 self.result = None;
+                self.refused = None;
                 // The next view needs a new frame.
                 self.last = None;
                 ctx.info(format!("camera {cam}: view {n} kept"));
@@ -184,8 +187,15 @@ impl CalibrateScreen {
 
     fn solve(&mut self, cam: u32, ctx: &mut Ctx) {
         let Some(m) = ctx.cell.camera_model(cam) else {
+            let file = ctx
+                .cell
+                .cdf_paths
+                .get(cam as usize - 1)
+                .cloned()
+                .flatten()
+                .map_or("none named".into(), |p| p.display().to_string());
             ctx.error(format!(
-                "camera {cam}: the profile's .cdf gives no scale S (vss calibrate --camera {cam} --scale SX,SY makes the first one)"
+                "camera {cam}: no scale S to calibrate with — the profile's .cdf ({file}) is missing or lacks S, C or f; `vss calibrate --camera {cam} --scale SX,SY IMAGES…` makes the first one"
             ));
             return;
         };
