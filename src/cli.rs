@@ -55,7 +55,9 @@ pub mod sim;
 /// Options every subcommand shares.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Global {
-    /// Profile: a path to a .toml file, or a name from profiles/ (default: "default").
+    /// Profile: a path to a .toml file, or a NAME looked up as NAME.toml in
+    /// ./profiles, then ~/.config/vss/profiles (default: "default", built in
+    /// unless a default.toml is there).
     #[arg(long, global = true, value_name = "P")]
     pub profile: Option<String>,
 }
@@ -82,10 +84,32 @@ pub struct Cli {
     #[command(flatten)]
     pub global: Global,
     /// Preview mode of the console (default: picked from TERM and NO_COLOR).
-    #[arg(long, value_name = "MODE", value_parser = ["ascii", "braille", "blocks"])]
-    pub preview: Option<String>,
+    #[arg(long, value_name = "MODE", value_enum)]
+    pub preview: Option<Preview>,
     #[command(subcommand)]
     pub command: Option<Command>,
+}
+
+/// How the console draws its previews (`--preview`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Preview {
+    /// Plain ASCII: a character ramp for grey, `- | / \\` strokes for lines.
+    Ascii,
+    /// Braille dots (2 × 4 a cell) for everything.
+    Braille,
+    /// Half-blocks in 256-colour greys for images, Braille for lines.
+    Blocks,
+}
+
+impl Preview {
+    /// The mode's name, as typed after `--preview`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preview::Ascii => "ascii",
+            Preview::Braille => "braille",
+            Preview::Blocks => "blocks",
+        }
+    }
 }
 
 #[derive(Debug, Subcommand)]
@@ -118,10 +142,12 @@ pub enum Command {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => cli
-            .global
-            .load_profile()
-            .and_then(|p| crate::tui::run(p, crate::tui::mode::from_env(cli.preview.as_deref()))),
+        None => cli.global.load_profile().and_then(|p| {
+            crate::tui::run(
+                p,
+                crate::tui::mode::from_env(cli.preview.map(Preview::name)),
+            )
+        }),
         Some(cmd) => run(&cli.global, cmd),
     };
     match result {

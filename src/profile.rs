@@ -1,6 +1,11 @@
 //! TOML profiles: which cell the console talks to (grabber, relay board,
 //! lights, lighting configurations, the simulated cell's settings) and every
-//! LLV parameter. A profile is given by path or by name (`profiles/NAME.toml`).
+//! LLV parameter. A profile is given by path or by name: `NAME.toml` in
+//! `./profiles`, then in the user's `~/.config/vss/profiles` (the XDG config
+//! folder). The default profile — the simulated cell — and its cameras'
+//! `.cdf` files are compiled into the binary, so `vss` copied alone to the
+//! cell PC (or installed with `cargo install`) still starts; a `default.toml`
+//! in either folder takes its place.
 //!
 //! The structure is the serde schema below; loading adds the checks a person
 //! needs: unknown keys, wrong types and out-of-range values are errors naming
@@ -35,6 +40,35 @@ pub struct Profile {
     /// folder.
     #[serde(skip)]
     pub source: Option<PathBuf>,
+    /// Whether this is the built-in default profile ([`Profile::builtin`]),
+    /// whose `survey.cdf` names the compiled-in camera descriptions.
+    #[serde(skip)]
+    pub builtin: bool,
+}
+
+/// The built-in default profile: `profiles/default.toml`, compiled in.
+pub const BUILTIN_TOML: &str = include_str!("../profiles/default.toml");
+
+/// What the built-in profile is called in messages and where its relative
+/// paths point (the folder vss runs in).
+pub const BUILTIN_NAME: &str = "default (built in)";
+
+/// The simulated cameras' descriptions the built-in profile names in
+/// `survey.cdf`, compiled in: (path as the profile gives it, text).
+pub const BUILTIN_CDF: [(&str, &str); 4] = [
+    ("sim/cam1.cdf", include_str!("../profiles/sim/cam1.cdf")),
+    ("sim/cam2.cdf", include_str!("../profiles/sim/cam2.cdf")),
+    ("sim/cam3.cdf", include_str!("../profiles/sim/cam3.cdf")),
+    ("sim/cam4.cdf", include_str!("../profiles/sim/cam4.cdf")),
+];
+
+/// Where a profile was found ([`locate`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Origin {
+    /// A profile file.
+    File(PathBuf),
+    /// The built-in default profile ([`BUILTIN_TOML`]).
+    Builtin,
 }
 
 /// Which frame grabber, and how to reach it.
@@ -202,6 +236,11 @@ pub enum ProfileError {
     },
     #[error("profile `{name}` not found (looked for {tried})")]
     NotFound { name: String, tried: String },
+    #[error("camera {camera}: {source}")]
+    Camera {
+        camera: u32,
+        source: crate::formats::FormatError,
+    },
     #[error("{path}:{line}: {message}")]
     Invalid {
         path: PathBuf,
@@ -230,17 +269,59 @@ impl Profile {
         Ok(p)
     }
 
-    /// Loads a profile by path, or by name from the `profiles/` folder.
+    /// Loads a profile by path or by name ([`locate`]).
     pub fn load(name_or_path: &str) -> Result<Profile, ProfileError> {
-        let path = resolve(name_or_path)?;
-        // Bounded, so a huge file is refused unread.
-        let text = crate::fsutil::read_input_text(&path, MAX_LEN as u64).map_err(|source| {
-            ProfileError::Io {
-                path: path.clone(),
-                source,
+        match locate(name_or_path)? {
+            Origin::File(path) => {
+                let (text, path) = text_of(&Origin::File(path))?;
+                Profile::from_toml(&text, &path)
             }
-        })?;
-        Profile::from_toml(&text, &path)
+            Origin::Builtin => Profile::builtin(),
+        }
+    }
+
+    /// The built-in default profile: the simulated cell, every parameter at
+    /// its default. Its relative paths are taken from the folder vss runs
+    /// in, but its `.cdf` files are the compiled-in ones.
+    pub fn builtin() -> Result<Profile, ProfileError> {
+        let mut p = check::parse_checked(BUILTIN_TOML, Path::new(BUILTIN_NAME))?;
+        p.builtin = true;
+        Ok(p)
+    }
+
+    /// The camera description of camera `cam` (1-based) that `survey.cdf`
+    /// names: `None` when it names none. A file named but missing or
+    /// malformed is an error naming the file.
+    pub fn camera_cdf(&self, cam: u32) -> Result<Option<crate::formats::cdf::Cdf>, ProfileError> {
+        let Some(named) = usize::try_from(cam)
+            .ok()
+            .and_then(|c| c.checked_sub(1))
+            .and_then(|i| self.survey.cdf.get(i))
+        else {
+            return Ok(None);
+        };
+        let fail = |source| ProfileError::Camera {
+            camera: cam,
+            source,
+        };
+        if self.builtin
+            && let Some((_, text)) = BUILTIN_CDF.iter().find(|(n, _)| Path::new(n) == named)
+        {
+            let shown = Path::new(BUILTIN_NAME).join(named);
+            return crate::formats::cdf::parse_cdf(text, &shown)
+                .map(Some)
+                .map_err(fail);
+        }
+        crate::formats::cdf::read_cdf(&self.resolve_path(named))
+            .map(Some)
+            .map_err(fail)
+    }
+
+    /// The camera model of camera `cam` for lens correction: none when the
+    /// profile names no `.cdf` for it, it cannot be read, or it lacks the
+    /// intrinsic parameters.
+    pub fn camera_model(&self, cam: u32) -> Option<crate::llv::lens::CameraModel> {
+        self.camera_cdf(cam).ok().flatten()?.camera_model()
     }
 
     /// The folder relative paths of this profile are relative to (the
@@ -280,35 +361,83 @@ impl Profile {
     }
 }
 
-/// Finds a profile: an existing path as given, else `NAME.toml` in
-/// `./profiles`, then in the `profiles/` folder beside the crate.
-pub fn resolve(name_or_path: &str) -> Result<PathBuf, ProfileError> {
+/// The folders a profile name is looked up in, in order: `./profiles`,
+/// then `vss/profiles` in the XDG config folder (`$XDG_CONFIG_HOME`, else
+/// `~/.config`).
+pub fn search_dirs() -> Vec<PathBuf> {
+    let mut dirs = vec![PathBuf::from("profiles")];
+    // The XDG base directory rule, which is all a Linux cell PC needs; an
+    // empty or relative value is to be ignored, as the specification says.
+    let config = std::env::var_os("XDG_CONFIG_HOME")
+        .map(PathBuf::from)
+        .filter(|p| p.is_absolute())
+        .or_else(|| {
+            std::env::var_os("HOME")
+                .map(PathBuf::from)
+                .filter(|p| p.is_absolute())
+                .map(|h| h.join(".config"))
+        });
+    if let Some(c) = config {
+        dirs.push(c.join("vss").join("profiles"));
+    }
+    dirs
+}
+
+/// Finds a profile: an existing path as given, else `NAME.toml` in each of
+/// [`search_dirs`], else for `default` the built-in profile.
+pub fn locate(name_or_path: &str) -> Result<Origin, ProfileError> {
     let p = Path::new(name_or_path);
     if p.is_file() {
-        return Ok(p.to_path_buf());
+        return Ok(Origin::File(p.to_path_buf()));
     }
     let file = if name_or_path.ends_with(".toml") {
         name_or_path.to_string()
     } else {
         format!("{name_or_path}.toml")
     };
-    let candidates = [
-        PathBuf::from("profiles").join(&file),
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("profiles")
-            .join(&file),
-    ];
-    for c in &candidates {
-        if c.is_file() {
-            return Ok(c.clone());
-        }
+    let candidates: Vec<PathBuf> = search_dirs().into_iter().map(|d| d.join(&file)).collect();
+    if let Some(c) = candidates.iter().find(|c| c.is_file()) {
+        return Ok(Origin::File(c.clone()));
     }
+    if name_or_path == "default" {
+        return Ok(Origin::Builtin);
+    }
+    let mut tried: Vec<String> = vec![p.display().to_string()];
+    tried.extend(candidates.iter().map(|c| c.display().to_string()));
+    tried.dedup();
     Err(ProfileError::NotFound {
-        name: name_or_path.to_string(),
-        tried: candidates
-            .iter()
-            .map(|c| c.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", "),
+        name: crate::text::sanitize(name_or_path),
+        tried: tried.join(", "),
     })
+}
+
+/// The profile file a name or path names ([`locate`]); the built-in
+/// profile has none, so `default` is an error unless a file takes its
+/// place.
+pub fn resolve(name_or_path: &str) -> Result<PathBuf, ProfileError> {
+    match locate(name_or_path)? {
+        Origin::File(p) => Ok(p),
+        Origin::Builtin => Err(ProfileError::NotFound {
+            name: name_or_path.to_string(),
+            tried: "the built-in default has no file".into(),
+        }),
+    }
+}
+
+/// A profile's text and the name its errors use, wherever it was found:
+/// what `vss params import` edits.
+pub fn text_of(origin: &Origin) -> Result<(String, PathBuf), ProfileError> {
+    match origin {
+        Origin::File(path) => {
+            // Bounded, so a huge file is refused unread.
+            let text = crate::fsutil::read_input_text(path, MAX_LEN as u64).map_err(|source| {
+                ProfileError::Io {
+                    path: path.clone(),
+                    source,
+                }
+            })?;
+            Ok((text, path.clone()))
+        }
+        Origin::Builtin => Ok((BUILTIN_TOML.to_string(), PathBuf::from(BUILTIN_NAME))),
+    }
 }

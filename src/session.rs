@@ -381,13 +381,26 @@ impl Session {
         location: u32,
         cdf: Option<&Path>,
     ) -> Result<(), SessionError> {
+        let parsed = cdf.map(formats::cdf::read_cdf).transpose()?;
+        self.set_image_camera(k, camera, location, parsed.as_ref())
+    }
+
+    /// Records which camera at which location took image `k`, and writes
+    /// its camera description (as [`crate::profile::Profile::camera_cdf`]
+    /// gives it, from a file or built in) into the session as `NAMEk.cdf`.
+    pub fn set_image_camera(
+        &mut self,
+        k: u32,
+        camera: u32,
+        location: u32,
+        cdf: Option<&formats::cdf::Cdf>,
+    ) -> Result<(), SessionError> {
         self.writable()?;
         check_image_number(k)?;
         let cdf_record = match cdf {
-            Some(src) => {
-                let parsed = formats::cdf::read_cdf(src)?;
+            Some(parsed) => {
                 let file = self.file_name(k, None, "cdf");
-                let bytes = formats::cdf::format_cdf(&parsed).into_bytes();
+                let bytes = formats::cdf::format_cdf(parsed).into_bytes();
                 self.write_file(&file, &bytes)?;
                 Some(FileRecord {
                     hash: stamp::hash(&bytes),

@@ -138,8 +138,14 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             known.iter().collect::<String>()
         );
     }
-    let cdf = profile.cdf_path(a.camera).filter(|p| p.is_file());
-    sess.set_image_info(a.image, a.camera, 1, cdf.as_deref())
+    let cdf = profile.camera_cdf(a.camera).unwrap_or_else(|e| {
+        eprintln!(
+            "vss: warning: {e}; image {} has no camera description",
+            a.image
+        );
+        None
+    });
+    sess.set_image_camera(a.image, a.camera, 1, cdf.as_ref())
         .context("cannot record the camera in the session")?;
     for (letter, path) in &files {
         let stem = path

@@ -20,7 +20,7 @@ use super::Global;
 use crate::formats::par::{ParamSet, format_par, from_params, import_params, write_par};
 use crate::llv::Params;
 use crate::llv::params::{Kind, PARAMS};
-use crate::profile::{Profile, edit, resolve};
+use crate::profile::{Origin, Profile, edit};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -34,11 +34,11 @@ pub enum Cmd {
     List,
     /// Write a profile's LLV parameters as a parameter file (.par).
     Export {
-        /// Profile: a path to a .toml file or a name from profiles/.
+        /// Profile: a path to a .toml file or a name (as for --profile).
         profile: String,
-        /// Which parameters: lens, edges, lines, connect or all.
-        #[arg(long = "set", value_name = "SET", default_value = "all", value_parser = ["lens", "edges", "lines", "connect", "all"])]
-        set: String,
+        /// Which parameters.
+        #[arg(long = "set", value_name = "SET", value_enum, default_value_t = SetArg::All)]
+        set: SetArg,
         /// Output file (default: standard output).
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
@@ -53,6 +53,33 @@ pub enum Cmd {
     },
 }
 
+/// The parameter set `vss params export --set` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SetArg {
+    /// Lens correction (`vss lens`).
+    Lens,
+    /// Edge detection (`vss edges`).
+    Edges,
+    /// Line extraction (`vss lines`).
+    Lines,
+    /// CONNECT and corner closing (`vss connect`).
+    Connect,
+    /// Every parameter (`vss all`).
+    All,
+}
+
+impl From<SetArg> for ParamSet {
+    fn from(s: SetArg) -> ParamSet {
+        match s {
+            SetArg::Lens => ParamSet::Lens,
+            SetArg::Edges => ParamSet::Edges,
+            SetArg::Lines => ParamSet::Lines,
+            SetArg::Connect => ParamSet::Connect,
+            SetArg::All => ParamSet::All,
+        }
+    }
+}
+
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     match a.cmd {
         Cmd::List => {
@@ -61,7 +88,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         }
         Cmd::Export { profile, set, out } => {
             let p = Profile::load(&profile)?;
-            let set = ParamSet::parse(&set).context("unknown parameter set")?;
+            let set = ParamSet::from(set);
             let f = from_params(&p.llv, set);
             match out {
                 Some(o) => {
@@ -79,11 +106,12 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         }
         Cmd::Import { file, out } => {
             let base_name = g.profile.as_deref().unwrap_or("default");
-            let base_path = resolve(base_name)?;
-            let base_text =
-                crate::fsutil::read_input_text(&base_path, crate::profile::MAX_LEN as u64)
-                    .with_context(|| format!("cannot read profile {}", base_path.display()))?;
-            let base = Profile::from_toml(&base_text, &base_path)?;
+            let origin = crate::profile::locate(base_name)?;
+            let (base_text, base_path) = crate::profile::text_of(&origin)?;
+            let base = match origin {
+                Origin::File(_) => Profile::from_toml(&base_text, &base_path)?,
+                Origin::Builtin => Profile::builtin()?,
+            };
             let text = crate::fsutil::read_input(&file, crate::formats::max_len(&file))
                 .with_context(|| format!("cannot read {}", file.display()))?;
             let text = std::str::from_utf8(&text).map_err(|_| {
@@ -103,7 +131,13 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                         .with_context(|| format!("cannot write {}", o.display()))?;
                     let moved = o.parent().map(|d| d.canonicalize().ok())
                         != base_path.parent().map(|d| d.canonicalize().ok());
-                    if moved && base.survey.cdf.iter().any(|c| c.is_relative()) {
+                    let relative = base.survey.cdf.iter().any(|c| c.is_relative());
+                    if base.builtin && relative {
+                        errln!(
+                            "vss: note: {} names the built-in cameras' .cdf files (sim/cam1.cdf, …), which are not files: put them beside it or change survey.cdf",
+                            o.display()
+                        );
+                    } else if moved && relative {
                         errln!(
                             "vss: note: {} is in another folder than {}: its relative survey.cdf paths now point elsewhere",
                             o.display(),

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::Context as _;
 
 use super::Global;
-use crate::profile::Profile;
+use crate::llv::params::Stage;
 use crate::session::{OutputState, Session};
 
 #[derive(Debug, clap::Args)]
@@ -42,8 +42,8 @@ pub enum Cmd {
         #[arg(long, value_name = "K")]
         image: u32,
         /// First stage to re-run.
-        #[arg(long, value_name = "STAGE", value_parser = ["lens", "edges", "lines", "connect"], default_value = "edges")]
-        from: String,
+        #[arg(long, value_name = "STAGE", value_enum, default_value_t = FromStage::Edges)]
+        from: FromStage,
         /// Take over the lock of a console that is gone.
         #[arg(long)]
         take_over: bool,
@@ -61,6 +61,30 @@ pub enum Cmd {
     },
 }
 
+/// The stage `vss session redo --from` starts at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FromStage {
+    /// Lens correction and everything after it, on the grey images.
+    Lens,
+    /// Edges and everything after them, on the grey images.
+    Edges,
+    /// Line extraction and CONNECT, on the saved .hpo and .vpo.
+    Lines,
+    /// CONNECT alone, on the saved .lex.
+    Connect,
+}
+
+impl From<FromStage> for Stage {
+    fn from(s: FromStage) -> Stage {
+        match s {
+            FromStage::Lens => Stage::Lens,
+            FromStage::Edges => Stage::Edges,
+            FromStage::Lines => Stage::Lines,
+            FromStage::Connect => Stage::Connect,
+        }
+    }
+}
+
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     match a.command {
         Cmd::New { name, dir } => new(g, &name, dir),
@@ -71,7 +95,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             image,
             from,
             take_over,
-        } => redo(g, &session_dir(g, dir), image, &from, take_over),
+        } => redo(g, &session_dir(g, dir), image, from.into(), take_over),
         Cmd::Torture { dir, seed, limit } => {
             use std::io::Write as _;
             let mut out = std::io::stdout().lock();
@@ -106,55 +130,29 @@ fn session_dir(g: &Global, dir: PathBuf) -> PathBuf {
     if dir.is_dir() || !bare {
         return dir;
     }
-    match profile(g) {
-        Ok((p, _)) if p.survey.dir.join(&dir).is_dir() => p.survey.dir.join(&dir),
+    match g.load_profile() {
+        Ok(p) if p.survey.dir.join(&dir).is_dir() => p.survey.dir.join(&dir),
         _ => dir,
     }
 }
 
-/// The profile named with --profile; without one, `default` if it exists,
-/// else the built-in defaults.
-fn profile(g: &Global) -> anyhow::Result<(Profile, Option<PathBuf>)> {
-    let name = g.profile.as_deref().unwrap_or("default");
-    match crate::profile::resolve(name) {
-        Ok(path) => {
-            let p = g.load_profile()?;
-            Ok((p, Some(path)))
-        }
-        Err(_) if g.profile.is_none() => Ok((Profile::default(), None)),
-        Err(e) => Err(e.into()),
-    }
-}
-
 fn new(g: &Global, name: &str, dir: Option<PathBuf>) -> anyhow::Result<ExitCode> {
-    let (profile, profile_path) = profile(g)?;
+    let profile = g.load_profile()?;
     let parent = dir.unwrap_or_else(|| profile.survey.dir.clone());
     let mut s = Session::create(&parent, name, &profile)?;
-    // Camera descriptions named by the profile (relative to it) go into the
-    // session as NAMEk.cdf for every planned image of that camera.
-    let base = profile_path
-        .as_deref()
-        .and_then(Path::parent)
-        .map(Path::to_path_buf)
-        .unwrap_or_default();
+    // The camera descriptions the profile names go into the session as
+    // NAMEk.cdf for every planned image of that camera.
     let cams = s.manifest().session.cameras.max(1);
     for k in 1..=s.manifest().session.planned_images {
         let cam = (k - 1) % cams + 1;
-        let cdf = profile
-            .survey
-            .cdf
-            .get((cam - 1) as usize)
-            .map(|c| base.join(c));
-        if let Some(c) = &cdf
-            && !c.is_file()
-        {
-            errln!(
-                "vss: warning: camera {cam}: {} not found; image {k} has no camera description",
-                c.display()
-            );
-            continue;
-        }
-        s.set_image_info(k, cam, (k - 1) / cams + 1, cdf.as_deref())?;
+        let cdf = match profile.camera_cdf(cam) {
+            Ok(c) => c,
+            Err(e) => {
+                errln!("vss: warning: {e}; image {k} has no camera description");
+                continue;
+            }
+        };
+        s.set_image_camera(k, cam, (k - 1) / cams + 1, cdf.as_ref())?;
     }
     if let Some(w) = s.name().dos_warning(s.manifest().session.planned_images) {
         errln!("vss: note: {w}");
@@ -302,14 +300,8 @@ fn check(dir: &Path, strict: bool) -> anyhow::Result<ExitCode> {
     })
 }
 
-fn redo(g: &Global, dir: &Path, k: u32, from: &str, take_over: bool) -> anyhow::Result<ExitCode> {
-    let (profile, _) = profile(g)?;
-    let stage = match from {
-        "lens" => crate::llv::params::Stage::Lens,
-        "edges" => crate::llv::params::Stage::Edges,
-        "lines" => crate::llv::params::Stage::Lines,
-        _ => crate::llv::params::Stage::Connect,
-    };
+fn redo(g: &Global, dir: &Path, k: u32, stage: Stage, take_over: bool) -> anyhow::Result<ExitCode> {
+    let profile = g.load_profile()?;
     let mut s = if take_over {
         Session::open_take_over(dir)?
     } else {

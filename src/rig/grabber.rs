@@ -5,8 +5,9 @@
 //! What the shop floor needs from it (hardware.md §1): a timeout on every
 //! reply, bounded retries of commands that are safe to repeat, a re-sync
 //! after garbage, CRC checks per block and per frame with bad blocks re-read
-//! (in smaller blocks while the line is noisy), progress with cancel, and a
-//! clear error naming the port when the device vanishes.
+//! at once (in blocks sized to the line's error rate: [`transfer`]),
+//! progress with cancel, and a clear error naming the port when the device
+//! vanishes.
 
 use std::io::{self, ErrorKind};
 use std::time::{Duration, Instant};
@@ -60,6 +61,8 @@ pub struct WireStats {
     /// Blocks that failed their CRC or came short.
     pub bad_blocks: u64,
     pub resyncs: u64,
+    /// Times a block's answer stopped and the inter-byte timeout was waited.
+    pub stalls: u64,
 }
 
 impl WireStats {
@@ -79,8 +82,12 @@ pub struct ClientConfig {
     pub timeout: Duration,
     /// Retries of a command that is safe to repeat.
     pub retries: u32,
-    /// Bytes per READ (capped by the grabber's maxblock).
+    /// Bytes per READ (capped by the grabber's maxblock); a noisy line
+    /// gets smaller ones.
     pub block: u32,
+    /// The line's baud rate: the inter-byte timeout inside an answer is a
+    /// few byte times at it ([`transfer::inter_byte_for`]).
+    pub baud: u32,
 }
 
 impl ClientConfig {
@@ -89,14 +96,11 @@ impl ClientConfig {
             timeout: Duration::from_millis(g.timeout_ms.max(1)),
             retries: g.retries,
             block: g.block.max(1),
+            baud: g.baud.max(1),
         }
     }
 }
 
-/// The smallest block a noisy line shrinks READs to.
-const MIN_BLOCK: u32 = 128;
-/// Good blocks in a row before the block size doubles again.
-const GROW_AFTER: u32 = 4;
 /// A reply line longer than this is garbage.
 const MAX_LINE: usize = 256;
 /// Quiet time that ends a re-sync.
@@ -122,8 +126,17 @@ pub struct VsgClient<P: Link> {
     port: Option<P>,
     name: String,
     cfg: ClientConfig,
-    /// Longest silence inside a reply once it has started.
+    /// Longest silence inside a reply line once it has started.
     gap: Duration,
+    /// Longest silence inside a block's answer ([`transfer`]), and what
+    /// it starts from (it doubles when the line's gaps prove longer).
+    inter_byte: Duration,
+    base_inter_byte: Duration,
+    /// When bytes last came in.
+    last_rx: Option<Instant>,
+    /// Requests were given up on during a transfer: their answers may
+    /// still be on the way.
+    untracked: bool,
     info: Option<GrabberInfo>,
     frame: Option<FrameInfo>,
     /// Received, not yet consumed bytes.
@@ -150,11 +163,16 @@ impl<P: Link> VsgClient<P> {
     /// Wraps a stream; call [`VsgClient::connect`] before use.
     pub fn new(port: P, name: &str, cfg: ClientConfig) -> Self {
         let gap = (cfg.timeout / 5).clamp(Duration::from_millis(50), Duration::from_millis(500));
+        let inter_byte = transfer::inter_byte_for(cfg.baud).min(gap);
         VsgClient {
             port: Some(port),
             name: name.to_string(),
             cfg,
             gap,
+            inter_byte,
+            base_inter_byte: inter_byte,
+            last_rx: None,
+            untracked: false,
             info: None,
             frame: None,
             rx: Vec::new(),
@@ -217,6 +235,7 @@ impl<P: Link> VsgClient<P> {
                     )));
                 }
                 Ok(n) => {
+                    self.last_rx = Some(Instant::now());
                     self.stats.rx += n as u64;
                     self.rx
                         .extend_from_slice(self.buf.get(..n).unwrap_or_default());
@@ -441,124 +460,6 @@ impl<P: Link> VsgClient<P> {
             .map(|_| ())
     }
 
-    /// One READ of `len` bytes at `off`, with its CRC checked.
-    /// `Ok(None)` means the block came bad (short, garbled, wrong CRC).
-    fn read_block(&mut self, off: u32, len: u32) -> Result<Option<Vec<u8>>, RigError> {
-        let cmd = Command::Read { off, len };
-        self.send(&cmd)?;
-        let mut stale = 0;
-        let fail = loop {
-            if stale > MAX_STALE {
-                break Some(ReadFail::Garbage(format!(
-                    "{stale} replies that do not fit `{cmd}`"
-                )));
-            }
-            stale += 1;
-            match self.read_reply() {
-                Ok(Reply::Data {
-                    off: o,
-                    len: l,
-                    crc,
-                }) if o == off && l == len => match self.read_exact(len as usize) {
-                    Ok(data) if crc32(&data) == crc => return Ok(Some(data)),
-                    Ok(_) => break None,
-                    Err(f) => break Some(f),
-                },
-                Ok(Reply::Data { len: l, .. }) => {
-                    if let Err(f) = self.skip_stale(l) {
-                        break Some(f);
-                    }
-                }
-                Ok(Reply::Err {
-                    code: ErrCode::Checksum,
-                    ..
-                }) => break None,
-                Ok(r @ Reply::Err { .. }) => return self.device_err(&cmd, r),
-                Ok(_) => {}
-                Err(f) => break Some(f),
-            }
-        };
-        if let Some(ReadFail::Vanished(e)) = fail {
-            return Err(self.vanished(e));
-        }
-        self.stats.bad_blocks += 1;
-        self.resync()?;
-        Ok(None)
-    }
-
-    /// The whole frozen frame, block by block.
-    fn read_frame(
-        &mut self,
-        frame: FrameInfo,
-        progress: &mut dyn FnMut(usize, usize) -> bool,
-    ) -> Result<GreyImage, RigError> {
-        let total = frame.len();
-        if total == 0 || total > MAX_FRAME {
-            return Err(RigError::Garbled {
-                port: self.name.clone(),
-                command: "FREEZE".into(),
-                detail: format!("frame size {} x {}", frame.width, frame.height),
-                attempts: 1,
-            });
-        }
-        let maxblock = self.info.as_ref().map_or(u32::MAX, |i| i.maxblock.max(1));
-        let full = self.cfg.block.min(maxblock).max(1);
-        let mut block = full;
-        let mut good_run = 0;
-        let mut data = Vec::with_capacity(total);
-        let budget = 2 + 2 * self.cfg.retries;
-        let mut failures = 0;
-        while data.len() < total {
-            let off = data.len();
-            let len = block.min((total - off) as u32);
-            match self.read_block(off as u32, len)? {
-                Some(bytes) => {
-                    data.extend_from_slice(&bytes);
-                    self.stats.payload += u64::from(len);
-                    failures = 0;
-                    good_run += 1;
-                    if good_run >= GROW_AFTER && block < full {
-                        block = (block * 2).min(full);
-                        good_run = 0;
-                    }
-                    if !progress(data.len(), total) {
-                        return Err(RigError::Cancelled {
-                            port: self.name.clone(),
-                            done: data.len(),
-                            total,
-                        });
-                    }
-                }
-                None => {
-                    good_run = 0;
-                    if block > MIN_BLOCK {
-                        // A noisy line: smaller blocks get through.
-                        block = (block / 2).max(MIN_BLOCK);
-                    } else {
-                        failures += 1;
-                        if failures >= budget {
-                            return Err(RigError::BlockCrc {
-                                port: self.name.clone(),
-                                offset: off,
-                                attempts: failures,
-                            });
-                        }
-                    }
-                }
-            }
-        }
-        let got = crc32(&data);
-        if got != frame.crc {
-            return Err(RigError::FrameCrc {
-                port: self.name.clone(),
-                expected: frame.crc,
-                got,
-            });
-        }
-        GreyImage::new(frame.width as usize, frame.height as usize, data)
-            .map_err(|e| RigError::Config(e.to_string()))
-    }
-
     fn garbled(&self, cmd: &str, r: &Reply) -> RigError {
         RigError::Garbled {
             port: self.name.clone(),
@@ -733,3 +634,4 @@ impl<P: Link> FrameGrabber for VsgClient<P> {
 
 #[cfg(test)]
 mod tests;
+pub mod transfer;

@@ -58,6 +58,37 @@ pub fn decode_line(line: &[u8]) -> Result<&str, LineError> {
     std::str::from_utf8(text).map_err(|_| LineError::NotAscii)
 }
 
+/// The longest reply line looked for by [`find_reply`].
+const MAX_REPLY_LINE: usize = 256;
+
+/// The first complete reply line in `buf` that checks out (`TEXT*HH`, then
+/// `\r\n` or `\n`) and parses as a [`Reply`], with whatever comes before it
+/// skipped — the tail of a block given up on, or a line damaged on the way.
+/// A line may start right after other bytes: its start is the last `OK`,
+/// `ERR ` or `DATA ` before the line end whose line checks out (a DATA
+/// line's text holds none of them). Returns where the line starts, where it
+/// ends (after the `\n`) and the reply.
+pub fn find_reply(buf: &[u8]) -> Option<(usize, usize, Reply)> {
+    let mut from = 0;
+    while let Some(nl) = buf.get(from..)?.iter().position(|&b| b == b'\n') {
+        let end = from + nl + 1;
+        let line = buf.get(..from + nl)?;
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        let lo = line.len().saturating_sub(MAX_REPLY_LINE);
+        for s in (lo..line.len()).rev() {
+            let t = line.get(s..).unwrap_or_default();
+            if !(t.starts_with(b"OK") || t.starts_with(b"ERR ") || t.starts_with(b"DATA ")) {
+                continue;
+            }
+            if let Some(r) = decode_line(t).ok().and_then(Reply::parse) {
+                return Some((s, end, r));
+            }
+        }
+        from = end;
+    }
+    None
+}
+
 /// CRC-32 (IEEE, as in zlib).
 pub fn crc32(bytes: &[u8]) -> u32 {
     crc32fast::hash(bytes)
@@ -490,6 +521,27 @@ mod tests {
             crc: 7,
         };
         assert_eq!(FrameInfo::parse(&f.format()), Some(f));
+    }
+
+    #[test]
+    fn replies_are_found_behind_junk() {
+        let data = Reply::Data {
+            off: 16,
+            len: 4,
+            crc: 0xABCD_EF01,
+        };
+        let mut buf = b"\x00\nxyz*OK".to_vec();
+        let start = buf.len();
+        buf.extend_from_slice(&data.encode());
+        buf.extend_from_slice(b"rest");
+        let (s, e, r) = find_reply(&buf).expect("found");
+        assert_eq!((s, r), (start, data.clone()));
+        assert_eq!(buf.get(e..), Some(&b"rest"[..]));
+        // A damaged line is no line.
+        let mut bad = data.encode();
+        bad[3] ^= 1;
+        assert_eq!(find_reply(&bad), None);
+        assert_eq!(find_reply(b"DATA 1 2"), None);
     }
 
     #[test]

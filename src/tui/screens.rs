@@ -353,7 +353,11 @@ pub fn pointer(
             ScreenId::Pipeline => {
                 let n = crate::llv::params::PARAMS.len();
                 let inner_h = p.height as usize;
-                let room = inner_h.saturating_sub(6usize.min(inner_h / 2)).max(1);
+                let doc = app.screens.pipeline.param_spec().doc;
+                let doc_rows = chrome::wrap(doc, p.width as usize).len();
+                let room = inner_h
+                    .saturating_sub((5 + doc_rows).min(inner_h / 2))
+                    .max(1);
                 let (start, shown, above) = window_span(n, app.screens.pipeline.param, room);
                 let i = r.checked_sub(usize::from(above))?;
                 (i < shown).then_some(Pointer::Param(start + i))

@@ -6,15 +6,3 @@
 pub fn clean(s: &str) -> String {
     crate::text::sanitize(s)
 }
-
-#[cfg(test)]
-mod tests {
-    use super::clean;
-
-    #[test]
-    fn strips_escapes_and_controls() {
-        assert_eq!(clean("cube\x1b[2J1a\r\n\x07"), "cube[2J1a");
-        assert_eq!(clean("a\tb\u{9b}c\u{202e}d"), "a bcd");
-        assert_eq!(clean("Grün 25°"), "Grün 25°");
-    }
-}

@@ -81,18 +81,29 @@ fn selftest_json_has_stable_keys_and_sane_values() {
 
 #[test]
 fn selftest_refuses_bad_arguments() {
-    for args in [
-        &["selftest", "--noise", "-1"][..],
-        &["selftest", "--size", "8"],
-        &["selftest", "--scenes", "0"],
-        &["selftest", "--noise", "two"],
-        &["selftest", "--family", "spheres"],
-        &["selftest", "--export", "/tmp/x", "--score", "/tmp/y"],
+    // 2: refused by the argument parser; 1: refused by the command with
+    // its reason. A panic (101) or a signal is not a refusal.
+    for (args, code, reason) in [
+        (&["selftest", "--noise=-1"][..], 2, "not a noise level"),
+        (&["selftest", "--noise", "-1"], 2, "unexpected argument"),
+        (&["selftest", "--size", "8"], 1, "too small"),
+        (&["selftest", "--scenes", "0"], 1, "at least 1"),
+        (&["selftest", "--noise", "two"], 2, "two"),
+        (&["selftest", "--family", "spheres"], 2, "spheres"),
+        (
+            &["selftest", "--export", "/tmp/x", "--score", "/tmp/y"],
+            2,
+            "cannot be used with",
+        ),
     ] {
         let out = vss().args(args).output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{args:?} should fail");
-        assert!(!stderr.trim().is_empty(), "{args:?}: no reason given");
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains(reason),
+            "{args:?}: no reason given: {stderr}"
+        );
         assert!(out.stdout.is_empty(), "{args:?}: printed results anyway");
     }
 }

@@ -250,3 +250,27 @@ fn profiles_survive_to_toml_and_back() {
         assert_eq!(q, p, "{name}");
     }
 }
+
+/// The compiled-in default is the shipped `profiles/default.toml`, and its
+/// cameras' descriptions are the shipped `profiles/sim/*.cdf`.
+#[test]
+fn the_built_in_profile_is_the_shipped_default() {
+    let file = Profile::load(profiles_dir().join("default.toml").to_str().unwrap()).unwrap();
+    let mut built = Profile::builtin().unwrap();
+    assert!(built.builtin && built.source.is_none());
+    built.builtin = false;
+    built.source = file.source.clone();
+    assert_eq!(built, file);
+    let built = Profile::builtin().unwrap();
+    for cam in 1..=4 {
+        let want = vss::formats::cdf::read_cdf(&file.cdf_path(cam).unwrap()).unwrap();
+        assert_eq!(
+            built.camera_cdf(cam).unwrap(),
+            Some(want.clone()),
+            "camera {cam}"
+        );
+        assert_eq!(file.camera_cdf(cam).unwrap(), Some(want));
+        assert!(built.camera_model(cam).is_some());
+    }
+    assert_eq!(built.camera_cdf(5).unwrap(), None);
+}

@@ -26,6 +26,22 @@ fn vss(args: &[&str], cwd: &Path) -> std::process::Output {
     out
 }
 
+/// Thirty edge points down column 20 of a 64 × 48 picture.
+fn edge_column() -> EdgePoints {
+    EdgePoints {
+        dir: Some(ScanDir::Horizontal),
+        width: 64,
+        height: 48,
+        points: (0..30)
+            .map(|i| EdgePoint {
+                x: 20.0,
+                y: i as f32 + 5.0,
+                response: 25.0,
+            })
+            .collect(),
+    }
+}
+
 fn svg_parses(p: &Path) -> resvg::usvg::Tree {
     let text = std::fs::read_to_string(p).unwrap();
     resvg::usvg::Tree::from_str(&text, &resvg::usvg::Options::default())
@@ -57,9 +73,7 @@ fn ldr_file_prints_with_its_image_size() {
     );
     let tree = svg_parses(&dir.path().join("test1.svg"));
     assert_eq!(tree.size().width(), 300.0);
-    if !gs::have_gs() {
-        return;
-    }
+    gs::require_gs();
     let page = &gs::render(&dir.path().join("test1.ps"), "a4", 72)[0];
     let bx = gs::long_run_box(page, 150).expect("frame");
     let (fw, fh) = ((bx.2 - bx.0) as f64, (bx.3 - bx.1) as f64);
@@ -96,9 +110,7 @@ fn img_files_print_six_per_page() {
         dir.path().join("cube1a.ps").is_file(),
         "default output beside the input"
     );
-    if !gs::have_gs() {
-        return;
-    }
+    gs::require_gs();
     assert_eq!(
         gs::render(&dir.path().join("cube1.ps"), "letter", 36).len(),
         2
@@ -114,18 +126,7 @@ fn session_report_has_every_image() {
     let mut p = Profile::default();
     p.survey.cameras = 2;
     let mut s = Session::create(dir.path(), "cube", &p).unwrap();
-    let e = EdgePoints {
-        dir: Some(ScanDir::Horizontal),
-        width: 64,
-        height: 48,
-        points: (0..30)
-            .map(|i| EdgePoint {
-                x: 20.0,
-                y: i as f32 + 5.0,
-                response: 25.0,
-            })
-            .collect(),
-    };
+    let e = edge_column();
     let l = [Segment::new(Point::new(20.0, 5.0), Point::new(20.0, 35.0))];
     for k in 1..=2 {
         s.save_image(
@@ -172,9 +173,7 @@ fn session_report_has_every_image() {
     let text = std::fs::read_to_string(dir.path().join("all.ps")).unwrap();
     assert!(text.contains("%%Pages: 4"), "two pages per image");
     assert!(text.contains("edges.half_width = 4"), "parameters printed");
-    if !gs::have_gs() {
-        return;
-    }
+    gs::require_gs();
     assert_eq!(gs::render(&dir.path().join("all.ps"), "a4", 36).len(), 4);
     assert_eq!(
         gs::render(&dir.path().join("cube.ps"), "letter", 36).len(),
@@ -190,18 +189,7 @@ fn the_console_s_export_and_vss_report_write_the_same_pages() {
     use vss::report::survey::{self, Targets};
     let dir = tempfile::tempdir().unwrap();
     let mut s = Session::create(dir.path(), "cube", &Profile::default()).unwrap();
-    let e = EdgePoints {
-        dir: Some(ScanDir::Horizontal),
-        width: 64,
-        height: 48,
-        points: (0..30)
-            .map(|i| EdgePoint {
-                x: 20.0,
-                y: i as f32 + 5.0,
-                response: 25.0,
-            })
-            .collect(),
-    };
+    let e = edge_column();
     let l = [
         Segment::new(Point::new(20.0, 5.0), Point::new(20.0, 35.0)),
         Segment::new(Point::new(30.0, 5.0), Point::new(30.0, 35.0)),

@@ -19,9 +19,7 @@ fn to_device(bx: (u32, u32, u32, u32), w: f64, h: f64, x: f64, y: f64) -> (f64, 
 
 #[test]
 fn lines_page_draws_lines_where_they_belong_on_any_paper() {
-    if !gs::have_gs() {
-        return;
-    }
+    gs::require_gs();
     let dir = tempfile::tempdir().unwrap();
     let (w, h) = (200.0, 100.0);
     let lines = [
@@ -75,9 +73,7 @@ fn target(w: usize, h: usize) -> GreyImage {
 
 #[test]
 fn grey_page_prints_pixels_in_place_and_six_per_page() {
-    if !gs::have_gs() {
-        return;
-    }
+    gs::require_gs();
     let dir = tempfile::tempdir().unwrap();
     let img = target(64, 48);
     let one = dir.path().join("one.ps");
@@ -123,9 +119,7 @@ fn grey_page_prints_pixels_in_place_and_six_per_page() {
 
 #[test]
 fn survey_report_renders_every_page() {
-    if !gs::have_gs() {
-        return;
-    }
+    gs::require_gs();
     let dir = tempfile::tempdir().unwrap();
     let edges = |dir| EdgePoints {
         dir: Some(dir),

@@ -177,6 +177,7 @@ fn the_driver_loads_and_transfers_over_a_pty() {
         timeout: Duration::from_millis(500),
         retries: 2,
         block: 700,
+        baud: 921_600,
     };
     let mut g = VsgClient::open(sim.grabber_path(), 921_600, cfg).expect("connect");
     assert_eq!(g.info().map(|i| i.maxblock), Some(1024));

@@ -187,9 +187,7 @@ fn far_line_vertex_still_prints_in_ghostscript_and_svg() {
         longest_digit_run(&ps) < 10,
         "absurd number in the PostScript"
     );
-    if !gs::have_gs() {
-        return;
-    }
+    gs::require_gs();
     let page = &gs::render(&ps_path, "a4", 72)[0];
     let bx = gs::long_run_box(page, 150).expect("frame");
     let (fw, fh) = ((bx.2 - bx.0) as f64, (bx.3 - bx.1) as f64);

@@ -216,11 +216,20 @@ fn bad_names_are_refused() {
         0,
         "nothing created"
     );
-    assert!(Session::create(dir.path(), "cube", &profile()).is_ok());
-    assert!(matches!(
-        Session::create(dir.path(), "cube", &profile()),
-        Err(SessionError::Exists { .. } | SessionError::Locked { .. })
-    ));
+    // A second create of the same name finds the manifest, whether the first
+    // session is still open (its lock held) or closed: it exists.
+    let first = Session::create(dir.path(), "cube", &profile()).unwrap();
+    let again = Session::create(dir.path(), "cube", &profile());
+    assert!(
+        matches!(again, Err(SessionError::Exists { .. })),
+        "{again:?}"
+    );
+    drop(first);
+    let again = Session::create(dir.path(), "cube", &profile());
+    assert!(
+        matches!(again, Err(SessionError::Exists { .. })),
+        "{again:?}"
+    );
 }
 
 #[test]

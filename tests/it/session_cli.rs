@@ -71,7 +71,12 @@ fn new_show_check_and_bad_names() {
         "camera 1's cdf copied for image 1"
     );
     assert!(!d.join("cube/cube2.cdf").exists());
-    assert!(text(&o).contains("cam2.cdf not found"), "{}", text(&o));
+    assert!(
+        text(&o).contains("camera 2: ./cam2.cdf: cannot read")
+            && text(&o).contains("image 2 has no camera description"),
+        "{}",
+        text(&o)
+    );
     assert_eq!(
         std::fs::read_to_string(d.join("cube/cube.ses")).unwrap(),
         "2\n2\n2\n"
@@ -214,10 +219,20 @@ fn lock_names_a_live_holder_and_yields_only_when_it_is_gone() {
         .spawn()
         .unwrap();
     let mut out = BufReader::new(child.stdout.take().unwrap());
+    // Killed however the test ends: a failed assertion must not leave it
+    // saving (and holding the test's output open) for a million rounds.
+    struct Reap(std::process::Child);
+    impl Drop for Reap {
+        fn drop(&mut self) {
+            let _ = self.0.kill();
+            let _ = self.0.wait();
+        }
+    }
+    let mut child = Reap(child);
     let mut line = String::new();
     out.read_line(&mut line).unwrap();
     assert_eq!(line.trim(), "ready");
-    let pid = child.id();
+    let pid = child.0.id();
     for args in [
         &["session", "redo", "held", "--image", "1"][..],
         &["session", "redo", "held", "--image", "1", "--take-over"][..],
@@ -234,8 +249,8 @@ fn lock_names_a_live_holder_and_yields_only_when_it_is_gone() {
     // show works read-only and names the holder.
     let t = text(&vss(&["session", "show", "held"], d));
     assert!(t.contains(&format!("in use by process {pid}")), "{t}");
-    child.kill().unwrap();
-    child.wait().unwrap();
+    child.0.kill().unwrap();
+    child.0.wait().unwrap();
     let o = vss(&["session", "redo", "held", "--image", "1"], d);
     assert!(!o.status.success());
     assert!(text(&o).contains("--take-over"), "{}", text(&o));
@@ -352,5 +367,29 @@ fn hostile_manifest_text_never_reaches_the_terminal() {
     for f in ["r.ps", "r1.svg"] {
         let found = terminal_controls(&std::fs::read(d.join(f)).unwrap());
         assert!(found.is_empty(), "{f}: {found:?}");
+    }
+}
+
+/// The choice arguments refuse what they do not know, listing what they do.
+#[test]
+fn choice_arguments_list_their_values() {
+    let d = tempfile::tempdir().unwrap();
+    for (args, values) in [
+        (
+            &["session", "redo", "x", "--image", "1", "--from", "sideways"][..],
+            "[possible values: lens, edges, lines, connect]",
+        ),
+        (
+            &["--preview", "sideways"][..],
+            "[possible values: ascii, braille, blocks]",
+        ),
+        (
+            &["params", "export", "default", "--set", "sideways"][..],
+            "[possible values: lens, edges, lines, connect, all]",
+        ),
+    ] {
+        let o = vss(args, d.path());
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(text(&o).contains(values), "{args:?}: {}", text(&o));
     }
 }

@@ -122,6 +122,8 @@ pub struct Console {
     parser: Arc<Mutex<vt100::Parser>>,
     pub raw: Arc<Mutex<Vec<u8>>>,
     pub dir: tempfile::TempDir,
+    /// Started in another console's folder.
+    pub twin: bool,
 }
 
 #[allow(dead_code)]
@@ -154,6 +156,18 @@ impl Console {
         env: &[(&str, &str)],
         args: &[&str],
     ) -> Console {
+        let cwd = dir.path().to_path_buf();
+        Console::spawn(&cwd, dir, cols, rows, env, args)
+    }
+
+    fn spawn(
+        cwd: &Path,
+        dir: tempfile::TempDir,
+        cols: u16,
+        rows: u16,
+        env: &[(&str, &str)],
+        args: &[&str],
+    ) -> Console {
         let pty = native_pty_system();
         let size = PtySize {
             rows,
@@ -164,11 +178,11 @@ impl Console {
         let pair = pty.openpty(size).unwrap();
         let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_vss"));
         cmd.args(args);
-        cmd.cwd(dir.path());
+        cmd.cwd(cwd);
         cmd.env("TERM", "xterm-256color");
         // The log file goes to the session folder or here, never to the
         // tester's own state folder.
-        cmd.env("XDG_STATE_HOME", dir.path().join("state"));
+        cmd.env("XDG_STATE_HOME", cwd.join("state"));
         cmd.env_remove("NO_COLOR");
         for (k, v) in env {
             cmd.env(k, v);
@@ -199,6 +213,7 @@ impl Console {
             parser,
             raw,
             dir,
+            twin: false,
         }
     }
 
@@ -267,6 +282,11 @@ impl Console {
         self.wait(text, secs, |s| s.contains(text))
     }
 
+    /// Waits for `text`, which may be wrapped over rows.
+    pub fn wait_words(&self, text: &str, secs: u64) -> String {
+        self.wait(text, secs, |s| flat(s).contains(text))
+    }
+
     pub fn wait_exit(&mut self, secs: u64) {
         let end = Instant::now() + Duration::from_secs(secs);
         while Instant::now() < end {
@@ -279,6 +299,46 @@ impl Console {
         }
         let _ = self.child.kill();
         panic!("vss did not exit; screen:\n{}", self.screen());
+    }
+
+    /// Quits (answering yes if asked) and starts the console again in the
+    /// same folder, with the same profile.
+    pub fn restart(mut self, cols: u16, rows: u16, env: &[(&str, &str)]) -> Console {
+        self.send("q");
+        self.wait_exit(15);
+        let dir = std::mem::replace(&mut self.dir, tempfile::tempdir().unwrap());
+        Console::start_in(dir, cols, rows, env, &["--profile", "cell.toml"])
+    }
+
+    /// Quits, lets `setup` change the folder, and starts again there at
+    /// the same size.
+    pub fn restart_after(mut self, setup: impl FnOnce(&Path)) -> Console {
+        let (rows, cols) = self.parser.lock().unwrap().screen().size();
+        self.send("q");
+        self.wait_exit(15);
+        let dir = std::mem::replace(&mut self.dir, tempfile::tempdir().unwrap());
+        setup(dir.path());
+        Console::start_in(dir, cols, rows, &[], &["--profile", "cell.toml"])
+    }
+
+    /// A second console started in the same folder (its own `dir` is an
+    /// empty one, for its drop).
+    pub fn another(&self, cols: u16, rows: u16) -> Console {
+        let mut c = Console::spawn(
+            self.dir.path(),
+            tempfile::tempdir().unwrap(),
+            cols,
+            rows,
+            &[],
+            &["--profile", "cell.toml"],
+        );
+        c.twin = true;
+        c
+    }
+
+    /// The child's exit status, once it has ended.
+    pub fn exit_code(&mut self) -> Option<u32> {
+        self.child.try_wait().ok().flatten().map(|s| s.exit_code())
     }
 
     pub fn sessions(&self) -> PathBuf {
@@ -335,16 +395,12 @@ pub const EDIT: Scope = Scope::Screen(ScreenId::Edit);
 #[allow(dead_code)]
 pub const SESSION: Scope = Scope::Screen(ScreenId::Session);
 
-/// The first key the table binds to `action` in `scope` (or globally).
+/// The first key the table binds to `action` in `scope`, else among the
+/// picture keys (a screen with a picture), else globally.
 pub fn key_of(scope: Scope, action: Action) -> Key {
-    KEYMAP
+    [scope, Scope::Picture, Scope::Global]
         .iter()
-        .find(|b| b.scope == scope && b.action == action)
-        .or_else(|| {
-            KEYMAP
-                .iter()
-                .find(|b| b.scope == Scope::Global && b.action == action)
-        })
+        .find_map(|sc| KEYMAP.iter().find(|b| b.scope == *sc && b.action == action))
         .map(|b| b.key)
         .unwrap_or_else(|| panic!("no key for {action:?} in {scope:?}"))
 }
@@ -408,6 +464,12 @@ pub fn line_count(screen: &str) -> Option<usize> {
         }
         digits.parse().ok()
     })
+}
+
+/// The screen's text with every run of blanks and line ends made one
+/// space, so wrapped words read on.
+pub fn flat(screen: &str) -> String {
+    screen.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// Whether `dir` holds a file `name`.

@@ -157,7 +157,8 @@ fn no_color_writes_no_colour_and_previews_in_ascii() {
     let mut c = Console::start(90, 28, &[("NO_COLOR", "1")]);
     c.survey(1);
     c.send("3");
-    c.wait_text("[ascii]", 10);
+    let s = c.wait_text("parameters", 10);
+    assert!(s.is_ascii(), "ASCII previews and frames:\n{s}");
     c.send("2");
     c.send("g");
     c.wait_text("camera 1 128", 20);

@@ -37,6 +37,7 @@ impl App {
                 cur.outputs = Some(out);
                 cur.outputs_params = Some(r.params);
                 cur.from_disk = false;
+                cur.in_session = false;
                 cur.failed = None;
                 self.screens.edit.clear();
                 self.ctx().pipeline_done();

@@ -50,8 +50,8 @@ pub struct SurveyScreen {
 }
 
 /// The rule of session names, shown before typing one.
-pub const NAME_RULE: &str = "letters, digits, _ and -, starting with a letter or _; \
-     end with a letter (q1 would make q11a.img for image 11)";
+pub const NAME_RULE: &str = "letters, digits, _ and -, starting with a letter or _, at most \
+     32; end with a letter: q1 would name its image 1 q11a.img, which reads as image 11 of q";
 
 impl SurveyScreen {
     /// The checklist row the keys act on.
@@ -289,10 +289,12 @@ impl Ctx<'_> {
         cur.frames.retain(|f| f.0 != letter);
         cur.damaged.retain(|d| d.0 != letter);
         cur.frames.push((letter, image.clone()));
-        // Frames newer than the outputs: those are an older capture's.
+        // Frames newer than the outputs: those, and hand edits of them, are
+        // an older capture's.
         cur.outputs = None;
         cur.outputs_params = None;
         cur.editor = None;
+        cur.saved_lines = None;
         self.info(format!("image {k}: lighting {letter} captured"));
         let mut cmds = vec![Cmd::Store(StoreCmd::SaveImage {
             k,
@@ -323,8 +325,8 @@ impl Ctx<'_> {
                 .tracker
                 .current
                 .as_ref()
-                .and_then(|c| c.outputs.as_ref())
-                .map_or(0, |o| o.lines.len());
+                .and_then(|c| c.lines())
+                .map_or(0, <[_]>::len);
             self.info(format!(
                 "image {k}: {n} lines — a accepts, R captures again, 3 tunes, 4 edits"
             ));
@@ -435,6 +437,7 @@ impl Ctx<'_> {
                 l.outputs = Some(std::sync::Arc::new(saved.outputs));
                 l.outputs_params = Some(saved.params);
                 l.from_disk = true;
+                l.in_session = true;
                 // Nothing runs: what is shown is what the session holds.
                 self.tracker.shown_generation = self.tracker.generation;
                 self.tracker.current = Some(l);
@@ -566,8 +569,10 @@ impl Ctx<'_> {
             self.warn("nothing to accept: capture and run an image first (Enter)");
             return Vec::new();
         }
+        // Outputs the session already holds (hand edits are written as they
+        // are made): nothing to save, nothing to ask.
         let unchanged = cur.is_some_and(|c| {
-            c.from_disk && c.edits == 0 && c.outputs_params.as_ref() == Some(&self.tracker.params)
+            c.in_session && c.outputs_params.as_ref() == Some(&self.tracker.params)
         });
         let mut cmds = Vec::new();
         if !unchanged {

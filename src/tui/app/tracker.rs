@@ -26,6 +26,9 @@ pub struct Loaded {
     pub outputs_params: Option<Params>,
     /// The outputs were read from the session's files, not run.
     pub from_disk: bool,
+    /// The outputs on screen are the ones the session holds (loaded, or
+    /// saved since they were made); hand edits are written as they are made.
+    pub in_session: bool,
     pub editor: Option<LineEditor>,
     /// Edits made in this run of the console (for the Edit screen).
     pub edits: usize,
@@ -55,6 +58,7 @@ impl Loaded {
             outputs: None,
             outputs_params: None,
             from_disk: false,
+            in_session: false,
             editor: None,
             edits: 0,
             saved_lines: None,
@@ -241,6 +245,7 @@ impl Ctx<'_> {
         }
         if let Some(c) = self.tracker.current.as_mut() {
             c.accepted = true;
+            c.in_session = true;
         }
         Some(cmds)
     }

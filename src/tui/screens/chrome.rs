@@ -370,9 +370,12 @@ pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
         Overlay::Help { scroll } => ("help", help_lines(app, inner_w), scroll),
         Overlay::Message { scroll } => {
             let mut lines: Vec<Line> = Vec::new();
-            if let Some(e) = app.chrome.log.last() {
+            let mut entry = |e: &crate::tui::app::LogEntry, what: &str| {
+                if !lines.is_empty() {
+                    lines.push(Line::raw(""));
+                }
                 lines.push(Line::styled(
-                    format!("{} {}", e.time, e.level.word()),
+                    format!("{what} {} {}", e.time, e.level.word()),
                     t.title(),
                 ));
                 lines.extend(
@@ -380,6 +383,20 @@ pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
                         .into_iter()
                         .map(|r| Line::styled(r, t.level(e.level))),
                 );
+            };
+            let last = app.chrome.log.last();
+            if let Some(e) = last {
+                entry(e, "newest,");
+            }
+            // An error that a later note pushed off the message row.
+            let trouble = app
+                .chrome
+                .log
+                .entries()
+                .rev()
+                .find(|e| e.level != crate::tui::app::Level::Info);
+            if let Some(e) = trouble.filter(|e| Some(*e) != last) {
+                entry(e, "last problem,");
             }
             if let Some(f) = app.chrome.log.file() {
                 lines.push(Line::raw(""));

@@ -43,12 +43,20 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
                 Layout::horizontal(vec![Constraint::Ratio(1, cols as u32); cols]).split(*ra);
             for (c, ca) in cells.iter().enumerate() {
                 if let Some(v) = StageView::ALL.get(r * cols + c) {
-                    stage_view(app, cur, &grey, *v, *ca, buf);
+                    stage_view(app, cur, &grey, *v, *ca, true, buf);
                 }
             }
         }
     } else {
-        stage_view(app, cur, &grey, app.screens.pipeline.view, views, buf);
+        stage_view(
+            app,
+            cur,
+            &grey,
+            app.screens.pipeline.view,
+            views,
+            false,
+            buf,
+        );
     }
     cursor_line(app, cur, info, buf);
 }
@@ -133,6 +141,7 @@ fn stage_view(
     grey: &GreyView,
     v: StageView,
     area: Rect,
+    small: bool,
     buf: &mut Buffer,
 ) {
     let out = cur.outputs.as_deref();
@@ -201,8 +210,14 @@ fn stage_view(
         (true, Some(l)) => l.to_string(),
         _ => String::new(),
     };
-    let top = format!("{stale}image {}{letter} · {}{count}", cur.k, v.title());
-    let b = if bottom.is_empty() {
+    let top = if small {
+        // Side by side: what the view is, and whether it is stale.
+        let stale = if stale.is_empty() { "" } else { "STALE " };
+        format!("{stale}{}{count}", v.title())
+    } else {
+        format!("{stale}image {}{letter} · {}{count}", cur.k, v.title())
+    };
+    let b = if bottom.is_empty() || small {
         block(app, &top)
     } else {
         block2(app, &top, &bottom)
@@ -235,9 +250,10 @@ fn params_panel(app: &App, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
     let inner_h = area.height.saturating_sub(2) as usize;
     let inner_w = area.width.saturating_sub(2) as usize;
-    let stats_rows = 6usize.min(inner_h / 2);
-    let room = inner_h.saturating_sub(stats_rows).max(1);
     let sel = app.screens.pipeline.param;
+    let doc_rows = super::chrome::wrap(app.screens.pipeline.param_spec().doc, inner_w).len();
+    let stats_rows = (5 + doc_rows).min(inner_h / 2);
+    let room = inner_h.saturating_sub(stats_rows).max(1);
     let params = &app.tracker.params;
     let rows: Vec<Line> = PARAMS
         .iter()
@@ -327,12 +343,11 @@ fn cursor_line(app: &App, cur: &Loaded, area: Rect, buf: &mut Buffer) {
     };
     let out = cur.outputs.as_deref();
     let text = format!(
-        "x{x} y{y} grey {g} H {} V {} · zoom {} {} [{}]",
+        "x{x} y{y} grey {g} H {} V {} · ×{} {}",
         resp(out.map(|o| &o.response_h)),
         resp(out.map(|o| &o.response_v)),
         nav.view.zoom,
         nav.position(size),
-        app.look_name()
     );
     Paragraph::new(text).render(area, buf);
 }

@@ -30,7 +30,7 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
 
 fn preview(app: &App, area: Rect, buf: &mut Buffer) {
     let cur = app.tracker.current.as_ref();
-    let Some((c, (letter, img))) = cur.and_then(|c| c.frames.last().map(|f| (c, f))) else {
+    let Some((c, (letter, img))) = cur.and_then(|c| first_frame(app, c).map(|f| (c, f))) else {
         Paragraph::new("no image yet")
             .block(block(app, "image"))
             .render(area, buf);
@@ -56,6 +56,18 @@ fn preview(app: &App, area: Rect, buf: &mut Buffer) {
         p.cursor = Some(nav.cursor_or_centre(img.size()));
     }
     p.render(inner, buf);
+}
+
+/// The first lighting captured, in profile order (the last one may be the
+/// dark ambient frame).
+fn first_frame<'a>(
+    app: &App,
+    c: &'a crate::tui::app::Loaded,
+) -> Option<(char, &'a crate::llv::GreyImage)> {
+    app.cell
+        .letters
+        .iter()
+        .find_map(|l| c.frame(*l).map(|g| (*l, g)))
 }
 
 fn sessions(app: &App, area: Rect, buf: &mut Buffer) {

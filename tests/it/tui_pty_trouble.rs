@@ -1,0 +1,224 @@
+//! The console when things go wrong, through the real binary in a pty at
+//! 80 × 24: a long error wraps and opens in full and lands in the log
+//! file; a damaged session is listed with why, a truncated image is marked
+//! and only its lighting retaken; a report that cannot be written says so;
+//! a session held by a console that still runs is offered to take over;
+//! a terminal too small, a dumb terminal and the Linux console.
+
+use std::time::Duration;
+
+use vss::tui::keymap::{Action, GlobalAction, Scope, SurveyAction};
+
+use super::tui_harness::{Console, SESSION, SURVEY, flat};
+
+fn global(c: &mut Console, g: GlobalAction) {
+    c.press(Scope::Global, Action::Global(g));
+}
+
+/// A refused session name is longer than a row: it wraps over the
+/// message rows, `!` shows it whole, the log pane keeps it, and the log
+/// file holds it.
+#[test]
+fn a_long_message_is_readable_and_kept() {
+    let mut c = Console::start(80, 24, &[]);
+    c.wait_text("relay board", 10);
+    c.press(SURVEY, Action::Survey(SurveyAction::NewSession));
+    c.wait_text("new session name", 5);
+    c.send("a bad name with spaces\r");
+    let s = c.wait_words(
+        "contains ' ' at position 2; use only letters, digits, _ or -",
+        10,
+    );
+    assert!(
+        s.contains("a bad name with spaces"),
+        "the typed text is kept:\n{s}"
+    );
+    c.send("\x1b");
+    c.wait("the field closed", 5, |s| !s.contains("new session name"));
+    global(&mut c, GlobalAction::LastMessage);
+    let s = c.wait_text("last message", 5);
+    assert!(flat(&s).contains("use only letters, digits, _ or -"), "{s}");
+    c.send("\x1b");
+    c.wait("the window closed", 5, |s| !s.contains("last message"));
+    global(&mut c, GlobalAction::ToggleLog);
+    let s = c.wait_text("log:", 5);
+    assert!(
+        s.contains("profile pty test cell") && s.contains("refused"),
+        "{s}"
+    );
+    let file = c.dir.path().join("state/vss/console.log");
+    let text = std::fs::read_to_string(&file).unwrap_or_default();
+    assert!(
+        text.contains("refused"),
+        "the log file {}: {text}",
+        file.display()
+    );
+    c.send("q");
+    c.wait_exit(10);
+}
+
+#[test]
+fn damaged_sessions_and_files_are_shown_and_only_the_damage_retaken() {
+    let mut c = Console::start(80, 24, &[]);
+    c.survey(1);
+    let d = c.session();
+    // Damage: a truncated image of lighting b, a session whose manifest
+    // does not read, a report that cannot be written over a folder.
+    let mut c = c.restart_after(|dir| {
+        let img = dir.join("sessions/cube/cube1b.img");
+        let f = std::fs::OpenOptions::new().write(true).open(&img).unwrap();
+        f.set_len(5000).unwrap();
+        let bad = dir.join("sessions/bad");
+        std::fs::create_dir_all(&bad).unwrap();
+        let m = std::fs::read_to_string(dir.join("sessions/cube/cube.toml")).unwrap();
+        let m: String = m
+            .lines()
+            .map(|l| {
+                if l.starts_with("planned_images") {
+                    "planned_images = \"five\"".to_string()
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        std::fs::write(bad.join("bad.toml"), m).unwrap();
+        std::fs::create_dir(dir.join("sessions/cube/cube.ps")).unwrap();
+    });
+    let s = c.wait_text("DAMAGED", 10);
+    assert!(s.contains("bad        DAMAGED"), "listed, not hidden:\n{s}");
+    // The damaged one is first: Enter shows the full error and the command.
+    c.send("\r");
+    let s = c.wait_text("last message", 5);
+    assert!(s.contains("vss session check"), "{s}");
+    assert!(s.contains("bad.toml:11: invalid type"), "{s}");
+    c.send("\x1b");
+    c.wait("the window closed", 5, |s| !s.contains("last message"));
+    c.press(SURVEY, Action::Survey(SurveyAction::Down));
+    c.send("\r");
+    let s = c.wait_text("session cube", 10);
+    assert!(s.contains("a!c"), "the truncated lighting is marked:\n{s}");
+    assert!(s.contains("damaged or missing"), "{s}");
+    c.send("5");
+    let s = c.wait_text("problem(s)", 10);
+    assert!(s.contains("cube1b.img"), "{s}");
+    c.press(
+        SESSION,
+        Action::Files(vss::tui::keymap::FilesAction::Export),
+    );
+    let s = c.wait_text("report NOT written", 10);
+    assert!(s.contains("cube.ps"), "which file:\n{s}");
+    c.send("1");
+    c.wait_text("session cube", 5);
+    c.press(SURVEY, Action::Survey(SurveyAction::Up));
+    c.press(SURVEY, Action::Survey(SurveyAction::Redo));
+    c.wait_text("y retakes only b", 10);
+    c.yes();
+    let s = c.wait_text("captures lighting b again", 10);
+    assert!(s.contains("Image 1"), "{s}");
+    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    c.wait("image 1 reviewed again", 30, |s| {
+        s.contains("before CONNECT")
+    });
+    let img = vss::formats::img::read_img(&d.join("cube1b.img")).expect("lighting b retaken");
+    assert_eq!(img.image.size(), (128, 128));
+    c.send("q");
+    c.wait_exit(10);
+}
+
+#[test]
+fn a_session_held_by_a_live_console_is_offered_for_take_over() {
+    let mut a = Console::start(80, 24, &[]);
+    a.create_session("cube");
+    let mut b = a.another(80, 24);
+    b.wait_text("in use by", 10);
+    b.send("\r");
+    let s = b.wait_text("over anyway?", 10);
+    assert!(s.contains("tmux attach"), "{s}");
+    b.yes();
+    b.wait_text("session cube", 20);
+    // The first console was asked to end, and did, restoring its terminal.
+    a.wait_exit(20);
+    let raw = String::from_utf8_lossy(&a.raw.lock().unwrap()).into_owned();
+    assert!(
+        raw.trim_end().ends_with("\x1b[?1049l"),
+        "left the alternate screen"
+    );
+    b.send("q");
+    b.wait_exit(10);
+}
+
+#[test]
+fn too_small_a_terminal_says_so_and_recovers() {
+    let mut c = Console::start(80, 24, &[]);
+    c.wait_text("choose a session", 10);
+    c.resize(12, 50);
+    let s = c.wait_text("terminal too small", 10);
+    assert!(s.contains("50 × 12"), "{s}");
+    c.resize(24, 80);
+    c.wait_text("choose a session", 10);
+    c.send("q");
+    c.wait_exit(10);
+}
+
+#[test]
+fn a_dumb_terminal_gets_words_not_escapes() {
+    let mut c = Console::start(80, 24, &[("TERM", "dumb")]);
+    c.wait_exit(10);
+    assert_eq!(c.exit_code(), Some(2));
+    let raw = String::from_utf8_lossy(&c.raw.lock().unwrap()).into_owned();
+    assert!(raw.contains("cursor addressing"), "{raw:?}");
+    assert!(!raw.contains('\x1b'), "no escape sequence: {raw:?}");
+}
+
+/// Every SGR colour parameter in `bytes`.
+fn colours(bytes: &[u8]) -> Vec<String> {
+    let s = String::from_utf8_lossy(bytes);
+    s.split("\x1b[")
+        .skip(1)
+        .filter_map(|part| {
+            let end = part.find(|c: char| !(c.is_ascii_digit() || c == ';'))?;
+            part[end..]
+                .starts_with('m')
+                .then(|| part[..end].to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn the_linux_console_gets_sixteen_colours() {
+    let mut c = Console::start(80, 24, &[("TERM", "linux")]);
+    c.survey(1);
+    c.send("3");
+    let s = c.wait_text("parameters", 10);
+    assert!(s.is_ascii(), "{s}");
+    c.send("q");
+    c.wait_exit(10);
+    std::thread::sleep(Duration::from_millis(50));
+    let sgr = colours(&c.raw.lock().unwrap());
+    // crossterm writes even the sixteen named colours as `38;5;N`, which the
+    // Linux console takes for N below 16: only those may appear.
+    let mut indices = Vec::new();
+    for p in &sgr {
+        let n: Vec<&str> = p.split(';').collect();
+        for w in n.windows(3) {
+            if matches!(w[0], "38" | "48") && w[1] == "5" {
+                indices.push(w[2].parse::<u32>().unwrap_or(999));
+            }
+        }
+        assert!(
+            !p.contains("38;2") && !p.contains("48;2"),
+            "no true colour: {p}"
+        );
+    }
+    assert!(!indices.is_empty(), "some colour is used");
+    assert!(
+        indices.iter().all(|&i| i < 16),
+        "only the sixteen colours: {:?}",
+        indices
+            .iter()
+            .filter(|&&i| i >= 16)
+            .take(5)
+            .collect::<Vec<_>>()
+    );
+}
