@@ -156,9 +156,7 @@ impl Prompt {
             | ModalAction::Yes
             | ModalAction::No
             | ModalAction::Submit
-            | ModalAction::Cancel
-            | ModalAction::Up
-            | ModalAction::Down => {}
+            | ModalAction::Cancel => {}
         }
         self.error = None;
     }
@@ -188,7 +186,6 @@ impl App {
                 self.chrome.modal = None;
                 Vec::new()
             }
-            ModalAction::Up | ModalAction::Down => Vec::new(),
             ModalAction::Left
             | ModalAction::Right
             | ModalAction::Home
