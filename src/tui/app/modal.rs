@@ -31,6 +31,8 @@ pub enum Pending {
     ExtraImage(u32),
     /// Go on with the edit of an accepted image's lines.
     Edit,
+    /// Write the calibration shown into its camera's `.cdf`.
+    CalibWrite,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -237,6 +239,7 @@ impl App {
                 let (s, mut ctx) = self.parts();
                 s.edit.confirmed(&mut ctx)
             }
+            Pending::CalibWrite => self.screens.calibrate.confirmed(),
         }
     }
 
