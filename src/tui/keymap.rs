@@ -221,9 +221,6 @@ pub enum ModalAction {
     KillLine,
     /// Ctrl-W: the word before the cursor.
     KillWord,
-    /// ↑↓ in a picker.
-    Up,
-    Down,
 }
 
 /// The help overlay and the message viewer.

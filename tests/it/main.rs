@@ -36,6 +36,7 @@ mod rig_images;
 mod rig_lights;
 mod rig_protocol;
 mod robust_fs;
+mod robust_fuzz;
 mod robust_inputs;
 mod robust_report;
 mod robust_session;

@@ -158,9 +158,7 @@ impl Prompt {
             | ModalAction::Yes
             | ModalAction::No
             | ModalAction::Submit
-            | ModalAction::Cancel
-            | ModalAction::Up
-            | ModalAction::Down => {}
+            | ModalAction::Cancel => {}
         }
         self.error = None;
     }
@@ -190,7 +188,6 @@ impl App {
                 self.chrome.modal = None;
                 Vec::new()
             }
-            ModalAction::Up | ModalAction::Down => Vec::new(),
             ModalAction::Left
             | ModalAction::Right
             | ModalAction::Home

@@ -88,8 +88,6 @@ pub const KEYMAP: &[Binding] = rows! {
     CO, ch('n'), Modal(No), "no, keep what is there", "no";
     CO, k(K::Esc), Modal(No), "no", "";
     CO, ch('a'), Modal(All), "all (where the question offers it)", "";
-    CO, k(K::Up), Modal(Up), "choose above (in a list)", "";
-    CO, k(K::Down), Modal(Down), "choose below (in a list)", "";
     // Typing.
     PR, k(K::Enter), Modal(Submit), "accept the typed text", "accept";
     PR, k(K::Esc), Modal(Cancel), "cancel typing", "cancel";
