@@ -51,7 +51,8 @@ fn grid_line(s: &CalibrateScreen, cam: u32, t: Theme) -> Line<'static> {
         }
         Some((c, Err(e))) if *c == cam => {
             // What went wrong; what to do is in the message `Space` gives.
-            let what = e.split(": ").next().unwrap_or(e);
+            let e = e.to_string();
+            let what = e.split(": ").next().unwrap_or(&e);
             Line::styled(format!("grid: {what}"), t.warn())
         }
         _ => Line::raw("grid: no frame yet"),
