@@ -200,6 +200,7 @@ impl Session {
             },
             lighting,
             image: Vec::new(),
+            calibration: Vec::new(),
         };
         // Check the manifest would load back before anything depends on it.
         let text = manifest.to_toml().map_err(|e| SessionError::Manifest {
@@ -337,6 +338,26 @@ impl Session {
     }
     pub fn is_read_only(&self) -> bool {
         self.lock.is_none()
+    }
+    /// Records a camera calibration accepted while this session is open
+    /// (the `.cdf` it wrote, when, its views and fit) in the manifest.
+    pub fn record_calibration(
+        &mut self,
+        camera: u32,
+        cdf: &Path,
+        c: &crate::calib::Calibration,
+    ) -> Result<(), SessionError> {
+        self.writable()?;
+        self.manifest.calibration.push(manifest::CalibrationRecord {
+            camera,
+            made: stamp::now_rfc3339(),
+            cdf: cdf.display().to_string(),
+            views: u32::try_from(c.views.len()).unwrap_or(u32::MAX),
+            rms_px: c.rms,
+            p95_px: c.p95,
+            centre_stated: c.centre_stated,
+        });
+        self.commit()
     }
     /// Who holds the lock of this session right now, if anyone.
     pub fn lock_holder(&self) -> Option<LockInfo> {

@@ -40,6 +40,29 @@ pub struct Manifest {
     /// Image numbers with anything recorded, in ascending order.
     #[serde(default)]
     pub image: Vec<ImageRecord>,
+    /// Camera calibrations made while the session was open, oldest first.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub calibration: Vec<CalibrationRecord>,
+}
+
+/// A camera's calibration accepted in the console: which `.cdf` it wrote,
+/// when, from how many views, and how well it fits them. Images captured
+/// after it copy the new `.cdf` into the session (their `cdf` record).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrationRecord {
+    pub camera: u32,
+    /// UTC, RFC 3339.
+    pub made: String,
+    /// The `.cdf` written (the profile's path for the camera).
+    pub cdf: String,
+    pub views: u32,
+    /// Reprojection error over all views: RMS and 95th percentile, px.
+    pub rms_px: f64,
+    pub p95_px: f64,
+    /// `C` was stated rather than solved for.
+    #[serde(default)]
+    pub centre_stated: bool,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -469,6 +492,15 @@ mod tests {
                     lines: 0,
                     hash: "crc32:0:0".into(),
                 }],
+            }],
+            calibration: vec![CalibrationRecord {
+                camera: 2,
+                made: "2026-01-01T00:00:00Z".into(),
+                cdf: "profiles/sim/cam2.cdf".into(),
+                views: 12,
+                rms_px: 0.051,
+                p95_px: 0.102,
+                centre_stated: false,
             }],
         }
     }

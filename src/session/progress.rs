@@ -225,6 +225,7 @@ mod tests {
                     edit: Vec::new(),
                 })
                 .collect(),
+            calibration: Vec::new(),
         }
     }
 

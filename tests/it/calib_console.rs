@@ -2,7 +2,8 @@
 //! shows the plate (`p`), each grab's grid is found and kept (`Space`), the
 //! calibration computed (`Enter`) and accepted (`a`, asked first because
 //! the camera's `.cdf` is there): the new file has the calibration, the old
-//! one is kept beside it as `.bak`.
+//! one is kept beside it as `.bak`, and the open session's manifest records
+//! it (camera, views, fit).
 
 use vss::formats::cdf::{Status, read_cdf, write_cdf};
 use vss::tui::keymap::{Action, CalibrateAction as CA, GlobalAction, Scope, ScreenId};
@@ -50,6 +51,7 @@ fn a_camera_calibrated_on_the_calibrate_screen() {
         .camera_model()
         .unwrap();
     c.wait_text("Survey", 10);
+    c.create_session("cube");
     c.press(
         Scope::Global,
         Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
@@ -80,6 +82,22 @@ fn a_camera_calibrated_on_the_calibrate_screen() {
         std::fs::read(dir.join("cam1.cdf")).is_ok_and(|b| b != before)
     });
     assert_eq!(std::fs::read(dir.join("cam1.cdf.bak")).unwrap(), before);
+    c.wait_text("recorded in session cube", 10);
+    let manifest = dir.join("sessions/cube/cube.toml");
+    let m = vss::session::manifest::Manifest::parse(
+        &std::fs::read_to_string(&manifest).unwrap(),
+        &manifest,
+    )
+    .unwrap();
+    let [rec] = m.calibration.as_slice() else {
+        panic!("one calibration recorded: {:?}", m.calibration);
+    };
+    assert_eq!((rec.camera, rec.views), (1, 6), "{rec:?}");
+    assert!(
+        rec.cdf.ends_with("cam1.cdf") && rec.centre_stated,
+        "{rec:?}"
+    );
+    assert!(rec.rms_px > 0.0 && rec.rms_px < 0.5, "{rec:?}");
     let got = read_cdf(&dir.join("cam1.cdf")).unwrap();
     assert_eq!(got.get("D").unwrap().status, Status::Calibrated);
     assert_eq!(got.get("C").unwrap().status, Status::Stated);

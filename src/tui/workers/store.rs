@@ -283,8 +283,19 @@ impl Store {
                         source,
                     }
                 })?;
+                let recorded = match self.session.as_mut() {
+                    Some(s) => {
+                        s.record_calibration(camera, &path, &calibration)
+                            .map_err(session_err(format!(
+                                "camera {camera}: {} written, but not recorded in the session",
+                                path.display()
+                            )))?;
+                        format!("; recorded in session {}", s.name())
+                    }
+                    None => String::new(),
+                };
                 self.reply(StoreEvent::Note(format!(
-                    "camera {camera}: wrote {} (RMS {:.3} px over {} views)",
+                    "camera {camera}: wrote {} (RMS {:.3} px over {} views){recorded}",
                     path.display(),
                     calibration.rms,
                     calibration.views.len()
