@@ -12,7 +12,8 @@
 //! (edges, lines, CONNECT; no lens), `pipeline2` (the same with a thread for
 //! each scan direction: time it, its instruction count means little),
 //! `edges` (response, noise scale and edge points, both directions),
-//! `response`, `noise`, `peaks`, `lines`, `connect`; `scene FILE.pgm` writes
+//! `response`, `noise`, `peaks`, `lines`, `connect`, `five` (four lightings and the ambient image to
+//! lines); `scene FILE.pgm` writes
 //! the scene.
 
 use vss::llv::connect::{ConnectScratch, connect_into};
@@ -31,7 +32,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let (Some(stage), Some(n)) = (args.get(1), args.get(2)) else {
         eprintln!(
-            "usage: llv_count pipeline|pipeline2|edges|response|noise|peaks|lines|connect N | scene FILE.pgm"
+            "usage: llv_count pipeline|pipeline2|edges|response|noise|peaks|lines|connect|five N | scene FILE.pgm"
         );
         std::process::exit(2);
     };
@@ -84,6 +85,21 @@ fn main() {
     let mut ls = LineScratch::default();
     let (mut lh, mut lv) = (Vec::new(), Vec::new());
     let (mut joined, mut cs) = (Vec::new(), ConnectScratch::default());
+    // Five images of the view (`five`): four lightings with their own
+    // noise and the ambient image at a fifth of the brightness, as
+    // `benches/llv.rs` has them.
+    let lit: Vec<_> = (0..4)
+        .map(|k| llv_scene::scene(512, 512, 2.0, 42 + k))
+        .collect();
+    let (w, h) = img.size();
+    let amb = vss::llv::GreyImage::new(w, h, img.data().iter().map(|&v| v / 5).collect())
+        .expect("sizes agree");
+    let five_input = Input {
+        images: &lit,
+        ambient: Some(&amb),
+        lens: None,
+    };
+    let mut five = Workspace::new();
     let mut check = 0usize;
     for _ in 0..n {
         match stage.as_str() {
@@ -142,6 +158,20 @@ fn main() {
             "connect" => {
                 connect_into(&warm.lines_raw, &p.connect, &mut joined, &mut cs);
                 check += joined.len();
+            }
+            "five" => {
+                let out = five.run(&five_input, &p).expect("the view runs");
+                check += out.lines.len();
+                let t = out.timings;
+                eprintln!(
+                    "five: edge points {} + {}, lines {} raw, {} after CONNECT; edges {} us, lines {} us",
+                    out.edges_h.points.len(),
+                    out.edges_v.points.len(),
+                    out.lines_raw.len(),
+                    out.lines.len(),
+                    t.edges_us,
+                    t.lines_us
+                );
             }
             other => {
                 eprintln!("unknown stage {other}");

@@ -160,21 +160,46 @@ pub fn track_into(
     out: &mut Vec<Segment>,
     s: &mut LineScratch,
 ) {
-    out.clear();
     let mut keybuf = std::mem::take(&mut s.keys);
-    let mut own = std::mem::take(&mut s.map);
-    {
-        let k = resp.keys(&mut keybuf);
-        let map = if map.fits(&k, floor, p.track_sigmas) {
-            map
-        } else {
-            let t = p.track_sigmas;
-            own.build_into(&k, noise, floor, t, t, &mut s.peaks);
-            &own
-        };
-        track_keys(&k, noise, map, seeds, half_width, p, out, s);
-    }
+    track_keys_into(
+        &resp.keys(&mut keybuf),
+        noise,
+        map,
+        seeds,
+        floor,
+        half_width,
+        p,
+        out,
+        s,
+    );
     s.keys = keybuf;
+}
+
+/// [`track_into`] on a response's keys ([`Response::keys`]), for a caller
+/// that has them already (the pipeline, which quantises an `f32` response
+/// once for the edge points and the line extractor).
+#[allow(clippy::too_many_arguments)]
+pub fn track_keys_into(
+    k: &Keys,
+    noise: &NoiseMap,
+    map: &PeakMap,
+    seeds: &EdgePoints,
+    floor: f64,
+    half_width: usize,
+    p: &LineParams,
+    out: &mut Vec<Segment>,
+    s: &mut LineScratch,
+) {
+    out.clear();
+    let mut own = std::mem::take(&mut s.map);
+    let map = if map.fits(k, floor, p.track_sigmas) {
+        map
+    } else {
+        let t = p.track_sigmas;
+        own.build_into(k, noise, floor, t, t, &mut s.peaks);
+        &own
+    };
+    track_keys(k, noise, map, seeds, half_width, p, out, s);
     s.map = own;
 }
 

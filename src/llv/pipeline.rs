@@ -15,11 +15,12 @@ use serde::Serialize;
 use super::connect::{ConnectScratch, connect_into};
 use super::corners::{CornerScratch, close_corners_with};
 use super::edges::{
-    NoiseMap, PeakMap, PeakScratch, Response, ResponseScratch, detect_into, exact_response_into,
+    KeyBuf, NoiseMap, PeakMap, PeakScratch, Response, ResponseScratch, detect_keys_into,
+    exact_response_into,
 };
 use super::image::GreyImage;
 use super::lens::{LensMap, correct_into};
-use super::lines::{LineScratch, extract_into, track_into};
+use super::lines::{LineScratch, extract_into, track_keys_into};
 use super::params::{Params, Stage};
 use super::photometric::{PhotoScratch, combined_response_into};
 use super::{EdgePoints, LlvError, ScanDir, Segment};
@@ -344,6 +345,9 @@ struct DirScratch {
     peaks: PeakScratch,
     /// The peaks the edge points and the line extractor are taken from.
     map: PeakMap,
+    /// The response's keys, when it is an `f32` one (several lightings):
+    /// quantised once a run for the edge points and the line extractor.
+    keys: KeyBuf,
     lines: LineScratch,
     /// The direction's extracted lines.
     segs: Vec<Segment>,
@@ -378,26 +382,27 @@ impl Job<'_> {
     ) -> Result<(u64, u64), LlvError> {
         let p = self.params;
         let mut edges_us = 0;
-        if self.from <= Stage::Edges {
-            let t = Instant::now();
-            if self.response {
-                let a = p.edges.half_width as usize;
-                match (images, ambient) {
-                    ([img], None) => {
-                        exact_response_into(img, o.dir, a, o.response, &mut o.s.response)?
-                    }
-                    _ => combined_response_into(
-                        images,
-                        ambient,
-                        o.dir,
-                        &p.edges,
-                        o.response,
-                        &mut o.s.photo,
-                    )?,
-                }
+        let t = Instant::now();
+        if self.from <= Stage::Edges && self.response {
+            let a = p.edges.half_width as usize;
+            match (images, ambient) {
+                ([img], None) => exact_response_into(img, o.dir, a, o.response, &mut o.s.response)?,
+                _ => combined_response_into(
+                    images,
+                    ambient,
+                    o.dir,
+                    &p.edges,
+                    o.response,
+                    &mut o.s.photo,
+                )?,
             }
-            detect_into(
-                o.response,
+        }
+        // (Free for one image's exact response; an `f32` one is quantised
+        // here, once for both readers.)
+        let k = o.response.keys(&mut o.s.keys);
+        if self.from <= Stage::Edges {
+            detect_keys_into(
+                &k,
                 &p.edges,
                 p.lines.track_sigmas,
                 o.noise,
@@ -408,8 +413,8 @@ impl Job<'_> {
             edges_us = micros(t);
         }
         let t = Instant::now();
-        track_into(
-            o.response,
+        track_keys_into(
+            &k,
             o.noise,
             &o.s.map,
             o.edges,

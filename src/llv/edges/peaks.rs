@@ -106,15 +106,27 @@ pub fn detect_into(
     s: &mut PeakScratch,
 ) {
     let mut buf = std::mem::take(&mut s.keys);
-    let mut ns = std::mem::take(&mut s.noise);
-    {
-        let k = resp.keys(&mut buf);
-        noise.estimate_into(&k, &mut ns);
-        let low = track_sigmas.min(p.noise_sigmas);
-        map.build_into(&k, noise, p.floor, low, p.noise_sigmas, s);
-        peaks_into(&k, noise, map, p, out, s);
-    }
+    detect_keys_into(&resp.keys(&mut buf), p, track_sigmas, noise, map, out, s);
     s.keys = buf;
+}
+
+/// [`detect_into`] on a response's keys ([`Response::keys`]), for a caller
+/// that reads them more than once: an `f32` response (several lightings)
+/// is then quantised once for the edge points and the line extractor.
+pub fn detect_keys_into(
+    k: &Keys,
+    p: &EdgeParams,
+    track_sigmas: f64,
+    noise: &mut NoiseMap,
+    map: &mut PeakMap,
+    out: &mut EdgePoints,
+    s: &mut PeakScratch,
+) {
+    let mut ns = std::mem::take(&mut s.noise);
+    noise.estimate_into(k, &mut ns);
+    let low = track_sigmas.min(p.noise_sigmas);
+    map.build_into(k, noise, p.floor, low, p.noise_sigmas, s);
+    peaks_into(k, noise, map, p, out, s);
     s.noise = ns;
 }
 
