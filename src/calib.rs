@@ -214,3 +214,33 @@ pub fn scale_of(cdf: &Cdf) -> Option<(f64, f64)> {
         _ => None,
     }
 }
+
+/// The solution in words, as the CLI prints it and the report's page shows
+/// it: a header, each parameter with its standard error and unit, then `C`
+/// when it was stated and `S` with how it was found. `pm` is the
+/// plus-minus sign (`±`, or `+-` where the font has only ASCII).
+pub fn parameter_lines(c: &Calibration, pm: &str) -> Vec<String> {
+    let mut t = vec!["parameter  value            standard error".to_string()];
+    for p in &c.params {
+        let unit = match p.name {
+            "Cx" | "Cy" => " px",
+            "f" => " mm",
+            "sy" => " mm/px",
+            _ => "",
+        };
+        t.push(format!(
+            "{:<9}  {:<16.9} {pm} {:.3e}{unit}",
+            p.name, p.value, p.se
+        ));
+    }
+    if c.centre_stated {
+        t.push(format!("C (stated) {:.3} {:.3} px", c.model.cx, c.model.cy));
+    }
+    let how = if c.scale_estimated {
+        "sy estimated"
+    } else {
+        "stated"
+    };
+    t.push(format!("S ({how})  {} {} mm/px", c.model.sx, c.model.sy));
+    t
+}

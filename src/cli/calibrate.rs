@@ -217,29 +217,9 @@ fn print_calibration(c: &Calibration) -> anyhow::Result<()> {
         c.rms,
         c.p95
     );
-    outln!("parameter  value            standard error");
-    for p in &c.params {
-        let unit = match p.name {
-            "Cx" | "Cy" => " px",
-            "f" => " mm",
-            "sy" => " mm/px",
-            _ => "",
-        };
-        outln!("{:<9}  {:<16.9} ± {:.3e}{unit}", p.name, p.value, p.se);
+    for l in calib::parameter_lines(c, "±") {
+        outln!("{l}");
     }
-    if !c.params.iter().any(|p| p.name == "Cx") {
-        outln!("C (stated) {:.3} {:.3} px", c.model.cx, c.model.cy);
-    }
-    outln!(
-        "S ({})  {} {} mm/px",
-        if c.scale_estimated {
-            "sy estimated"
-        } else {
-            "stated"
-        },
-        c.model.sx,
-        c.model.sy
-    );
     Ok(())
 }
 

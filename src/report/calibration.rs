@@ -20,23 +20,7 @@ pub fn summary_lines(c: &Calibration) -> Vec<String> {
         c.p95
     ));
     t.push(String::new());
-    t.push("parameter  value            standard error".into());
-    for p in &c.params {
-        t.push(format!("{:<9}  {:<16.9} +- {:.3e}", p.name, p.value, p.se));
-    }
-    if c.centre_stated {
-        t.push(format!("C (stated) {:.3} {:.3} px", c.model.cx, c.model.cy));
-    }
-    t.push(format!(
-        "S ({})  {} {} mm/px",
-        if c.scale_estimated {
-            "sy estimated"
-        } else {
-            "stated"
-        },
-        c.model.sx,
-        c.model.sy
-    ));
+    t.extend(crate::calib::parameter_lines(c, "+-"));
     t.push(String::new());
     t.push("view                     RMS px  p95 px  tilt".into());
     for v in &c.views {

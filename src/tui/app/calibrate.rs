@@ -14,7 +14,7 @@ use super::{Ctx, Pending};
 use crate::calib::{self, Calibration, DetectError, Detection, Detector, Plate, PlateError, View};
 use crate::llv::GreyImage;
 use crate::rig::sim::plate::{Mode, PlateTarget};
-use crate::tui::event::{Cmd, DeviceCmd, FramePurpose, StoreCmd};
+use crate::tui::event::{Cmd, DeviceCmd, StoreCmd};
 use crate::tui::keymap::CalibrateAction;
 
 /// The plate the console calibrates with (`profiles/plates/`).
@@ -97,28 +97,9 @@ impl CalibrateScreen {
     pub fn update(&mut self, a: CalibrateAction, ctx: &mut Ctx) -> Vec<Cmd> {
         let cam = self.camera;
         match a {
-            CalibrateAction::Camera => {
-                self.camera = self.camera % ctx.cell.cameras + 1;
-                ctx.info(format!("camera {}", self.camera));
-                if ctx.cell.device.live {
-                    return vec![Cmd::Device(DeviceCmd::Live {
-                        on: true,
-                        camera: self.camera,
-                    })];
-                }
-                Vec::new()
-            }
-            CalibrateAction::ToggleLive => {
-                ctx.cell.device.live = !ctx.cell.device.live;
-                vec![Cmd::Device(DeviceCmd::Live {
-                    on: ctx.cell.device.live,
-                    camera: cam,
-                })]
-            }
-            CalibrateAction::Grab => {
-                ctx.info(format!("grabbing a frame of camera {cam}"));
-                vec![ctx.capture(FramePurpose::Snapshot, cam, None)]
-            }
+            CalibrateAction::Camera => ctx.next_camera(&mut self.camera),
+            CalibrateAction::ToggleLive => ctx.toggle_live(cam),
+            CalibrateAction::Grab => ctx.grab(cam),
             CalibrateAction::Plate => match self.plate() {
                 Ok(plate) => {
                     self.plate_shown = !self.plate_shown;

@@ -2,7 +2,7 @@
 //! live view, single grabs, each light or lighting configuration switched.
 
 use super::{Ctx, PreviewNav};
-use crate::tui::event::{Cmd, DeviceCmd, FramePurpose};
+use crate::tui::event::{Cmd, DeviceCmd};
 use crate::tui::keymap::CaptureAction;
 
 /// The Capture screen's own state.
@@ -27,28 +27,9 @@ impl Default for CaptureScreen {
 impl CaptureScreen {
     pub fn update(&mut self, a: CaptureAction, ctx: &mut Ctx) -> Vec<Cmd> {
         match a {
-            CaptureAction::Camera => {
-                self.camera = self.camera % ctx.cell.cameras + 1;
-                ctx.info(format!("camera {}", self.camera));
-                if ctx.cell.device.live {
-                    return vec![Cmd::Device(DeviceCmd::Live {
-                        on: true,
-                        camera: self.camera,
-                    })];
-                }
-                Vec::new()
-            }
-            CaptureAction::ToggleLive => {
-                ctx.cell.device.live = !ctx.cell.device.live;
-                vec![Cmd::Device(DeviceCmd::Live {
-                    on: ctx.cell.device.live,
-                    camera: self.camera,
-                })]
-            }
-            CaptureAction::Grab => {
-                ctx.info(format!("grabbing a frame of camera {}", self.camera));
-                vec![ctx.capture(FramePurpose::Snapshot, self.camera, None)]
-            }
+            CaptureAction::Camera => ctx.next_camera(&mut self.camera),
+            CaptureAction::ToggleLive => ctx.toggle_live(self.camera),
+            CaptureAction::Grab => ctx.grab(self.camera),
             CaptureAction::LightPrev => {
                 self.light = self.light.saturating_sub(1);
                 Vec::new()

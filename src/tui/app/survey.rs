@@ -238,6 +238,35 @@ impl Ctx<'_> {
         missing_letters(self.cell, &self.session.work, self.tracker)
     }
 
+    /// Steps `camera` to the next one (wrapping); a live view follows it.
+    /// The Capture and Calibrate screens each keep their own camera.
+    pub fn next_camera(&mut self, camera: &mut u32) -> Vec<Cmd> {
+        *camera = *camera % self.cell.cameras + 1;
+        self.info(format!("camera {camera}"));
+        if self.cell.device.live {
+            return vec![Cmd::Device(DeviceCmd::Live {
+                on: true,
+                camera: *camera,
+            })];
+        }
+        Vec::new()
+    }
+
+    /// Turns the live view of `camera` on, or off.
+    pub fn toggle_live(&mut self, camera: u32) -> Vec<Cmd> {
+        self.cell.device.live = !self.cell.device.live;
+        vec![Cmd::Device(DeviceCmd::Live {
+            on: self.cell.device.live,
+            camera,
+        })]
+    }
+
+    /// Grabs one frame of `camera` as it is lit now.
+    pub fn grab(&mut self, camera: u32) -> Vec<Cmd> {
+        self.info(format!("grabbing a frame of camera {camera}"));
+        vec![self.capture(FramePurpose::Snapshot, camera, None)]
+    }
+
     /// Marks the transfer under way with its purpose (the worker's progress
     /// messages carry only numbers).
     pub fn capture(&mut self, purpose: FramePurpose, camera: u32, lighting: Option<char>) -> Cmd {
