@@ -15,7 +15,7 @@ use super::keymap::ScreenId;
 use super::widgets::preview::PreviewMode;
 
 mod capture;
-mod chrome;
+pub mod chrome;
 mod edit;
 mod pipeline;
 mod session;
