@@ -385,7 +385,7 @@ fn the_session_picker_confirms_and_shows_damaged_sessions() {
     ])));
     survey(&mut app, SurveyAction::OpenPicker);
     let (s, _) = draw(&app, 80, 24);
-    assert!(s.contains("bad        DAMAGED: bad.toml"), "{s}");
+    assert!(s.contains("bad  DAMAGED: bad.toml"), "{s}");
     assert_eq!(app.screens.survey.selected, 1, "the open session is chosen");
     survey(&mut app, SurveyAction::Down);
     let cmds = survey(&mut app, SurveyAction::Enter);
