@@ -14,6 +14,7 @@ pub mod cell;
 pub mod grabber;
 pub mod lights;
 pub mod protocol;
+pub mod replay;
 #[cfg(test)]
 mod script;
 pub mod sim;

@@ -106,6 +106,18 @@ fn quoted(s: &str) -> Option<(&str, &str)> {
     Some((s.get(..end)?, s.get(end + 1..)?))
 }
 
+/// Why a quoted name cannot be taken: a control character (the writer
+/// cannot write it back, and it would reach a terminal).
+fn control_char(name: &str, what: &str) -> Option<String> {
+    let (at, c) = name.char_indices().find(|(_, c)| c.is_control())?;
+    Some(format!(
+        "{what} holds the control character U+{:04X} at character {}: \
+         names are printable text",
+        u32::from(c),
+        name.get(..at).map_or(0, |s| s.chars().count()) + 1
+    ))
+}
+
 /// Like [`parse_par`], also returning the line of each entry's value.
 pub fn parse_par_spanned(text: &str, path: &Path) -> Result<(ParFile, Vec<usize>), FormatError> {
     let all: Vec<(usize, &str)> = numbered_lines(text)
@@ -142,6 +154,9 @@ pub fn parse_par_spanned(text: &str, path: &Path) -> Result<(ParFile, Vec<usize>
             ),
         ));
     };
+    if let Some(m) = control_char(name, "the set's name") {
+        return Err(err(n1, K::Syntax, m));
+    }
     if !tail.trim().is_empty() {
         return Err(err(
             n1,
@@ -210,6 +225,9 @@ pub fn parse_par_spanned(text: &str, path: &Path) -> Result<(ParFile, Vec<usize>
                 format!("expected `index \"name\" type`, found \"{}\"", shorten(t)),
             ));
         };
+        if let Some(m) = control_char(dname, "the name") {
+            return Err(err(n, K::Syntax, m));
+        }
         let Some(ty) = ParType::from_letter(ty.trim()) else {
             return Err(err(
                 n,

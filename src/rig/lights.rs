@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 
 use super::protocol::{
     NumatoCommand, numato_channels_of_digits, numato_mask_digits, numato_parse_mask,
-    numato_parse_state, numato_split,
+    numato_parse_state, numato_reply, numato_split,
 };
 use super::{Link, RigError, SerialLink, open_serial};
 
@@ -269,15 +269,10 @@ impl<P: Link> NumatoBoard<P> {
         self.rx.clear();
         self.write(format!("{text}\r").as_bytes())?;
         let deadline = Instant::now() + self.timeout;
-        let echo = text.as_bytes();
         loop {
-            if let Some(p) = find(&self.rx, echo) {
-                let after = self.rx.get(p..).unwrap_or_default();
-                if let Some(q) = after.iter().position(|&b| b == b'>') {
-                    let body = after.get(..q).unwrap_or_default().to_vec();
-                    self.rx.drain(..p + q + 1);
-                    return Ok(numato_split(text, &body).map_err(|e| Miss::Garbled(e.to_string())));
-                }
+            if let Some((used, reply)) = numato_reply(text, &self.rx) {
+                self.rx.drain(..used);
+                return Ok(reply.map_err(|e| Miss::Garbled(e.to_string())));
             }
             if self.rx.len() > MAX_REPLY {
                 let got = String::from_utf8_lossy(&self.rx).into_owned();

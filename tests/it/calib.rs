@@ -290,3 +290,50 @@ fn a_symmetric_plate_gives_no_extrinsic_pose() {
     let e = calib::extrinsic::extrinsic(&view, &p, &truth(1)).unwrap_err();
     assert!(matches!(e, CalibError::Symmetric(_)), "{e}");
 }
+
+#[test]
+fn the_calibration_page_renders_in_ghostscript() {
+    let p = plate("squares");
+    let t = truth(1);
+    let views = held_views(&p, 1, 12);
+    let c = calib::calibrate(&views, &options(&t, Some([t.cx, t.cy]))).unwrap();
+    let ps = vss::report::calibration::document(1, &c);
+    for want in ["camera 1: calibration", "RMS", "k1", "view12", "coverage"] {
+        assert!(ps.contains(want), "{want}");
+    }
+    assert!(
+        ps.contains("C \\(stated\\)"),
+        "the stated centre is on the page"
+    );
+    crate::support::gs::require_gs();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cal.ps");
+    std::fs::write(&path, &ps).unwrap();
+    let pages = crate::support::gs::render(&path, "a4", 72);
+    assert_eq!(pages.len(), 1);
+    let page = &pages[0];
+    let (w, h) = page.dimensions();
+    let count = |x0: u32, x1: u32, y0: u32, y1: u32, f: &dyn Fn(u32) -> bool| {
+        (y0..y1)
+            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                f(page
+                    .get_pixel(x, y)
+                    .0
+                    .iter()
+                    .map(|&c| u32::from(c))
+                    .sum::<u32>()
+                    / 3)
+            })
+            .count()
+    };
+    // The residual picture (top left) holds the corners' dots; the coverage
+    // map (top right) is shaded grey where the plate was.
+    let dots = count(0, w / 2, 0, h / 2, &|v| v < 100);
+    let grey = count(w / 2, w, 0, h / 2, &|v| (60..230).contains(&v));
+    assert!(dots > 500, "{dots} dark pixels in the residual picture");
+    assert!(grey > 2000, "{grey} grey pixels in the coverage map");
+    // The text half has the parameters.
+    let text = count(0, w, h / 2, h, &|v| v < 100);
+    assert!(text > 500, "{text}");
+}

@@ -318,6 +318,20 @@ fn cases() -> Vec<(&'static str, &'static str, Vec<u8>, K, Location)> {
             Line(1),
         ),
         (
+            "par control character in a name",
+            "par",
+            t("1 \"set\"\n0 1\n0 \"c\u{1}nect.wl\" i\n"),
+            K::Syntax,
+            Line(3),
+        ),
+        (
+            "par control character in the set's name",
+            "par",
+            t("1 \"s\u{1b}[2Jet\"\n0 1\n0 \"a\" i\n"),
+            K::Syntax,
+            Line(1),
+        ),
+        (
             "par fewer lines than count",
             "par",
             t("3 \"set\"\n0 1\n0 \"a\" i\n"),

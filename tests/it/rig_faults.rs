@@ -320,3 +320,5 @@ fn lossy_line_timings() {
         );
     }
 }
+
+mod matrix;

@@ -92,7 +92,7 @@ fn help_lists_every_key_of_every_screen_and_hints_fit() {
             Scope::Prompt,
             Scope::Viewer,
         ];
-        if *screen != ScreenId::Session {
+        if keymap::has_picture(*screen) {
             scopes.push(Scope::Picture);
         }
         for scope in scopes {

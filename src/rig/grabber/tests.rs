@@ -60,6 +60,30 @@ fn garbled_reply_is_retried_and_counted() {
 }
 
 #[test]
+fn a_noisy_line_gets_more_tries_than_a_silent_one() {
+    // Five damaged HELLO replies in a row (a long reply on a line losing
+    // 1 in 100 bytes): the grabber is there, so it is asked again beyond
+    // the profile's two retries.
+    let mut bad = line(HELLO);
+    bad[3] ^= 0x20;
+    let mut answers = vec![bad.clone(); 5];
+    answers.push(line(HELLO));
+    let mut c = client(answers);
+    assert!(c.hello().is_ok(), "connects after five garbled replies");
+    assert_eq!(sent(&mut c).matches("HELLO*42").count(), 6);
+    // A line that only ever garbles ends, with every attempt counted.
+    let mut c = client(vec![bad; 40]);
+    match c.hello() {
+        Err(RigError::Garbled { attempts, .. }) => assert_eq!(attempts, GARBLED_TRIES),
+        other => panic!("expected a garbled reply, got {other:?}"),
+    }
+    assert_eq!(
+        sent(&mut c).matches("HELLO*42").count(),
+        GARBLED_TRIES as usize
+    );
+}
+
+#[test]
 fn silence_ends_in_a_timeout_naming_port_and_command() {
     let mut c = client(vec![]);
     let e = c.status();

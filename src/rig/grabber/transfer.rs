@@ -26,7 +26,7 @@
 //! inter-byte wait of a failure, each weighed by how likely a block of that
 //! size comes through whole.
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
 use super::{ReadFail, VsgClient};
@@ -318,7 +318,9 @@ impl<P: Link> VsgClient<P> {
         let maxblock = self.info.as_ref().map_or(u32::MAX, |i| i.maxblock.max(1));
         let sizer = Sizer::new(self.cfg.block.min(maxblock).max(1));
         let byte_time = 10.0 / f64::from(self.cfg.baud.max(1));
-        let mut data = vec![0u8; total];
+        // Blocks as they come, put together at the end: memory follows the
+        // bytes received, not the size a FREEZE reply claims.
+        let mut blocks: BTreeMap<u32, Vec<u8>> = BTreeMap::new();
         let mut done = 0usize;
         let mut t = Pipeline {
             owed: VecDeque::from([(0, total as u32)]),
@@ -345,9 +347,7 @@ impl<P: Link> VsgClient<P> {
                     failed.clear();
                     match self.payload(len, crc)? {
                         Payload::Good(bytes) => {
-                            if let Some(dst) = data.get_mut(off as usize..(off + len) as usize) {
-                                dst.copy_from_slice(&bytes);
-                            }
+                            blocks.insert(off, bytes);
                             done += len as usize;
                             t.sizer.record(len, true);
                             (silent, bad_in_a_row) = (0, 0);
@@ -408,6 +408,10 @@ impl<P: Link> VsgClient<P> {
             }
             t.fail(&failed);
             self.count_failures(&failed, &mut bad_in_a_row)?;
+        }
+        let mut data = Vec::with_capacity(total);
+        for b in blocks.into_values() {
+            data.extend_from_slice(&b);
         }
         let got = crc32(&data);
         if got != frame.crc {

@@ -135,6 +135,25 @@ pub fn numato_split(sent: &str, raw: &[u8]) -> Result<Vec<String>, NumatoReplyEr
         .collect())
 }
 
+/// The answer to `sent` in what the board has sent so far: the lines
+/// between this command's echo and the next `>` prompt, and how many bytes
+/// that took; `None` until a prompt has followed the echo. Whatever comes
+/// before the echo (a late answer to an earlier command) is passed over.
+pub fn numato_reply(
+    sent: &str,
+    rx: &[u8],
+) -> Option<(usize, Result<Vec<String>, NumatoReplyError>)> {
+    let echo = sent.as_bytes();
+    let p = if echo.is_empty() {
+        0
+    } else {
+        rx.windows(echo.len()).position(|w| w == echo)?
+    };
+    let after = rx.get(p..)?;
+    let q = after.iter().position(|&b| b == b'>')?;
+    Some((p + q + 1, numato_split(sent, after.get(..q)?)))
+}
+
 /// The state `relay read N` reports.
 pub fn numato_parse_state(lines: &[String]) -> Result<bool, NumatoReplyError> {
     match lines {

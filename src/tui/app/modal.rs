@@ -33,6 +33,8 @@ pub enum Pending {
     Edit,
     /// Create a session whose name ends in a digit.
     CreateSession(String),
+    /// Write the calibration shown into its camera's `.cdf`.
+    CalibWrite,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -251,6 +253,7 @@ impl App {
                 let (s, mut ctx) = self.parts();
                 s.edit.confirmed(&mut ctx)
             }
+            Pending::CalibWrite => self.screens.calibrate.confirmed(),
         }
     }
 
