@@ -127,12 +127,22 @@ fn damaged_sessions_and_files_are_shown_and_only_the_damage_retaken() {
     let s = c.wait_text("captures lighting b again", 10);
     assert!(s.contains("Image 1"), "{s}");
     c.press(SURVEY, Action::Survey(SurveyAction::Enter));
-    // Reviewed, and the new frame saved: the checklist's mark goes when the
-    // session holds it (the review can come first).
-    c.wait("image 1 reviewed again, b saved", 30, |s| {
+    c.wait("image 1 reviewed again", 30, |s| {
         s.contains("before CONNECT") && s.contains("abc") && !s.contains("a!c")
     });
-    let img = vss::formats::img::read_img(&d.join("cube1b.img")).expect("lighting b retaken");
+    // The frame is saved by the store worker, which may finish after the
+    // review is on screen: wait for the file itself.
+    let end = std::time::Instant::now() + Duration::from_secs(20);
+    let img = loop {
+        match vss::formats::img::read_img(&d.join("cube1b.img")) {
+            Ok(img) => break img,
+            Err(e) => assert!(
+                std::time::Instant::now() < end,
+                "lighting b never retaken: {e}"
+            ),
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
     assert_eq!(img.image.size(), (128, 128));
     c.send("q");
     c.wait_exit(10);
