@@ -57,7 +57,7 @@ fn a_camera_calibrated_on_the_calibrate_screen() {
     c.wait_text("views kept: 0", 10);
     let cb = Scope::Screen(ScreenId::Calibrate);
     c.press(cb, Action::Calibrate(CA::Plate));
-    c.wait_text("(in view)", 10);
+    c.wait_text("plate shown (p)", 10);
     for n in 1..=6 {
         c.press(cb, Action::Calibrate(CA::Grab));
         c.wait("a grid in the new frame", 30, |s| {
@@ -70,7 +70,7 @@ fn a_camera_calibrated_on_the_calibrate_screen() {
     c.wait_text("stated, image middle", 10);
     c.press(cb, Action::Calibrate(CA::Solve));
     let s = c.wait("the calibration", 30, |s| {
-        s.contains("RMS 0.") && s.contains("worst:")
+        s.contains("RMS 0.") && s.contains("worst views")
     });
     assert!(s.contains("residuals ×"), "{s}");
     c.press(cb, Action::Calibrate(CA::Accept));
@@ -96,7 +96,8 @@ fn a_camera_calibrated_on_the_calibrate_screen() {
 }
 
 /// At 80 × 24: a frame without the plate is not kept and says why, and
-/// two views are refused with what to do; no `.cdf` is touched.
+/// two views are refused with what to do, no `.cdf` touched; with eight
+/// the whole solution fits the panel.
 #[test]
 fn too_few_views_and_no_plate_are_refused_at_80_by_24() {
     let mut c = Console::start_with(PROFILE, 80, 24, &[], |dir| {
@@ -122,7 +123,7 @@ fn too_few_views_and_no_plate_are_refused_at_80_by_24() {
     c.press(cb, Action::Calibrate(CA::Keep));
     c.wait_words("not kept: the plate is not in view", 10);
     c.press(cb, Action::Calibrate(CA::Plate));
-    c.wait_text("(in view)", 10);
+    c.wait_text("plate shown (p)", 10);
     for n in 1..=2 {
         c.press(cb, Action::Calibrate(CA::Grab));
         c.wait("a grid in the new frame", 30, |s| s.contains("188 corners"));
@@ -135,6 +136,19 @@ fn too_few_views_and_no_plate_are_refused_at_80_by_24() {
     c.wait_words("nothing to accept", 10);
     assert_eq!(std::fs::read(dir.join("cam1.cdf")).unwrap(), before);
     assert!(!dir.join("cam1.cdf.bak").exists());
+    // Enough views: every parameter and the worst views fit in 80 × 24.
+    for n in 3..=8 {
+        c.press(cb, Action::Calibrate(CA::Grab));
+        c.wait("a grid in the new frame", 30, |s| s.contains("188 corners"));
+        c.press(cb, Action::Calibrate(CA::Keep));
+        c.wait_text(&format!("views kept: {n}"), 10);
+    }
+    c.press(cb, Action::Calibrate(CA::Solve));
+    // The panel's last rows: the frame is drawn top to bottom.
+    let s = c.wait("the calibration", 30, |s| s.contains("worst views"));
+    for want in ["RMS 0.", "Cx", "f ", "k1", "g4", " view "] {
+        assert!(s.contains(want), "{want} on the screen:\n{s}");
+    }
     c.send("q");
     c.wait_exit(10);
 }

@@ -6,12 +6,12 @@
 //! `.bak`). On the simulated cell `p` puts the plate in view, at a new pose
 //! each freeze.
 //!
-//! Finding the grid takes a few tens of milliseconds a frame and solving a
-//! dozen views well under a second; both run on the UI thread, between
-//! frames that come at most twice a second.
+//! Finding the grid takes about 10 ms of CPU a frame at 512² and solving a
+//! dozen views about 35 ms (docs/calibration.md); both run on the UI
+//! thread, between frames that come at most twice a second.
 
 use super::{Ctx, Pending};
-use crate::calib::{self, Calibration, Detection, Detector, Plate, View};
+use crate::calib::{self, Calibration, DetectError, Detection, Detector, Plate, PlateError, View};
 use crate::llv::GreyImage;
 use crate::rig::sim::plate::{Mode, PlateTarget};
 use crate::tui::event::{Cmd, DeviceCmd, FramePurpose, StoreCmd};
@@ -20,6 +20,15 @@ use crate::tui::keymap::CalibrateAction;
 /// The plate the console calibrates with (`profiles/plates/`).
 pub const PLATE: &str = "squares";
 
+/// Why a frame gave no grid.
+#[derive(Debug, thiserror::Error)]
+pub enum GridError {
+    #[error(transparent)]
+    Plate(#[from] PlateError),
+    #[error(transparent)]
+    Detect(#[from] DetectError),
+}
+
 /// The Calibrate screen's own state.
 #[derive(Debug)]
 pub struct CalibrateScreen {
@@ -27,7 +36,7 @@ pub struct CalibrateScreen {
     plate: Option<Plate>,
     detector: Detector,
     /// The grid in the latest frame: its camera and what was found (or why not).
-    pub last: Option<(u32, Result<Detection, String>)>,
+    pub last: Option<(u32, Result<Detection, GridError>)>,
     /// Views kept: camera, view.
     pub kept: Vec<(u32, View)>,
     /// Image size of the views kept.
@@ -57,13 +66,12 @@ impl Default for CalibrateScreen {
 }
 
 impl CalibrateScreen {
-    /// The plate, read on first use; an error is logged and kept for the
-    /// grid line of the panel.
-    fn plate(&mut self) -> Result<Plate, String> {
+    /// The plate, read on first use.
+    fn plate(&mut self) -> Result<Plate, PlateError> {
         if let Some(p) = &self.plate {
             return Ok(p.clone());
         }
-        let p = Plate::load(PLATE).map_err(|e| e.to_string())?;
+        let p = Plate::load(PLATE)?;
         self.plate = Some(p.clone());
         Ok(p)
     }
@@ -81,7 +89,8 @@ impl CalibrateScreen {
     pub fn frame(&mut self, camera: u32, img: &GreyImage) {
         let found = self
             .plate()
-            .and_then(|p| self.detector.detect(img, &p).map_err(|e| e.to_string()));
+            .map_err(GridError::from)
+            .and_then(|p| Ok(self.detector.detect(img, &p)?));
         self.last = Some((camera, found));
     }
 
@@ -120,7 +129,7 @@ impl CalibrateScreen {
                     vec![Cmd::Device(DeviceCmd::SimTarget(target))]
                 }
                 Err(e) => {
-                    ctx.error(e);
+                    ctx.error(e.to_string());
                     Vec::new()
                 }
             },
@@ -133,6 +142,7 @@ impl CalibrateScreen {
                     Some(i) => {
                         let (_, v) = self.kept.remove(i);
                         self.result = None;
+                        self.refused = None;
                         ctx.info(format!("camera {cam}: {} dropped", v.name));
                     }
                     None => ctx.info(format!("camera {cam}: no view kept")),
@@ -142,6 +152,7 @@ impl CalibrateScreen {
             CalibrateAction::Centre => {
                 self.centre_stated = !self.centre_stated;
                 self.result = None;
+                self.refused = None;
                 Vec::new()
             }
             CalibrateAction::Solve => {
@@ -171,6 +182,7 @@ impl CalibrateScreen {
                 };
                 self.kept.push((cam, view));
                 self.result = None;
+                self.refused = None;
                 // The next view needs a new frame.
                 self.last = None;
                 ctx.info(format!("camera {cam}: view {n} kept"));
@@ -184,8 +196,15 @@ impl CalibrateScreen {
 
     fn solve(&mut self, cam: u32, ctx: &mut Ctx) {
         let Some(m) = ctx.cell.camera_model(cam) else {
+            let file = ctx
+                .cell
+                .cdf_paths
+                .get(cam as usize - 1)
+                .cloned()
+                .flatten()
+                .map_or("none named".into(), |p| p.display().to_string());
             ctx.error(format!(
-                "camera {cam}: the profile's .cdf gives no scale S (vss calibrate --camera {cam} --scale SX,SY makes the first one)"
+                "camera {cam}: no scale S to calibrate with — the profile's .cdf ({file}) is missing or lacks S, C or f; `vss calibrate --camera {cam} --scale SX,SY IMAGES…` makes the first one"
             ));
             return;
         };

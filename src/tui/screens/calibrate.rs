@@ -9,10 +9,10 @@ use ratatui::layout::Rect;
 use ratatui::text::Line;
 use ratatui::widgets::{Paragraph, Widget, Wrap};
 
-use super::{block, split_panel};
-use crate::calib::{self, COVERAGE, Calibration, Detection};
+use super::{Theme, block, split_panel};
+use crate::calib::{self, COVERAGE, Calibration, Detection, View};
 use crate::llv::{Point, Segment};
-use crate::tui::app::{App, PLATE};
+use crate::tui::app::{App, CalibrateScreen, PLATE};
 use crate::tui::widgets::preview::{Layer, Preview, PreviewMode};
 
 /// The cells found, as outlines to draw over the picture.
@@ -43,49 +43,41 @@ fn residuals(c: &Calibration) -> Vec<Segment> {
         .collect()
 }
 
-pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
-    let t = app.theme();
-    let s = &app.screens.calibrate;
-    let cam = s.camera;
-    let (panel, right) = split_panel(
-        area,
-        super::panel_width(crate::tui::keymap::ScreenId::Calibrate),
-    );
-    let mut lines = vec![
-        Line::styled(format!("camera {cam} (c)  plate {PLATE}"), t.title()),
-        Line::raw(format!(
-            "live {} (v)  grab g  plate p{}",
-            if app.cell.device.live { "ON" } else { "off" },
-            if s.plate_shown { " (in view)" } else { "" }
-        )),
-    ];
+/// The panel's line on the grid in the latest frame.
+fn grid_line(s: &CalibrateScreen, cam: u32, t: Theme) -> Line<'static> {
     match &s.last {
-        Some((c, Ok(d))) if *c == cam => lines.push(Line::styled(
-            format!("grid: {} corners found", d.corners.len()),
-            t.ok(),
-        )),
-        Some((c, Err(e))) if *c == cam => lines.push(Line::styled(format!("grid: {e}"), t.warn())),
-        _ => lines.push(Line::raw("grid: no frame yet")),
+        Some((c, Ok(d))) if *c == cam => {
+            Line::styled(format!("grid: {} corners found", d.corners.len()), t.ok())
+        }
+        Some((c, Err(e))) if *c == cam => {
+            // What went wrong; what to do is in the message `Space` gives.
+            let e = e.to_string();
+            let what = e.split(": ").next().unwrap_or(&e);
+            Line::styled(format!("grid: {what}"), t.warn())
+        }
+        _ => Line::raw("grid: no frame yet"),
     }
-    let views = s.views_of(cam);
-    lines.push(Line::raw(format!(
-        "views kept: {} (Space keep, Bksp drop)",
-        views.len()
-    )));
-    // Coverage: where the corners of the kept views fell.
-    let (w, h) = s.size;
+}
+
+/// The coverage map: where the corners of the views kept fell.
+fn coverage_lines(
+    views: &[View],
+    (w, h): (usize, usize),
+    ascii: bool,
+    t: Theme,
+) -> Vec<Line<'static>> {
     let hits = calib::coverage(
         views.iter().flat_map(|v| v.corners.iter().map(|c| c.px)),
         w.max(1),
         h.max(1),
     );
     let most = hits.iter().copied().max().unwrap_or(0).max(1);
-    let ramp: &[char] = if app.chrome.look.mode != PreviewMode::Ascii {
-        &[' ', '░', '▒', '▓', '█']
-    } else {
+    let ramp: &[char] = if ascii {
         &[' ', '.', ':', '*', '#']
+    } else {
+        &[' ', '░', '▒', '▓', '█']
     };
-    lines.push(Line::styled("coverage", t.title()));
+    let mut lines = vec![Line::styled("coverage", t.title())];
     for row in 0..COVERAGE {
         let cells: String = (0..COVERAGE)
             .map(|col| {
@@ -101,6 +93,40 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
             .collect();
         lines.push(Line::raw(format!(" |{cells}|")));
     }
+    lines
+}
+
+pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
+    let t = app.theme();
+    let s = &app.screens.calibrate;
+    let cam = s.camera;
+    let (panel, right) = split_panel(
+        area,
+        super::panel_width(crate::tui::keymap::ScreenId::Calibrate),
+    );
+    let mut lines = vec![
+        Line::styled(format!("camera {cam} (c)  plate {PLATE}"), t.title()),
+        Line::raw(format!(
+            "live {} (v)  plate {} (p)",
+            if app.cell.device.live { "ON" } else { "off" },
+            if s.plate_shown { "shown" } else { "away" }
+        )),
+    ];
+    // With a solution shown, its figures take the room of the grid line
+    // and the coverage map (80 × 24 has sixteen rows here).
+    let solved = s.result.as_ref().filter(|(c, _)| *c == cam).map(|(_, c)| c);
+    if solved.is_none() {
+        lines.push(grid_line(s, cam, t));
+    }
+    let views = s.views_of(cam);
+    lines.push(Line::raw(format!(
+        "views kept: {} (Space/Bksp)",
+        views.len()
+    )));
+    if solved.is_none() {
+        let ascii = app.chrome.look.mode == PreviewMode::Ascii;
+        lines.extend(coverage_lines(&views, s.size, ascii, t));
+    }
     lines.push(Line::raw(format!(
         "centre C: {} (s)",
         if s.centre_stated {
@@ -109,8 +135,8 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
             "solved"
         }
     )));
-    match &s.result {
-        Some((c_cam, c)) if *c_cam == cam => {
+    match solved {
+        Some(c) => {
             lines.push(Line::styled(
                 format!("RMS {:.3} px  p95 {:.3} px", c.rms, c.p95),
                 t.ok(),
@@ -125,18 +151,20 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
             worst.sort_by(|a, b| b.rms.total_cmp(&a.rms));
             let names: Vec<String> = worst
                 .iter()
-                .take(3)
+                .take(2)
                 .map(|v| format!("{} {:.3}", v.name, v.rms))
                 .collect();
-            lines.push(Line::raw(format!("worst: {}", names.join(", "))));
-            lines.push(Line::raw("a accept: write the camera's .cdf"));
+            lines.push(Line::styled("worst views (RMS px):", t.title()));
+            lines.push(Line::raw(format!(" {}", names.join("  "))));
         }
-        _ => {
-            if let Some(e) = &s.refused {
-                lines.push(Line::styled(e.clone(), t.error()));
-            }
-            lines.push(Line::raw("Enter: compute"));
-        }
+        None => match &s.refused {
+            // Why; what to do is in the message line (`!` shows it all).
+            Some(e) => lines.push(Line::styled(
+                format!("refused: {}", e.split(": ").next().unwrap_or(e)),
+                t.error(),
+            )),
+            None => lines.push(Line::raw("Enter: compute")),
+        },
     }
     Paragraph::new(lines)
         .wrap(Wrap { trim: false })
