@@ -16,7 +16,7 @@ use super::widgets::preview::PreviewMode;
 
 mod calibrate;
 mod capture;
-mod chrome;
+pub mod chrome;
 mod edit;
 mod pipeline;
 mod session;

@@ -18,6 +18,7 @@ use vss::tui::keymap::{
     Action, EditAction, GlobalAction, ModalAction, Scope, ScreenId, SurveyAction,
 };
 
+use super::tui_harness::flat;
 use super::tui_screens::{
     code, colour, draw, edit, go, key, lines_shown, press, profile, reviewed, reviewed_in, run,
     square, survey, view,
@@ -384,7 +385,7 @@ fn the_session_picker_confirms_and_shows_damaged_sessions() {
     ])));
     survey(&mut app, SurveyAction::OpenPicker);
     let (s, _) = draw(&app, 80, 24);
-    assert!(s.contains("bad        DAMAGED: bad.toml"), "{s}");
+    assert!(s.contains("bad  DAMAGED: bad.toml"), "{s}");
     assert_eq!(app.screens.survey.selected, 1, "the open session is chosen");
     survey(&mut app, SurveyAction::Down);
     let cmds = survey(&mut app, SurveyAction::Enter);
@@ -518,16 +519,23 @@ fn the_session_name_field_edits_like_a_shell() {
     ctrl(&mut app, 'u');
     key(&mut app, 'q');
     key(&mut app, '1');
+    // A name ending in a digit is asked about; no goes back to the field.
     let cmds = code(&mut app, KeyCode::Enter);
+    assert!(cmds.is_empty(), "not created before the question");
+    let (s, _) = draw(&app, 80, 24);
+    assert!(flat(&s).contains("q11a.img"), "the digit warning:\n{s}");
+    assert!(flat(&s).contains("Create q1 anyway?"), "{s}");
+    let cmds = key(&mut app, 'n');
+    assert!(cmds.is_empty());
+    let Some(Modal::Prompt(p)) = &app.chrome.modal else {
+        panic!("back to the field")
+    };
+    assert_eq!(p.text, "q1", "with the name to change");
+    code(&mut app, KeyCode::Enter);
+    let cmds = key(&mut app, 'y');
     assert!(
         cmds.iter()
-            .any(|c| matches!(c, Cmd::Store(StoreCmd::Create(n)) if n == "q1"))
-    );
-    assert!(
-        app.chrome
-            .log
-            .entries()
-            .any(|e| e.text.contains("q11a.img")),
-        "the digit warning"
+            .any(|c| matches!(c, Cmd::Store(StoreCmd::Create(n)) if n == "q1")),
+        "yes creates it: {cmds:?}"
     );
 }

@@ -1,7 +1,8 @@
 //! The console when things go wrong, through the real binary in a pty at
 //! 80 × 24: a long error wraps and opens in full and lands in the log
-//! file; a damaged session is listed with why, a truncated image is marked
-//! and only its lighting retaken; a report that cannot be written says so;
+//! file; a damaged session is listed with why, a truncated image and a
+//! garbled line file are marked and only the image's damaged lighting
+//! retaken; a report that cannot be written says so;
 //! a session held by a console that still runs is offered to take over;
 //! a terminal too small, a dumb terminal and the Linux console.
 
@@ -68,6 +69,7 @@ fn damaged_sessions_and_files_are_shown_and_only_the_damage_retaken() {
         let img = dir.join("sessions/cube/cube1b.img");
         let f = std::fs::OpenOptions::new().write(true).open(&img).unwrap();
         f.set_len(5000).unwrap();
+        std::fs::write(dir.join("sessions/cube/cube1.ldr"), "not a line file\n").unwrap();
         let bad = dir.join("sessions/bad");
         std::fs::create_dir_all(&bad).unwrap();
         let m = std::fs::read_to_string(dir.join("sessions/cube/cube.toml")).unwrap();
@@ -86,7 +88,10 @@ fn damaged_sessions_and_files_are_shown_and_only_the_damage_retaken() {
         std::fs::create_dir(dir.join("sessions/cube/cube.ps")).unwrap();
     });
     let s = c.wait_text("DAMAGED", 10);
-    assert!(s.contains("bad        DAMAGED"), "listed, not hidden:\n{s}");
+    assert!(
+        s.contains("bad  DAMAGED: bad.toml:11"),
+        "listed with the file and line, not hidden:\n{s}"
+    );
     // The damaged one is first: Enter shows the full error and the command.
     c.send("\r");
     let s = c.wait_text("last message", 5);
@@ -98,6 +103,11 @@ fn damaged_sessions_and_files_are_shown_and_only_the_damage_retaken() {
     c.send("\r");
     let s = c.wait_text("session cube", 10);
     assert!(s.contains("a!c"), "the truncated lighting is marked:\n{s}");
+    assert!(
+        s.lines()
+            .any(|r| r.contains("a!c") && r.contains("DAMAGED")),
+        "so is the garbled .ldr, on image 1's row:\n{s}"
+    );
     assert!(s.contains("damaged or missing"), "{s}");
     c.send("5");
     let s = c.wait_text("problem(s)", 10);
@@ -117,12 +127,22 @@ fn damaged_sessions_and_files_are_shown_and_only_the_damage_retaken() {
     let s = c.wait_text("captures lighting b again", 10);
     assert!(s.contains("Image 1"), "{s}");
     c.press(SURVEY, Action::Survey(SurveyAction::Enter));
-    // Reviewed, and the new frame saved: the checklist's mark goes when the
-    // session holds it (the review can come first).
-    c.wait("image 1 reviewed again, b saved", 30, |s| {
+    c.wait("image 1 reviewed again", 30, |s| {
         s.contains("before CONNECT") && s.contains("abc") && !s.contains("a!c")
     });
-    let img = vss::formats::img::read_img(&d.join("cube1b.img")).expect("lighting b retaken");
+    // The frame is saved by the store worker, which may finish after the
+    // review is on screen: wait for the file itself.
+    let end = std::time::Instant::now() + Duration::from_secs(20);
+    let img = loop {
+        match vss::formats::img::read_img(&d.join("cube1b.img")) {
+            Ok(img) => break img,
+            Err(e) => assert!(
+                std::time::Instant::now() < end,
+                "lighting b never retaken: {e}"
+            ),
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
     assert_eq!(img.image.size(), (128, 128));
     c.send("q");
     c.wait_exit(10);

@@ -31,6 +31,8 @@ pub enum Pending {
     ExtraImage(u32),
     /// Go on with the edit of an accepted image's lines.
     Edit,
+    /// Create a session whose name ends in a digit.
+    CreateSession(String),
     /// Write the calibration shown into its camera's `.cdf`.
     CalibWrite,
 }
@@ -212,6 +214,17 @@ impl App {
         let pending = match yes {
             Some(true) => on_yes,
             Some(false) => {
+                if let Pending::CreateSession(name) = on_yes {
+                    // Back to the field, the name there to change.
+                    self.chrome.modal = Some(Modal::prompt(
+                        "new session name:",
+                        super::survey::NAME_RULE,
+                        name,
+                        crate::formats::names::MAX_SESSION_LEN,
+                        PromptPurpose::SessionName,
+                    ));
+                    return Vec::new();
+                }
                 self.chrome.log.push(Level::Info, "nothing changed");
                 return Vec::new();
             }
@@ -235,6 +248,7 @@ impl App {
             Pending::Switch(dir) => vec![Cmd::Store(StoreCmd::Open(dir))],
             Pending::TakeOver(dir) => vec![Cmd::Store(StoreCmd::TakeOver(dir))],
             Pending::ExtraImage(k) => self.ctx().extra_image(k),
+            Pending::CreateSession(name) => vec![Cmd::Store(StoreCmd::Create(name))],
             Pending::Edit => {
                 let (s, mut ctx) = self.parts();
                 s.edit.confirmed(&mut ctx)
@@ -254,15 +268,20 @@ impl App {
                         let name = n.as_str();
                         let stem = name.trim_end_matches(|c: char| c.is_ascii_digit());
                         if stem.len() < name.len() {
+                            // Asked, not only logged: the messages of the
+                            // opening would push a warning off the row.
                             let digits = &name[stem.len()..];
-                            self.chrome.log.push(
-                                Level::Warn,
-                                format!(
-                                    "session name {name} ends in a digit: its image 1 is \
-                                     {name}1a.img, which also reads as session {stem} image \
-                                     {digits}1 — a letter at the end avoids that"
-                                ),
+                            let why = format!(
+                                "session name {name} ends in a digit: its image 1 is \
+                                 {name}1a.img, which also reads as session {stem} image \
+                                 {digits}1 — a letter at the end avoids that"
                             );
+                            self.chrome.log.push(Level::Warn, why.clone());
+                            self.chrome.modal = Some(Modal::confirm(
+                                format!("{why}. Create {name} anyway? (n: change the name)"),
+                                Pending::CreateSession(name.to_string()),
+                            ));
+                            return Vec::new();
                         }
                         Ok(vec![Cmd::Store(StoreCmd::Create(n.as_str().to_string()))])
                     }

@@ -348,11 +348,13 @@ fn help_lines(app: &App, width: usize) -> Vec<Line<'static>> {
             Span::raw(*d),
         ]));
     }
-    lines.push(Line::styled(
-        "The mouse, where the terminal sends it: a click chooses a checklist row or a \
-         line, the wheel scrolls lists and zooms pictures; Shift+drag selects text.",
-        t.dim(),
-    ));
+    let mouse = "The mouse, where the terminal sends it: a click chooses a checklist row or a \
+                 line, the wheel scrolls lists and zooms pictures; Shift+drag selects text.";
+    lines.extend(
+        wrap(mouse, width.max(10))
+            .into_iter()
+            .map(|r| Line::styled(r, t.dim())),
+    );
     lines
 }
 

@@ -83,7 +83,13 @@ fn sessions(app: &App, area: Rect, buf: &mut Buffer) {
             Default::default()
         };
         let text = match &e.damaged {
-            Some(why) => format!(" {:<10} DAMAGED: {why}", e.name),
+            Some(why) => {
+                // The row is narrow: the file's name, not its folder (Enter
+                // shows the whole error).
+                let folder = format!("{}/", e.dir.display());
+                let why = why.strip_prefix(folder.as_str()).unwrap_or(why);
+                format!(" {}  DAMAGED: {why}", e.name)
+            }
             None => format!(" {:<10} {}", e.name, e.summary),
         };
         let w = area.width.saturating_sub(2) as usize;
