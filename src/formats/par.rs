@@ -106,16 +106,23 @@ fn quoted(s: &str) -> Option<(&str, &str)> {
     Some((s.get(..end)?, s.get(end + 1..)?))
 }
 
-/// Why a quoted name cannot be taken: a control character (the writer
-/// cannot write it back, and it would reach a terminal).
-fn control_char(name: &str, what: &str) -> Option<String> {
-    let (at, c) = name.char_indices().find(|(_, c)| c.is_control())?;
-    Some(format!(
-        "{what} holds the control character U+{:04X} at character {}: \
-         names are printable text",
-        u32::from(c),
-        name.get(..at).map_or(0, |s| s.chars().count()) + 1
-    ))
+/// Why `name` cannot stand in a `.par` file, if so: a `"` (the format has
+/// no escape) or a control character (it would reach a terminal). The
+/// reader and the writer both ask, so what reads back is what was written.
+fn name_problem(name: &str, what: &str) -> Option<String> {
+    let (at, c) = name
+        .char_indices()
+        .find(|&(_, c)| c == '"' || c.is_control())?;
+    let nth = name.get(..at).map_or(0, |s| s.chars().count()) + 1;
+    Some(if c == '"' {
+        format!("{what} holds a '\"' at character {nth}: names may not hold quotes")
+    } else {
+        format!(
+            "{what} holds the control character U+{:04X} at character {nth}: \
+             names are printable text",
+            u32::from(c)
+        )
+    })
 }
 
 /// Like [`parse_par`], also returning the line of each entry's value.
@@ -154,7 +161,7 @@ pub fn parse_par_spanned(text: &str, path: &Path) -> Result<(ParFile, Vec<usize>
             ),
         ));
     };
-    if let Some(m) = control_char(name, "the set's name") {
+    if let Some(m) = name_problem(name, "the set's name") {
         return Err(err(n1, K::Syntax, m));
     }
     if !tail.trim().is_empty() {
@@ -225,7 +232,7 @@ pub fn parse_par_spanned(text: &str, path: &Path) -> Result<(ParFile, Vec<usize>
                 format!("expected `index \"name\" type`, found \"{}\"", shorten(t)),
             ));
         };
-        if let Some(m) = control_char(dname, "the name") {
+        if let Some(m) = name_problem(dname, "the name") {
             return Err(err(n, K::Syntax, m));
         }
         let Some(ty) = ParType::from_letter(ty.trim()) else {
@@ -330,15 +337,12 @@ pub fn format_par(f: &ParFile) -> String {
 
 /// Why a set cannot be written so that it reads back the same, if so.
 pub fn check_writable(f: &ParFile) -> Option<String> {
-    let bad_text = |s: &str| s.contains('"') || s.chars().any(char::is_control);
-    if bad_text(&f.name) {
-        return Some("the set's name may not hold '\"' or control characters".into());
+    if let Some(m) = name_problem(&f.name, "the set's name") {
+        return Some(m);
     }
     for (i, e) in f.entries.iter().enumerate() {
-        if bad_text(&e.name) {
-            return Some(format!(
-                "entry {i}: the name may not hold '\"' or control characters"
-            ));
+        if let Some(m) = name_problem(&e.name, "the name") {
+            return Some(format!("entry {i}: {m}"));
         }
         if e.value.chars().any(char::is_control) || e.value.trim() != e.value {
             return Some(format!(
