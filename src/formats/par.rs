@@ -107,22 +107,28 @@ fn quoted(s: &str) -> Option<(&str, &str)> {
 }
 
 /// Why `name` cannot stand in a `.par` file, if so: a `"` (the format has
-/// no escape) or a control character (it would reach a terminal). The
-/// reader and the writer both ask, so what reads back is what was written.
+/// no escape) or a control character. The reader and the writer both ask,
+/// so what reads back is what was written.
 fn name_problem(name: &str, what: &str) -> Option<String> {
-    let (at, c) = name
-        .char_indices()
-        .find(|&(_, c)| c == '"' || c.is_control())?;
-    let nth = name.get(..at).map_or(0, |s| s.chars().count()) + 1;
-    Some(if c == '"' {
-        format!("{what} holds a '\"' at character {nth}: names may not hold quotes")
-    } else {
-        format!(
-            "{what} holds the control character U+{:04X} at character {nth}: \
-             names are printable text",
-            u32::from(c)
-        )
-    })
+    if let Some(at) = name.chars().position(|c| c == '"') {
+        return Some(format!(
+            "{what} holds a '\"' at character {}: names may not hold quotes",
+            at + 1
+        ));
+    }
+    control_problem(name, what)
+}
+
+/// Why `text` (a name or a value) cannot stand in a `.par` file, if so: a
+/// control character, which would end its line or reach a terminal.
+fn control_problem(text: &str, what: &str) -> Option<String> {
+    let (at, c) = text.chars().enumerate().find(|(_, c)| c.is_control())?;
+    Some(format!(
+        "{what} holds the control character U+{:04X} at character {}: \
+         .par files hold printable text",
+        u32::from(c),
+        at + 1
+    ))
 }
 
 /// Like [`parse_par`], also returning the line of each entry's value.
@@ -207,6 +213,9 @@ pub fn parse_par_spanned(text: &str, path: &Path) -> Result<(ParFile, Vec<usize>
         let slot = slot(&mut values, i, n, path)?;
         if slot.is_some() {
             return Err(err(n, K::Syntax, format!("value of entry {i} given twice")));
+        }
+        if let Some(m) = control_problem(v.trim(), &format!("the value of entry {i}")) {
+            return Err(err(n, K::Syntax, m));
         }
         *slot = Some((v.trim().to_string(), n));
     }
@@ -344,10 +353,11 @@ pub fn check_writable(f: &ParFile) -> Option<String> {
         if let Some(m) = name_problem(&e.name, "the name") {
             return Some(format!("entry {i}: {m}"));
         }
-        if e.value.chars().any(char::is_control) || e.value.trim() != e.value {
-            return Some(format!(
-                "entry {i}: the value may not hold control characters or outer spaces"
-            ));
+        if let Some(m) = control_problem(&e.value, "the value") {
+            return Some(format!("entry {i}: {m}"));
+        }
+        if e.value.trim() != e.value {
+            return Some(format!("entry {i}: the value may not have outer spaces"));
         }
         if let Some(m) = e.kind.check(&e.value) {
             return Some(format!("entry {i} \"{}\": {m}", e.name));
