@@ -2,7 +2,10 @@
 //! 512² and 2048², on one thread (`edges.threads = 1`, the default) and, for
 //! the pipeline, on two; on a realistic scene (anti-aliased polygons with
 //! noise σ = 2, `tests/it/support/llv_scene.rs`). Lens correction uses a
-//! precomputed map of a distorting camera. Run: `cargo bench --bench llv`.
+//! precomputed map of a distorting camera. `pipeline_five_lightings` is the
+//! same view under four lightings plus an ambient image, so that one run
+//! gives both sides of the several-lightings goal (five images ≤ 2.5 × one).
+//! Run: `cargo bench --bench llv`.
 
 use divan::{Bencher, black_box};
 use vss::llv::connect::{ConnectScratch, connect_into};
@@ -171,6 +174,33 @@ fn pipeline_two_threads(b: Bencher, n: usize) {
     let input = Input {
         images: std::slice::from_ref(&img),
         ambient: None,
+        lens: Some(&map),
+    };
+    let mut ws = Workspace::new();
+    ws.run(&input, &p).expect("runs");
+    b.bench_local(|| {
+        ws.run(black_box(&input), &p).expect("runs");
+    });
+}
+
+/// Five images of one view (four lightings and the ambient image, with lens
+/// correction): the several-lightings path against `pipeline` beside it.
+#[divan::bench(args = SIZES)]
+fn pipeline_five_lightings(b: Bencher, n: usize) {
+    // The same scene with independent noise for each lighting; the ambient
+    // image is the scene at a fifth of its brightness.
+    let lit: Vec<GreyImage> = (0..4)
+        .map(|k| llv_scene::scene(n, n, 2.0, 42 + k))
+        .collect();
+    let amb = image(n);
+    let (w, h) = amb.size();
+    let dim = amb.data().iter().map(|&v| v / 5).collect();
+    let amb = GreyImage::new(w, h, dim).expect("sizes agree");
+    let map = lens_map(n);
+    let p = Params::default();
+    let input = Input {
+        images: &lit,
+        ambient: Some(&amb),
         lens: Some(&map),
     };
     let mut ws = Workspace::new();

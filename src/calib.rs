@@ -12,10 +12,11 @@
 //! - `zhang`: starting values in closed form — a homography per view,
 //!   Zhang's method for the pinhole, each view's pose;
 //! - `solve`: Levenberg–Marquardt on the reprojection error of every
-//!   corner through the forward model (`model`: the pinhole, then
-//!   [`CameraModel`]'s distortion, the same function lens correction
-//!   inverts), standard errors from the Jacobian, and the checks on the set
-//!   of views (few, alike, the plate always in the middle);
+//!   corner through the forward model (`model`: the pinhole, then the
+//!   distortion of [`CameraModel`](crate::llv::lens::CameraModel), the same
+//!   function lens correction inverts), standard errors from the Jacobian,
+//!   and the checks on the set of views (few, alike, the plate always in
+//!   the middle);
 //! - [`extrinsic`]: one view at the plate's place gives `T`, world → camera.
 //!
 //! The command line (`vss calibrate`) and the console call these same
@@ -24,6 +25,7 @@
 
 pub mod detect;
 pub mod extrinsic;
+mod lm;
 pub mod model;
 pub mod plate;
 mod quads;
@@ -40,7 +42,6 @@ pub use solve::{
 };
 
 use crate::formats::cdf::{Cdf, CdfParam, Status};
-use crate::llv::lens::CameraModel;
 
 /// Why a calibration gave no result. Each says what to do.
 #[derive(Debug, thiserror::Error)]
@@ -205,15 +206,11 @@ pub fn detect_all(images: &[(String, crate::llv::GreyImage)], plate: &Plate) -> 
     }
 }
 
-/// The camera an intrinsic calibration starts from when nothing else is
-/// known: a stated scale, the rest found from the views.
-pub fn stated(sx: f64, sy: f64) -> CameraModel {
-    CameraModel {
-        cx: 0.0,
-        cy: 0.0,
-        sx,
-        sy,
-        f: 0.0,
-        distortion: None,
+/// The scale `S` (mm per pixel) a `.cdf` states, if it has a usable one.
+pub fn scale_of(cdf: &Cdf) -> Option<(f64, f64)> {
+    let s: Vec<f64> = cdf.get("S").filter(|p| p.available())?.values().collect();
+    match s[..] {
+        [x, y] if x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite() => Some((x, y)),
+        _ => None,
     }
 }

@@ -7,6 +7,7 @@
 //! report, for the command line and the console alike; saving goes through
 //! [`crate::fsutil::write_atomic`].
 
+pub mod calibration;
 pub mod clip;
 pub mod encode;
 pub mod ps;

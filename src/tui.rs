@@ -95,6 +95,9 @@ pub fn leave() {
     let mut out = io::stdout();
     let _ = execute!(
         out,
+        // A frame cut short (a panic mid-draw) must not leave the terminal
+        // holding back its output.
+        terminal::EndSynchronizedUpdate,
         term_event::DisableMouseCapture,
         cursor::Show,
         terminal::LeaveAlternateScreen
@@ -151,7 +154,7 @@ fn run_loop(
         app.update(Msg::Resize(size.width, size.height));
     }
     // Draw before anything slow starts: the operator sees the console at once.
-    terminal.draw(|f| f.render_widget(&app, f.area()))?;
+    draw(terminal, &app)?;
     spawn_input(tx.clone(), stop.clone())?;
     let workers = Workers {
         device: workers::device::spawn(profile.clone(), tx.clone())?,
@@ -166,7 +169,7 @@ fn run_loop(
     let mut last_draw = Instant::now();
     while !app.quit() && !stop.load(Ordering::SeqCst) {
         if dirty && last_draw.elapsed() >= FRAME {
-            terminal.draw(|f| f.render_widget(&app, f.area()))?;
+            draw(terminal, &app)?;
             last_draw = Instant::now();
             dirty = false;
         }
@@ -202,6 +205,16 @@ fn run_loop(
     workers.dispatch(app.take_log_lines().into_iter().collect());
     workers.finish();
     Ok(())
+}
+
+/// Draws one frame as a synchronized update (DEC mode 2026): a terminal
+/// that knows the mode shows the frame whole, never half old and half new
+/// (over a slow SSH link, or while the machine is loaded); others ignore
+/// the two sequences.
+fn draw(term: &mut Term, app: &App) -> io::Result<()> {
+    ratatui::crossterm::queue!(term.backend_mut(), terminal::BeginSynchronizedUpdate)?;
+    term.draw(|f| f.render_widget(app, f.area()))?;
+    execute!(term.backend_mut(), terminal::EndSynchronizedUpdate)
 }
 
 /// A mouse event placed on what the screen shows there (nothing, where

@@ -40,7 +40,9 @@ use crate::llv::{GreyImage, Params, Segment};
 /// Why a view gave no grid.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DetectError {
-    #[error("the plate is not in view (found {quads} square outlines, the plate has {expected})")]
+    #[error(
+        "the plate is not in view (found {quads} square outlines, the plate has {expected}): hold the whole plate in front of the camera, sharp and evenly lit"
+    )]
     NotFound { quads: usize, expected: usize },
     #[error(
         "found {found} of the plate's {expected} squares in a grid of {columns} × {rows}: the whole plate must be in view, sharp and evenly lit"

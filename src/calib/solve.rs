@@ -1,8 +1,8 @@
 //! The solution: starting values in closed form ([`super::zhang`]), then
-//! Levenberg–Marquardt (the `levenberg-marquardt` crate, MINPACK's method,
-//! over `nalgebra`) on the reprojection error of every corner of every view
-//! through the forward model ([`super::model`]), all intrinsics and every
-//! view's pose at once; standard errors from the Jacobian at the solution
+//! Levenberg–Marquardt ([`super::lm`]: the normal equations summed corner
+//! by corner, over `nalgebra`) on the reprojection error of every corner of
+//! every view through the forward model ([`super::model`]), all intrinsics
+//! and every view's pose at once; standard errors from the Jacobian at the solution
 //! (`s² (JᵀJ)⁻¹`, `s²` the residual variance), and the checks that say
 //! whether the set of views was good enough.
 //!
@@ -16,11 +16,11 @@
 //! projects points nearly as well, but where the centre is known it can be
 //! stated ([`Options::centre`]) and the rest follows it.
 
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Matrix3, Owned, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use super::CalibError;
 use super::detect::Corner;
+use super::lm::{self, Normal as _};
 use super::model::{self, INTRINSIC_NAMES, Pose};
 use super::zhang;
 use crate::llv::lens::CameraModel;
@@ -29,9 +29,6 @@ use crate::llv::lens::CameraModel;
 /// distance) a view counts as parallel to the image plane (about 4° of
 /// tilt for a plate half as wide as it is far).
 pub const PARALLEL_DEPTH: f64 = 0.02;
-
-/// The residual of every corner when a step throws one out of view (px).
-const OUT_OF_VIEW: f64 = 1e4;
 
 /// One view's corners.
 #[derive(Clone, Debug, PartialEq)]
@@ -178,51 +175,62 @@ impl<'a> Fit<'a> {
     }
 }
 
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Fit<'_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
+impl Fit<'_> {
+    /// Every corner's residual (predicted − observed), `None` when a
+    /// corner is out of the camera's view.
+    fn residuals(&self) -> Option<DVector<f64>> {
+        let mut r = DVector::zeros(self.rows);
+        self.each(|row, _, p, obs| {
+            r[row] = p.px.x - obs[0];
+            r[row + 1] = p.px.y - obs[1];
+        })?;
+        Some(r)
+    }
+}
+
+impl lm::Normal for Fit<'_> {
+    fn params(&self) -> DVector<f64> {
+        self.x.clone()
+    }
 
     fn set_params(&mut self, x: &DVector<f64>) {
         self.x.copy_from(x);
     }
 
-    fn params(&self) -> DVector<f64> {
-        self.x.clone()
+    fn cost(&self) -> Option<f64> {
+        self.residuals().map(|r| r.norm_squared())
     }
 
-    fn residuals(&self) -> Option<DVector<f64>> {
-        let mut r = DVector::zeros(self.rows);
-        // A trial step that throws a corner out of the camera's view (or
-        // its distortion out of reach) is a bad step, not the end: a large
-        // residual makes the solver take a shorter one.
-        if self
-            .each(|row, _, p, obs| {
-                r[row] = p.px.x - obs[0];
-                r[row + 1] = p.px.y - obs[1];
-            })
-            .is_none()
-        {
-            r.fill(OUT_OF_VIEW);
-        }
-        Some(r)
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
+    fn normal(&self) -> Option<(DMatrix<f64>, DVector<f64>)> {
         let n = self.x.len();
-        let mut j = DMatrix::zeros(self.rows, n);
         let ni = self.n_intr;
-        self.each(|row, k, p, _| {
-            for a in 0..2 {
+        let mut a = DMatrix::zeros(n, n);
+        let mut g = DVector::zeros(n);
+        // One corner's row of J: its intrinsics' and its view's columns.
+        let mut cols = Vec::with_capacity(ni + 6);
+        let mut vals = Vec::with_capacity(ni + 6);
+        self.each(|_, k, p, obs| {
+            let r = [p.px.x - obs[0], p.px.y - obs[1]];
+            for (row, &res) in r.iter().enumerate() {
+                cols.clear();
+                vals.clear();
                 for (c, &i) in self.free.iter().enumerate() {
-                    j[(row + a, c)] = p.d_intrinsics[(a, i)];
+                    cols.push(c);
+                    vals.push(p.d_intrinsics[(row, i)]);
                 }
                 for c in 0..6 {
-                    j[(row + a, ni + 6 * k + c)] = p.d_pose[(a, c)];
+                    cols.push(ni + 6 * k + c);
+                    vals.push(p.d_pose[(row, c)]);
+                }
+                for (u, &cu) in cols.iter().enumerate() {
+                    g[cu] += vals[u] * res;
+                    for (v, &cv) in cols.iter().enumerate() {
+                        a[(cu, cv)] += vals[u] * vals[v];
+                    }
                 }
             }
         })?;
-        Some(j)
+        Some((a, g))
     }
 }
 
@@ -262,23 +270,19 @@ fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|e| e * e).sum::<f64>() / v.len().max(1) as f64).sqrt()
 }
 
-/// Standard errors of every parameter: `s · sqrt(diag((JᵀJ)⁻¹))`, columns
-/// scaled to unit norm first so that mm, radians and 10⁻⁴ sit together.
-fn standard_errors(j: &DMatrix<f64>, ssr: f64) -> Option<DVector<f64>> {
-    let (m, n) = j.shape();
+/// Standard errors of every parameter from `JᵀJ` over `m` residuals:
+/// `s · sqrt(diag((JᵀJ)⁻¹))`, scaled to a unit diagonal first so that mm,
+/// radians and 10⁻⁴ sit together.
+fn standard_errors(a: &DMatrix<f64>, ssr: f64, m: usize) -> Option<DVector<f64>> {
+    let n = a.nrows();
     if m <= n {
         return None;
     }
-    let norms: Vec<f64> = (0..n).map(|c| j.column(c).norm().max(1e-300)).collect();
-    let mut js = j.clone();
-    for (c, nc) in norms.iter().enumerate() {
-        js.column_mut(c).scale_mut(1.0 / nc);
-    }
-    let inv = js.tr_mul(&js).cholesky()?.inverse();
+    let d: Vec<f64> = (0..n).map(|i| a[(i, i)].max(1e-300).sqrt()).collect();
+    let scaled = DMatrix::from_fn(n, n, |i, j| a[(i, j)] / (d[i] * d[j]));
+    let inv = scaled.cholesky()?.inverse();
     let s2 = ssr / (m - n) as f64;
-    Some(DVector::from_fn(n, |i, _| {
-        (s2 * inv[(i, i)]).sqrt() / norms[i]
-    }))
+    Some(DVector::from_fn(n, |i, _| (s2 * inv[(i, i)]).sqrt() / d[i]))
 }
 
 /// Intrinsic calibration from three or more views.
@@ -353,24 +357,15 @@ pub fn calibrate(views: &[View], o: &Options) -> Result<Calibration, CalibError>
             _ => true,
         })
         .collect();
-    let fit = Fit::new(views, start, free.clone(), &poses);
-    let (fit, report) = LevenbergMarquardt::new().minimize(fit);
-    if !report.termination.was_successful() {
-        return Err(CalibError::NoConvergence {
-            why: format!("{:?}", report.termination),
-        });
-    }
+    let mut fit = Fit::new(views, start, free.clone(), &poses);
+    let report = lm::minimize(&mut fit)?;
     let model = fit.camera();
-    let r = fit
-        .residuals()
-        .filter(|r| r.iter().all(|v| v.abs() < OUT_OF_VIEW))
-        .ok_or(CalibError::NoConvergence {
-            why: "a corner left the camera's view".into(),
-        })?;
-    let j = fit.jacobian().ok_or(CalibError::NoConvergence {
+    let out = || CalibError::NoConvergence {
         why: "a corner left the camera's view".into(),
-    })?;
-    let se = standard_errors(&j, r.norm_squared()).ok_or(CalibError::Degenerate {
+    };
+    let r = fit.residuals().ok_or_else(out)?;
+    let (a, _) = fit.normal().ok_or_else(out)?;
+    let se = standard_errors(&a, r.norm_squared(), r.len()).ok_or(CalibError::Degenerate {
         what: "the parameters cannot be told apart from these views".into(),
     })?;
     let iv = model::intrinsics_vector(&model);
@@ -445,7 +440,7 @@ pub fn calibrate(views: &[View], o: &Options) -> Result<Calibration, CalibError>
         p95: percentile(all, 0.95),
         params,
         warnings,
-        evaluations: report.number_of_evaluations,
+        evaluations: report.evaluations,
         width: o.width,
         height: o.height,
     })
@@ -570,22 +565,14 @@ pub fn solve_pose(view: &View, m: &CameraModel) -> Result<(Pose, f64, f64, [f64;
         what: format!("view {}: no pose fits its homography", view.name),
     })?;
     let views = std::slice::from_ref(view);
-    let fit = Fit::new(views, *m, Vec::new(), &[pose]);
-    let (fit, report) = LevenbergMarquardt::new().minimize(fit);
-    if !report.termination.was_successful() {
-        return Err(CalibError::NoConvergence {
-            why: format!("{:?}", report.termination),
-        });
-    }
+    let mut fit = Fit::new(views, *m, Vec::new(), &[pose]);
+    lm::minimize(&mut fit)?;
     let none = || CalibError::NoConvergence {
         why: "a corner left the camera's view".into(),
     };
-    let r = fit
-        .residuals()
-        .filter(|r| r.iter().all(|v| v.abs() < OUT_OF_VIEW))
-        .ok_or_else(none)?;
-    let j = fit.jacobian().ok_or_else(none)?;
-    let se = standard_errors(&j, r.norm_squared()).ok_or(CalibError::Degenerate {
+    let r = fit.residuals().ok_or_else(none)?;
+    let (a, _) = fit.normal().ok_or_else(none)?;
+    let se = standard_errors(&a, r.norm_squared(), r.len()).ok_or(CalibError::Degenerate {
         what: "the pose cannot be told from this view".into(),
     })?;
     let errs: Vec<f64> = (0..r.len() / 2)

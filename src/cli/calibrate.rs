@@ -51,6 +51,10 @@ pub struct Args {
     /// Replace the intrinsics of an existing --out file.
     #[arg(long)]
     pub yes: bool,
+    /// Also write the calibration page (residuals, coverage, parameters) as
+    /// PostScript.
+    #[arg(long, value_name = "FILE.ps")]
+    pub report: Option<PathBuf>,
     /// Only check the plate file and describe it.
     #[arg(long)]
     pub check_plate: bool,
@@ -160,6 +164,12 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     }
     let existed = out.exists();
     calib::write_intrinsics(&out, &c)?;
+    if let Some(r) = &a.report {
+        let ps = crate::report::calibration::document(cam, &c);
+        crate::fsutil::write_atomic(r, ps.as_bytes())
+            .with_context(|| format!("cannot write {}", r.display()))?;
+        outln!("wrote the calibration page {}", r.display());
+    }
     outln!(
         "wrote {}: C{} f D calibrated, S {}{}",
         out.display(),
@@ -185,15 +195,7 @@ fn stated_scale(profile: &crate::profile::Profile, cam: u32) -> anyhow::Result<(
         bail!("the profile names no .cdf for camera {cam}, so no scale S: {hint}");
     };
     let c = cdf::read_cdf(&path).with_context(|| format!("the scale S: {hint}"))?;
-    let s = c
-        .get("S")
-        .filter(|p| p.available())
-        .map(|p| p.values().collect::<Vec<_>>())
-        .unwrap_or_default();
-    match s[..] {
-        [x, y] if x > 0.0 && y > 0.0 => Ok((x, y)),
-        _ => bail!("{} has no scale S: {hint}", path.display()),
-    }
+    calib::scale_of(&c).with_context(|| format!("{} has no scale S: {hint}", path.display()))
 }
 
 fn print_calibration(c: &Calibration) -> anyhow::Result<()> {

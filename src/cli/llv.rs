@@ -202,10 +202,7 @@ fn run_group(
         .iter()
         .map(|f| {
             // The size from the header, before the pixels are read.
-            imageio::read_any_sized(f, |w, h| {
-                crate::llv::image::check_stage_size(w, h).map_err(|e| e.to_string())
-            })
-            .map(|(f, _)| f)
+            imageio::read_any_sized(f, crate::llv::image::check_stage_size).map(|(f, _)| f)
         })
         .collect::<Result<_, _>>()?;
     // Sizes first: a lens map is made for the size before the stages run.

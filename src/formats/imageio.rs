@@ -70,16 +70,16 @@ pub fn read_any(path: &Path) -> Result<ImgFile, FormatError> {
 /// Reads a grey image and returns the notes a person should see (colour
 /// reduced to grey, 16 bits reduced to 8, alpha dropped).
 pub fn read_any_noted(path: &Path) -> Result<(ImgFile, Vec<String>), FormatError> {
-    read_any_sized(path, |_, _| Ok(()))
+    read_any_sized(path, |_, _| Ok::<(), std::convert::Infallible>(()))
 }
 
 /// Reads a grey image whose size `accept(width, height)` takes, checking
 /// the size from the header before the pixels are read or decoded (an
 /// `.img` costs its 64-byte header, a PNG its compressed bytes, when the
 /// image is refused). Returns the notes as [`read_any_noted`].
-pub fn read_any_sized(
+pub fn read_any_sized<E: std::fmt::Display>(
     path: &Path,
-    accept: impl Fn(usize, usize) -> Result<(), String>,
+    accept: impl Fn(usize, usize) -> Result<(), E>,
 ) -> Result<(ImgFile, Vec<String>), FormatError> {
     let kind = ImageKind::of_or_err(path)?;
     if kind == ImageKind::Img {
@@ -87,7 +87,8 @@ pub fn read_any_sized(
     }
     let bytes = read_bytes(path)?;
     if let Some((w, h)) = foreign_size(&bytes, kind) {
-        accept(w, h).map_err(|m| FormatError::new(path, Location::None, K::Range, m))?;
+        accept(w, h)
+            .map_err(|m| FormatError::new(path, Location::None, K::Range, m.to_string()))?;
     }
     decode_any(&bytes, kind, path)
 }

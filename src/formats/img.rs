@@ -213,20 +213,20 @@ fn open_checked(path: &Path) -> Result<(ImgHeader, Vec<u8>, std::fs::File), Form
 
 /// Reads an `.img`/`.imc` file.
 pub fn read_img(path: &Path) -> Result<ImgFile, FormatError> {
-    read_img_sized(path, |_, _| Ok(()))
+    read_img_sized(path, |_, _| Ok::<(), std::convert::Infallible>(()))
 }
 
 /// Reads an `.img`/`.imc` file whose size `accept(width, height)` takes:
 /// the header is checked (against the file's size and by `accept`) before
 /// a pixel is read, so a refused image costs 64 bytes, not its size.
-pub fn read_img_sized(
+pub fn read_img_sized<E: std::fmt::Display>(
     path: &Path,
-    accept: impl Fn(usize, usize) -> Result<(), String>,
+    accept: impl Fn(usize, usize) -> Result<(), E>,
 ) -> Result<ImgFile, FormatError> {
     use std::io::Read;
     let (h, mut bytes, f) = open_checked(path)?;
     accept(usize::from(h.width), usize::from(h.height))
-        .map_err(|m| FormatError::at_byte(path, 4, K::Range, m))?;
+        .map_err(|m| FormatError::at_byte(path, 4, K::Range, m.to_string()))?;
     let rest = h.file_len().saturating_sub(HEADER_LEN as u64);
     bytes.reserve_exact(usize::try_from(rest).unwrap_or(0));
     f.take(rest)

@@ -9,6 +9,11 @@
 //! it can merge with (re-checking the later ones after each merge, since it
 //! grew), and passes repeat until one merges nothing. [`merge`] itself is
 //! symmetric: `merge(a, b) == merge(b, a)` exactly.
+//!
+//! Beyond §4: a merge also needs the merged line to fit the parts about as
+//! well as their own lines do ([`one_edge`]), so that two distinct
+//! near-collinear edges (a plate's edge and its chamfer, stacked plates seen
+//! edge-on) are not averaged into one line between them.
 
 use super::fit::LineFit;
 use super::params::ConnectParams;
@@ -72,6 +77,39 @@ pub fn mergeable(s1: &Segment, s2: &Segment, p: &ConnectParams) -> bool {
         .clamp(0.0, std::f64::consts::FRAC_PI_2);
     let (sin_max, cos_max) = max.sin_cos();
     geo_mergeable(&Geo::of(s1, p), &Geo::of(s2, p), sin_max, cos_max)
+        && one_edge(s1, s2, &merge(s1, s2))
+}
+
+/// The spread (px) a merge is allowed beyond the parts' residuals: half of
+/// the smallest offset at which two parallel edges count as two.
+const MIN_SPREAD: f64 = 0.25;
+
+/// Whether `merged` is one edge rather than two distinct near-collinear
+/// ones: the length-weighted RMS distance of the parts' endpoints from the
+/// merged line is within the larger of the parts' own residuals plus
+/// [`MIN_SPREAD`]. Two pieces of one edge lie on its line to within their
+/// fits' errors; two parallel edges a pixel apart are half a pixel off the
+/// line between them, whatever their environments and angles allow.
+pub fn one_edge(s1: &Segment, s2: &Segment, merged: &Segment) -> bool {
+    let len = merged.length();
+    if len.is_nan() || len <= 0.0 {
+        return true;
+    }
+    let (dx, dy) = (
+        (merged.b.x - merged.a.x) / len,
+        (merged.b.y - merged.a.y) / len,
+    );
+    let dist = |q: Point| ((q.x - merged.a.x) * dy - (q.y - merged.a.y) * dx).abs();
+    let (w1, w2) = (s1.length(), s2.length());
+    let w = w1 + w2;
+    if w.is_nan() || w <= 0.0 {
+        return true;
+    }
+    let sq = |a: f64, b: f64| a * a + b * b;
+    let spread =
+        ((w1 * sq(dist(s1.a), dist(s1.b)) + w2 * sq(dist(s2.a), dist(s2.b))) / (2.0 * w)).sqrt();
+    let allowed = s1.residual.max(s2.residual) + MIN_SPREAD;
+    spread.is_nan() || spread <= allowed
 }
 
 /// The canonical order of segments: longer first, then by coordinates.
@@ -240,8 +278,12 @@ pub fn connect_into(
             let mut j = i + 1;
             while j < n {
                 let fresh = s.changed[i] + 1 >= pass || s.changed[j] + 1 >= pass;
-                if s.alive[j] && fresh && geo_mergeable(&s.geo[i], &s.geo[j], sin_max, cos_max) {
-                    s.segs[i] = merge(&s.segs[i], &s.segs[j]);
+                let joined =
+                    (s.alive[j] && fresh && geo_mergeable(&s.geo[i], &s.geo[j], sin_max, cos_max))
+                        .then(|| merge(&s.segs[i], &s.segs[j]))
+                        .filter(|m| one_edge(&s.segs[i], &s.segs[j], m));
+                if let Some(m) = joined {
+                    s.segs[i] = m;
                     s.geo[i] = Geo::of(&s.segs[i], p);
                     s.changed[i] = pass;
                     s.alive[j] = false;
@@ -341,6 +383,25 @@ mod tests {
         // 2 merged lines; the 5 px segment falls to the length filter.
         assert_eq!(out1.len(), 2);
         assert!(connect(&[], &p).is_empty());
+    }
+
+    /// Two parallel edges a pixel apart overlap within `wd` and agree in
+    /// direction, but are two edges: not merged. Two pieces of one edge
+    /// with a gap are.
+    #[test]
+    fn distinct_parallel_edges_stay_apart() {
+        let p = ConnectParams::default();
+        let fitted = |mut s: Segment| {
+            s.residual = 0.05;
+            s
+        };
+        let a = fitted(seg(0.0, 0.0, 60.0, 0.0));
+        let b = fitted(seg(40.0, 1.0, 100.0, 1.0));
+        assert!(!mergeable(&a, &b, &p));
+        assert_eq!(connect(&[a, b], &p).len(), 2);
+        let c = fitted(seg(64.0, 0.1, 120.0, 0.1));
+        assert!(mergeable(&a, &c, &p));
+        assert_eq!(connect(&[a, c], &p).len(), 1);
     }
 
     #[test]

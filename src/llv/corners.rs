@@ -34,6 +34,8 @@
 //! ill-defined, and joining colinear pieces is CONNECT's job (§4).
 //! Attributes (response, residual, shadow) are kept.
 
+use nalgebra::{Matrix2, Vector2};
+
 use super::{Point, Segment};
 
 /// Two lines whose directions differ by less than this (degrees) are treated
@@ -84,23 +86,24 @@ fn angle_between_deg(s: &Segment, t: &Segment) -> f64 {
 }
 
 /// The point with the least sum of squared distances to the given lines;
-/// `None` when the lines are (numerically) all parallel.
+/// `None` when the lines are (numerically) all parallel. Each line
+/// `a x + b y + c = 0` (unit normal) is one row of `N p = -c`; the point
+/// solves the normal equations `NᵀN p = -Nᵀc`.
 fn least_squares_point(lines: &[Segment], idx: &[usize]) -> Option<Point> {
-    let (mut sxx, mut sxy, mut syy, mut sx, mut sy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut ntn = Matrix2::zeros();
+    let mut ntc = Vector2::zeros();
     for &i in idx {
         let (a, b, c) = normal_form(&lines[i])?;
-        sxx += a * a;
-        sxy += a * b;
-        syy += b * b;
-        sx -= a * c;
-        sy -= b * c;
+        let n = Vector2::new(a, b);
+        ntn += n * n.transpose();
+        ntc -= n * c;
     }
-    let det = sxx * syy - sxy * sxy;
+    let det = ntn.determinant();
     if det.is_nan() || det.abs() <= 1e-12 {
         return None;
     }
-    let p = Point::new((syy * sx - sxy * sy) / det, (sxx * sy - sxy * sx) / det);
-    (p.x.is_finite() && p.y.is_finite()).then_some(p)
+    let p = ntn.try_inverse()? * ntc;
+    (p.x.is_finite() && p.y.is_finite()).then(|| Point::new(p.x, p.y))
 }
 
 /// Whether moving endpoint `e` to `p` is a corner move: outward along the

@@ -62,6 +62,12 @@ impl PsDoc {
         }
     }
 
+    /// Appends a page whose body another module drew with this prolog's
+    /// procedures (`crate::report::calibration`).
+    pub(super) fn push_page(&mut self, body: String) {
+        self.pages.push(body);
+    }
+
     /// Number of pages so far.
     pub fn page_count(&self) -> usize {
         self.pages.len()
@@ -207,7 +213,7 @@ pub fn survey_report(title: &str, images: &[ImageReport]) -> String {
 }
 
 /// A PostScript string literal: `(`, `)` and `\` escaped, non-ASCII dropped.
-fn ps_string(s: &str) -> String {
+pub(super) fn ps_string(s: &str) -> String {
     let mut out = String::with_capacity(s.len() + 2);
     out.push('(');
     for c in printable(s).chars() {
@@ -220,7 +226,7 @@ fn ps_string(s: &str) -> String {
     out
 }
 
-fn page_heading(heading: &str, i: usize, n: usize) -> String {
+pub(super) fn page_heading(heading: &str, i: usize, n: usize) -> String {
     let text = if n > 1 {
         format!("{heading} ({}/{n})", i + 1)
     } else {
@@ -280,7 +286,7 @@ fn lines_cell(
     let _ = writeln!(out, "grestore\n{} caption", ps_string(caption));
 }
 
-fn text_cell(
+pub(super) fn text_cell(
     out: &mut String,
     text: &[String],
     (col, row): (usize, usize),

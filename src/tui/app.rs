@@ -18,6 +18,7 @@ use super::keymap::{self, Action, GlobalAction, NavAction, Scope, ScreenId};
 use super::mode::Look;
 use crate::profile::Profile;
 
+mod calibrate;
 mod capture;
 mod cell;
 mod chrome;
@@ -33,6 +34,7 @@ mod session;
 mod survey;
 mod tracker;
 
+pub use calibrate::{CalibrateScreen, PLATE};
 pub use capture::CaptureScreen;
 pub use cell::{CellState, DeviceState};
 pub use chrome::{Chrome, LogView, Overlay};
@@ -54,6 +56,7 @@ pub struct Screens {
     pub pipeline: PipelineScreen,
     pub edit: EditScreen,
     pub files: FilesScreen,
+    pub calibrate: CalibrateScreen,
 }
 
 impl Screens {
@@ -64,7 +67,7 @@ impl Screens {
             ScreenId::Capture => Some(&self.capture.nav),
             ScreenId::Pipeline => Some(&self.pipeline.nav),
             ScreenId::Edit => Some(&self.edit.nav),
-            ScreenId::Session => None,
+            ScreenId::Session | ScreenId::Calibrate => None,
         }
     }
 
@@ -74,7 +77,7 @@ impl Screens {
             ScreenId::Capture => Some(&mut self.capture.nav),
             ScreenId::Pipeline => Some(&mut self.pipeline.nav),
             ScreenId::Edit => Some(&mut self.edit.nav),
-            ScreenId::Session => None,
+            ScreenId::Session | ScreenId::Calibrate => None,
         }
     }
 }
@@ -231,6 +234,10 @@ impl App {
             Action::Files(a) => {
                 let (s, mut ctx) = self.parts();
                 s.files.update(a, &mut ctx)
+            }
+            Action::Calibrate(a) => {
+                let (s, mut ctx) = self.parts();
+                s.calibrate.update(a, &mut ctx)
             }
         }
     }

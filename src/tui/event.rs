@@ -243,6 +243,9 @@ pub enum DeviceCmd {
     },
     AllOff,
     Lighting(char),
+    /// Show a calibration plate in the simulated cell's view (`None`: the
+    /// bare cell); a real cell ignores it, with a note.
+    SimTarget(Option<crate::rig::sim::plate::PlateTarget>),
     /// Stop the transfer under way (and the live view).
     Cancel,
 }
@@ -297,4 +300,10 @@ pub enum StoreCmd {
     Export,
     /// Re-read the session, checking every file.
     Refresh,
+    /// Write a camera's calibration into the profile's `.cdf` of that
+    /// camera (the old file kept as `.bak`), then report the cameras again.
+    WriteCdf {
+        camera: u32,
+        calibration: Box<crate::calib::Calibration>,
+    },
 }

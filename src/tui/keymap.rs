@@ -24,15 +24,17 @@ pub enum ScreenId {
     Pipeline,
     Edit,
     Session,
+    Calibrate,
 }
 
 impl ScreenId {
-    pub const ALL: [ScreenId; 5] = [
+    pub const ALL: [ScreenId; 6] = [
         ScreenId::Survey,
         ScreenId::Capture,
         ScreenId::Pipeline,
         ScreenId::Edit,
         ScreenId::Session,
+        ScreenId::Calibrate,
     ];
     pub fn title(self) -> &'static str {
         match self {
@@ -41,6 +43,7 @@ impl ScreenId {
             ScreenId::Pipeline => "Pipeline",
             ScreenId::Edit => "Edit",
             ScreenId::Session => "Session/Report",
+            ScreenId::Calibrate => "Calibrate",
         }
     }
     /// The short title of the top bar at 80 columns.
@@ -79,6 +82,7 @@ pub enum Action {
     Pipeline(PipelineAction),
     Edit(EditAction),
     Files(FilesAction),
+    Calibrate(CalibrateAction),
     Modal(ModalAction),
     Viewer(ViewerAction),
 }
@@ -183,6 +187,21 @@ pub enum FilesAction {
     Down,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CalibrateAction {
+    ToggleLive,
+    Grab,
+    Camera,
+    /// The simulated cell's plate in view / away.
+    Plate,
+    Keep,
+    Drop,
+    /// The centre `C` solved or stated at the image's middle.
+    Centre,
+    Solve,
+    Accept,
+}
+
 /// Questions and text fields.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ModalAction {
@@ -202,9 +221,6 @@ pub enum ModalAction {
     KillLine,
     /// Ctrl-W: the word before the cursor.
     KillWord,
-    /// ↑↓ in a picker.
-    Up,
-    Down,
 }
 
 /// The help overlay and the message viewer.
@@ -236,6 +252,7 @@ impl Action {
                     | EditAction::Redo
             ),
             Action::Files(a) => a == FilesAction::Export,
+            Action::Calibrate(a) => matches!(a, CalibrateAction::Drop | CalibrateAction::Accept),
             Action::Global(a) => a == GlobalAction::Quit,
             Action::Capture(_) | Action::Nav(_) | Action::Modal(_) | Action::Viewer(_) => false,
         }
@@ -264,7 +281,7 @@ impl Action {
             Action::Edit(a) => matches!(a, EditAction::LineNext | EditAction::LinePrev),
             Action::Files(a) => matches!(a, FilesAction::Up | FilesAction::Down),
             Action::Capture(a) => matches!(a, CaptureAction::LightPrev | CaptureAction::LightNext),
-            Action::Modal(_) | Action::Viewer(_) => false,
+            Action::Calibrate(_) | Action::Modal(_) | Action::Viewer(_) => false,
         }
     }
 }
@@ -342,7 +359,7 @@ pub struct Binding {
 pub fn has_picture(s: ScreenId) -> bool {
     match s {
         ScreenId::Survey | ScreenId::Capture | ScreenId::Pipeline | ScreenId::Edit => true,
-        ScreenId::Session => false,
+        ScreenId::Session | ScreenId::Calibrate => false,
     }
 }
 

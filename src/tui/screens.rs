@@ -14,6 +14,7 @@ use super::app::{App, Level, LogView};
 use super::keymap::ScreenId;
 use super::widgets::preview::PreviewMode;
 
+mod calibrate;
 mod capture;
 mod chrome;
 mod edit;
@@ -265,6 +266,7 @@ impl Widget for &App {
             ScreenId::Pipeline => pipeline::render(self, f.body, buf),
             ScreenId::Edit => edit::render(self, f.body, buf),
             ScreenId::Session => session::render(self, f.body, buf),
+            ScreenId::Calibrate => calibrate::render(self, f.body, buf),
         }
         match self.chrome.log_view {
             LogView::Expanded => chrome::log_pane(self, f.message, buf),
@@ -295,7 +297,7 @@ pub fn signed(v: f32) -> String {
 /// The columns of a screen's left panel.
 pub fn panel_width(s: ScreenId) -> u16 {
     match s {
-        ScreenId::Survey | ScreenId::Session => 34,
+        ScreenId::Survey | ScreenId::Session | ScreenId::Calibrate => 34,
         ScreenId::Capture | ScreenId::Pipeline => 32,
         ScreenId::Edit => 30,
     }
@@ -362,7 +364,7 @@ pub fn pointer(
                 let i = r.checked_sub(usize::from(above))?;
                 (i < shown).then_some(Pointer::Param(start + i))
             }
-            ScreenId::Capture | ScreenId::Edit | ScreenId::Session => None,
+            ScreenId::Capture | ScreenId::Edit | ScreenId::Session | ScreenId::Calibrate => None,
         };
     }
     if !inside(right) || !super::keymap::has_picture(screen) {

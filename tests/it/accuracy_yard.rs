@@ -70,15 +70,15 @@ fn floors(level: Level, recall: f64, precision: f64, f: f64) {
 
 #[test]
 fn noise_free() {
-    floors(Level::Sigma(0.0), 0.919, 0.934, 0.926);
+    floors(Level::Sigma(0.0), 0.945, 0.953, 0.949);
 }
 
 #[test]
 fn noise_2() {
-    floors(Level::Sigma(2.0), 0.915, 0.904, 0.909);
+    floors(Level::Sigma(2.0), 0.942, 0.943, 0.942);
     let m = metrics(Level::Sigma(2.0));
     assert!(
-        m.recall_strong >= 0.923,
+        m.recall_strong >= 0.945,
         "strong recall {:.4}",
         m.recall_strong
     );
@@ -86,17 +86,17 @@ fn noise_2() {
 
 #[test]
 fn noise_5() {
-    floors(Level::Sigma(5.0), 0.817, 0.869, 0.842);
+    floors(Level::Sigma(5.0), 0.848, 0.954, 0.898);
 }
 
 #[test]
 fn noise_10() {
-    floors(Level::Sigma(10.0), 0.480, 0.822, 0.606);
+    floors(Level::Sigma(10.0), 0.514, 0.954, 0.669);
 }
 
 #[test]
 fn signal_dependent_noise() {
-    floors(Level::Signal, 0.847, 0.880, 0.863);
+    floors(Level::Signal, 0.888, 0.932, 0.910);
 }
 
 #[test]

@@ -159,6 +159,17 @@ fn twelve_views_fit_to_a_tenth_of_a_pixel_and_find_the_focal_length() {
         }
         // Even so, the images it corrects are within a few tenths of a pixel.
         let d = map_difference(&c.model, &t);
+        // The figures docs/calibration.md quotes (`-- --nocapture`).
+        eprintln!(
+            "camera {cam}, C solved: RMS {:.4} px (p95 {:.4}), f {:+.4} %, C off {:.2} / {:.2} px (se {:.1} / {:.1}), lens map {d:.3} px",
+            c.rms,
+            c.p95,
+            100.0 * (f - t.f) / t.f,
+            param(&c, "Cx").0 - t.cx,
+            param(&c, "Cy").0 - t.cy,
+            param(&c, "Cx").1,
+            param(&c, "Cy").1,
+        );
         assert!(d < 0.6, "camera {cam}: lens map {d} px from the true one");
         solved.push(cam);
     }
@@ -185,6 +196,11 @@ fn with_the_centre_stated_the_lens_map_and_the_pose_are_the_true_ones() {
             .extrinsic()
             .unwrap();
         let (dt, da) = pose_difference(&e.t, &true_t);
+        eprintln!(
+            "camera {cam}, C stated: RMS {:.4} px, f {:+.4} %, lens map {d:.3} px, T off {dt:.3} mm {da:.4}°",
+            c.rms,
+            100.0 * (f - t.f) / t.f
+        );
         assert!(
             dt <= 0.5 && da <= 0.05,
             "camera {cam}: T off by {dt} mm, {da}°"
@@ -203,6 +219,7 @@ fn the_extrinsic_pose_with_the_true_intrinsics() {
             .extrinsic()
             .unwrap();
         let (dt, da) = pose_difference(&e.t, &true_t);
+        eprintln!("camera {cam}, true intrinsics: T off {dt:.3} mm {da:.4}°");
         assert!(
             dt <= 0.5 && da <= 0.05,
             "camera {cam}: T off by {dt} mm, {da}°"
@@ -289,4 +306,69 @@ fn a_symmetric_plate_gives_no_extrinsic_pose() {
     p.origin_mark = false;
     let e = calib::extrinsic::extrinsic(&view, &p, &truth(1)).unwrap_err();
     assert!(matches!(e, CalibError::Symmetric(_)), "{e}");
+}
+
+#[test]
+fn the_calibration_page_renders_in_ghostscript() {
+    let p = plate("squares");
+    let t = truth(1);
+    let views = held_views(&p, 1, 12);
+    let c = calib::calibrate(&views, &options(&t, Some([t.cx, t.cy]))).unwrap();
+    let ps = vss::report::calibration::document(1, &c);
+    for want in ["camera 1: calibration", "RMS", "k1", "view12", "coverage"] {
+        assert!(ps.contains(want), "{want}");
+    }
+    assert!(
+        ps.contains("C \\(stated\\)"),
+        "the stated centre is on the page"
+    );
+    crate::support::gs::require_gs();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cal.ps");
+    std::fs::write(&path, &ps).unwrap();
+    let pages = crate::support::gs::render(&path, "a4", 72);
+    assert_eq!(pages.len(), 1);
+    let page = &pages[0];
+    let (w, h) = page.dimensions();
+    let count = |x0: u32, x1: u32, y0: u32, y1: u32, f: &dyn Fn(u32) -> bool| {
+        (y0..y1)
+            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                f(page
+                    .get_pixel(x, y)
+                    .0
+                    .iter()
+                    .map(|&c| u32::from(c))
+                    .sum::<u32>()
+                    / 3)
+            })
+            .count()
+    };
+    // The residual picture (top left) holds the corners' dots; the coverage
+    // map (top right) is shaded grey where the plate was.
+    let dots = count(0, w / 2, 0, h / 2, &|v| v < 100);
+    let grey = count(w / 2, w, 0, h / 2, &|v| (60..230).contains(&v));
+    assert!(dots > 500, "{dots} dark pixels in the residual picture");
+    assert!(grey > 2000, "{grey} grey pixels in the coverage map");
+    // The text half has the parameters.
+    let text = count(0, w, h / 2, h, &|v| v < 100);
+    assert!(text > 500, "{text}");
+}
+
+/// A view whose grid was misread (its corners' positions shuffled among
+/// their labels) leaves no camera that fits: refused as not converging,
+/// with the likely causes named.
+#[test]
+fn a_misread_view_is_refused_as_not_converging() {
+    let p = plate("squares");
+    let t = truth(1);
+    let mut views = held_views(&p, 1, 12);
+    let px: Vec<[f64; 2]> = views[4].corners.iter().map(|c| c.px).collect();
+    let n = px.len();
+    for (i, c) in views[4].corners.iter_mut().enumerate() {
+        c.px = px[(i * 7 + 3) % n];
+    }
+    let e = calib::calibrate(&views, &options(&t, None)).unwrap_err();
+    assert!(matches!(e, CalibError::NoConvergence { .. }), "{e}");
+    assert!(e.to_string().contains("misread"), "{e}");
 }

@@ -196,15 +196,18 @@ impl Console {
         let (p, r) = (parser.clone(), raw.clone());
         std::thread::spawn(move || {
             let mut buf = [0u8; 8192];
+            let mut frames = Frames::default();
             loop {
                 match reader.read(&mut buf) {
                     Ok(0) | Err(_) => break,
                     Ok(n) => {
-                        p.lock().unwrap().process(&buf[..n]);
                         r.lock().unwrap().extend_from_slice(&buf[..n]);
+                        frames.take(&buf[..n], |bytes| p.lock().unwrap().process(bytes));
                     }
                 }
             }
+            let rest = std::mem::take(&mut frames.pending);
+            p.lock().unwrap().process(&rest);
         });
         Console {
             master: pair.master,
@@ -380,6 +383,51 @@ impl Console {
     }
 }
 
+/// Begin and end of a synchronized update (DEC mode 2026), which the
+/// console puts around every frame.
+const SYNC_BEGIN: &[u8] = b"\x1b[?2026h";
+const SYNC_END: &[u8] = b"\x1b[?2026l";
+
+/// What a terminal that knows synchronized updates does: a frame reaches
+/// the screen whole, at its end, so a test never reads a screen half old
+/// and half new (the console writes a frame in pieces, and under load the
+/// reader gets them one by one). Bytes outside a frame go through at once.
+#[derive(Default)]
+struct Frames {
+    pending: Vec<u8>,
+    in_frame: bool,
+}
+
+impl Frames {
+    fn take(&mut self, bytes: &[u8], mut show: impl FnMut(&[u8])) {
+        self.pending.extend_from_slice(bytes);
+        loop {
+            let mark = if self.in_frame { SYNC_END } else { SYNC_BEGIN };
+            if let Some(at) = find(&self.pending, mark) {
+                let end = at + mark.len();
+                // Bytes before a frame begins show at once; a frame's whole
+                // bytes show together at its end.
+                show(&self.pending[..end]);
+                self.pending.drain(..end);
+                self.in_frame = !self.in_frame;
+            } else {
+                if !self.in_frame {
+                    // All but what could be the start of a mark cut in two.
+                    let keep = (mark.len() - 1).min(self.pending.len());
+                    let upto = self.pending.len() - keep;
+                    show(&self.pending[..upto]);
+                    self.pending.drain(..upto);
+                }
+                return;
+            }
+        }
+    }
+}
+
+fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
+    hay.windows(needle.len()).position(|w| w == needle)
+}
+
 impl Drop for Console {
     fn drop(&mut self) {
         if let Ok(None) = self.child.try_wait() {
@@ -475,4 +523,32 @@ pub fn flat(screen: &str) -> String {
 /// Whether `dir` holds a file `name`.
 pub fn exists(dir: &Path, name: &str) -> bool {
     dir.join(name).is_file()
+}
+
+/// A frame cut anywhere, its marks included, reaches the screen only whole.
+#[test]
+fn frames_reach_the_screen_whole() {
+    let stream = b"ab\x1b[?2026hFRAME ONE\x1b[?2026lcd\x1b[?2026hTWO\x1b[?2026l".to_vec();
+    for cut in 0..=stream.len() {
+        for cut2 in cut..=stream.len() {
+            let mut f = Frames::default();
+            let mut seen: Vec<Vec<u8>> = Vec::new();
+            let mut shown = Vec::new();
+            for part in [&stream[..cut], &stream[cut..cut2], &stream[cut2..]] {
+                f.take(part, |b| shown.extend_from_slice(b));
+                seen.push(shown.clone());
+            }
+            assert_eq!(shown, stream, "cut at {cut} and {cut2}");
+            for s in &seen {
+                let text = String::from_utf8_lossy(s);
+                let frame_one = text.contains("FRAME");
+                assert_eq!(frame_one, text.contains("ONE\x1b[?2026l"), "{text:?}");
+                assert_eq!(
+                    text.contains('T'),
+                    text.contains("TWO\x1b[?2026l"),
+                    "{text:?}"
+                );
+            }
+        }
+    }
 }

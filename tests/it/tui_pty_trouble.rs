@@ -117,8 +117,10 @@ fn damaged_sessions_and_files_are_shown_and_only_the_damage_retaken() {
     let s = c.wait_text("captures lighting b again", 10);
     assert!(s.contains("Image 1"), "{s}");
     c.press(SURVEY, Action::Survey(SurveyAction::Enter));
-    c.wait("image 1 reviewed again", 30, |s| {
-        s.contains("before CONNECT")
+    // Reviewed, and the new frame saved: the checklist's mark goes when the
+    // session holds it (the review can come first).
+    c.wait("image 1 reviewed again, b saved", 30, |s| {
+        s.contains("before CONNECT") && s.contains("abc") && !s.contains("a!c")
     });
     let img = vss::formats::img::read_img(&d.join("cube1b.img")).expect("lighting b retaken");
     assert_eq!(img.image.size(), (128, 128));

@@ -99,11 +99,11 @@ fn every_parameter(lens: bool) {
             let shown = line_count(&s).expect("a line count on the Pipeline screen");
             c.press(PIPELINE, Action::Pipeline(PipelineAction::Save));
             // Once saved, image 1 is accepted: saving over it asks.
-            let s = c.wait("saved, or the question", 10, |s| {
+            let q = c.wait("saved, or the question", 10, |s| {
                 s.contains("Replace its saved outputs")
                     || saved(&c).is_some_and(|(p, _)| p.get(sp.key) == Some(target))
             });
-            if s.contains("Replace its saved outputs") {
+            if q.contains("Replace its saved outputs") {
                 c.yes();
             }
             let (p, n) = wait_saved(&c, sp.key, target);
@@ -114,9 +114,11 @@ fn every_parameter(lens: bool) {
                 sp.key
             );
             assert_eq!(
-                n, shown,
-                "saved the line count on screen ({} = {target})",
-                sp.key
+                n,
+                shown,
+                "saved the line count on screen ({} = {target}); the screen read:\n{s}\nnow:\n{}",
+                sp.key,
+                c.screen()
             );
         }
     }

@@ -39,6 +39,8 @@ pub struct CellState {
     pub lighting_on: Vec<(char, Vec<String>)>,
     pub cameras: u32,
     pub camera_models: Vec<Option<CameraModel>>,
+    /// The profile's `.cdf` of each camera (index 0 is camera 1).
+    pub cdf_paths: Vec<Option<std::path::PathBuf>>,
     pub device: DeviceState,
     /// The latest frame of the live view or a single grab (camera, image).
     pub live: Option<(u32, GreyImage)>,
@@ -65,6 +67,9 @@ impl CellState {
                 .collect(),
             cameras: profile.survey.cameras.max(1),
             camera_models: Vec::new(),
+            cdf_paths: (1..=profile.survey.cameras.max(1))
+                .map(|k| profile.cdf_path(k))
+                .collect(),
             device: DeviceState::default(),
             live: None,
         }

@@ -31,6 +31,8 @@ pub enum Pending {
     ExtraImage(u32),
     /// Go on with the edit of an accepted image's lines.
     Edit,
+    /// Write the calibration shown into its camera's `.cdf`.
+    CalibWrite,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -156,9 +158,7 @@ impl Prompt {
             | ModalAction::Yes
             | ModalAction::No
             | ModalAction::Submit
-            | ModalAction::Cancel
-            | ModalAction::Up
-            | ModalAction::Down => {}
+            | ModalAction::Cancel => {}
         }
         self.error = None;
     }
@@ -188,7 +188,6 @@ impl App {
                 self.chrome.modal = None;
                 Vec::new()
             }
-            ModalAction::Up | ModalAction::Down => Vec::new(),
             ModalAction::Left
             | ModalAction::Right
             | ModalAction::Home
@@ -240,6 +239,7 @@ impl App {
                 let (s, mut ctx) = self.parts();
                 s.edit.confirmed(&mut ctx)
             }
+            Pending::CalibWrite => self.screens.calibrate.confirmed(),
         }
     }
 

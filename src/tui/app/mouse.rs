@@ -57,7 +57,7 @@ impl App {
                 } else {
                     FilesAction::Down
                 })),
-                ScreenId::Capture | ScreenId::Edit => Vec::new(),
+                ScreenId::Capture | ScreenId::Edit | ScreenId::Calibrate => Vec::new(),
             },
             Pointer::Zoom { zoom_in } => self.act(Action::Nav(if zoom_in {
                 NavAction::ZoomIn

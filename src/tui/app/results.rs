@@ -104,11 +104,17 @@ impl App {
                         self.ctx().survey_frame(k, letter, camera, image)
                     }
                     FramePurpose::Live => {
+                        if self.chrome.screen == crate::tui::keymap::ScreenId::Calibrate {
+                            self.screens.calibrate.frame(camera, &image);
+                        }
                         self.cell.live = Some((camera, image));
                         Vec::new()
                     }
                     FramePurpose::Snapshot => {
                         let (w, h) = image.size();
+                        if self.chrome.screen == crate::tui::keymap::ScreenId::Calibrate {
+                            self.screens.calibrate.frame(camera, &image);
+                        }
                         self.cell.live = Some((camera, image));
                         self.ctx()
                             .info(format!("grabbed a frame of camera {camera}, {w}×{h}"));

@@ -10,7 +10,6 @@ use super::{Ctx, Pending};
 use crate::llv::edit::LineEditor;
 use crate::llv::pipeline::StageOutputs;
 use crate::llv::{GreyImage, Params, Segment};
-use crate::session::input::PipelineInput;
 use crate::tui::event::{Cmd, ImageKey, PipelineRequest, StoreCmd};
 
 /// The grey images of one image number and what the pipeline made of them.
@@ -44,8 +43,6 @@ pub struct Loaded {
     pub edit_confirmed: bool,
     /// Lightings whose saved grey image is damaged, with why.
     pub damaged: Vec<(char, String)>,
-    /// The pipeline input made of `frames` (and for which version of them).
-    pub input: Option<(u64, Arc<PipelineInput>)>,
 }
 
 impl Loaded {
@@ -66,7 +63,6 @@ impl Loaded {
             accepted: false,
             edit_confirmed: false,
             damaged: Vec::new(),
-            input: None,
         }
     }
 
@@ -146,23 +142,18 @@ impl Tracker {
     /// its frames split by the profile's rule, as the session code splits
     /// them.
     pub fn request(&mut self, cell: &super::CellState) -> Option<Cmd> {
-        let cur = self.current.as_mut()?;
+        let cur = self.current.as_ref()?;
         if cur.frames.is_empty() {
             return None;
         }
         let camera = cell.camera_model(cur.camera);
-        let input = match &cur.input {
-            Some((v, input)) if *v == cur.version && input.camera == camera => input.clone(),
-            _ => {
-                let input = Arc::new(
-                    cell.rule
-                        .split(cur.frames.iter().cloned())
-                        .with_camera(camera),
-                );
-                cur.input = Some((cur.version, input.clone()));
-                input
-            }
-        };
+        // A copy of the frames per request, as before: keeping one with the
+        // image would hold every frame twice for the whole survey.
+        let input = Arc::new(
+            cell.rule
+                .split(cur.frames.iter().cloned())
+                .with_camera(camera),
+        );
         let (k, version) = (cur.k, cur.version);
         self.generation += 1;
         Some(Cmd::Pipeline(PipelineRequest {

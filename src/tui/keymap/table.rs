@@ -12,8 +12,8 @@
 use ratatui::crossterm::event::KeyCode;
 
 use super::{
-    Action, Binding, CaptureAction, EditAction, FilesAction, GlobalAction, Key, ModalAction,
-    NavAction, PipelineAction, Scope, ScreenId, SurveyAction, ViewerAction,
+    Action, Binding, CalibrateAction, CaptureAction, EditAction, FilesAction, GlobalAction, Key,
+    ModalAction, NavAction, PipelineAction, Scope, ScreenId, SurveyAction, ViewerAction,
 };
 
 const fn ch(c: char) -> Key {
@@ -52,6 +52,7 @@ const CA: Scope = Scope::Screen(ScreenId::Capture);
 const PI: Scope = Scope::Screen(ScreenId::Pipeline);
 const ED: Scope = Scope::Screen(ScreenId::Edit);
 const SE: Scope = Scope::Screen(ScreenId::Session);
+const CB: Scope = Scope::Screen(ScreenId::Calibrate);
 const CO: Scope = Scope::Confirm;
 const PR: Scope = Scope::Prompt;
 const VI: Scope = Scope::Viewer;
@@ -75,6 +76,7 @@ macro_rules! rows {
     (@act Pipeline($($a:tt)+)) => { Action::Pipeline(PipelineAction::$($a)+) };
     (@act Edit($($a:tt)+)) => { Action::Edit(EditAction::$($a)+) };
     (@act Files($($a:tt)+)) => { Action::Files(FilesAction::$($a)+) };
+    (@act Calibrate($($a:tt)+)) => { Action::Calibrate(CalibrateAction::$($a)+) };
     (@act Modal($($a:tt)+)) => { Action::Modal(ModalAction::$($a)+) };
     (@act Viewer($($a:tt)+)) => { Action::Viewer(ViewerAction::$($a)+) };
 }
@@ -86,8 +88,6 @@ pub const KEYMAP: &[Binding] = rows! {
     CO, ch('n'), Modal(No), "no, keep what is there", "no";
     CO, k(K::Esc), Modal(No), "no", "";
     CO, ch('a'), Modal(All), "all (where the question offers it)", "";
-    CO, k(K::Up), Modal(Up), "choose above (in a list)", "";
-    CO, k(K::Down), Modal(Down), "choose below (in a list)", "";
     // Typing.
     PR, k(K::Enter), Modal(Submit), "accept the typed text", "accept";
     PR, k(K::Esc), Modal(Cancel), "cancel typing", "cancel";
@@ -120,6 +120,16 @@ pub const KEYMAP: &[Binding] = rows! {
     SU, ch('c'), Survey(Camera), "next camera for the image to capture", "camera";
     SU, ch('p'), Survey(Location), "next camera location for the image to capture", "place";
     SU, k(K::Esc), Survey(CancelCapture), "stop the capture under way", "";
+    // Calibrate.
+    CB, ch('p'), Calibrate(Plate), "simulated cell: the calibration plate in view / away", "plate";
+    CB, ch('v'), Calibrate(ToggleLive), "live view on/off", "live";
+    CB, ch('g'), Calibrate(Grab), "grab one frame", "grab";
+    CB, ch('c'), Calibrate(Camera), "next camera", "camera";
+    CB, ch(' '), Calibrate(Keep), "keep this view (its grid was found)", "keep";
+    CB, k(K::Backspace), Calibrate(Drop), "drop the last view kept", "";
+    CB, ch('s'), Calibrate(Centre), "centre C: solved / stated at the image's middle", "centre";
+    CB, k(K::Enter), Calibrate(Solve), "compute the calibration from the views kept", "compute";
+    CB, ch('a'), Calibrate(Accept), "accept: write the camera's .cdf (asks first)", "accept";
     // Capture.
     CA, ch('v'), Capture(ToggleLive), "live view on/off", "live";
     CA, ch('g'), Capture(Grab), "grab one frame", "grab";
@@ -190,6 +200,7 @@ pub const KEYMAP: &[Binding] = rows! {
     G, ch('3'), Global(GoTo(ScreenId::Pipeline)), "Pipeline screen", "";
     G, ch('4'), Global(GoTo(ScreenId::Edit)), "Edit screen", "";
     G, ch('5'), Global(GoTo(ScreenId::Session)), "Session/Report screen", "";
+    G, ch('6'), Global(GoTo(ScreenId::Calibrate)), "Calibrate screen", "";
     G, ch('?'), Global(Help), "help: every key, the checklist's marks", "help";
     G, k(K::F(1)), Global(Help), "help", "";
     G, ch('m'), Global(ToggleLog), "message log: one line / expanded / hidden", "log";

@@ -214,6 +214,17 @@ impl Worker {
             }),
             DeviceCmd::AllOff => self.lights(|c| c.set_lights(0)),
             DeviceCmd::Lighting(l) => self.lights(|c| c.switch_lighting(l)),
+            DeviceCmd::SimTarget(t) => {
+                let note = match self.cell.as_ref().and_then(|c| c.sim()) {
+                    Some(sim) => {
+                        let on = t.is_some();
+                        sim.scene().set_target(t);
+                        format!("calibration plate {}", if on { "in view" } else { "away" })
+                    }
+                    None => "no simulated cell: hold the plate in front of the camera".into(),
+                };
+                ev(&self.ui, DeviceEvent::Note(note));
+            }
         }
     }
 

@@ -49,6 +49,14 @@ pub enum StoreError {
         dir.display()
     )]
     TakeOver { dir: PathBuf, holder: String },
+    #[error("the profile names no .cdf for camera {camera}: add it to [survey] cdf")]
+    NoCdf { camera: u32 },
+    #[error("{} NOT written: {source}", path.display())]
+    Cdf {
+        path: PathBuf,
+        #[source]
+        source: formats::FormatError,
+    },
 }
 
 fn session_err(what: impl Into<String>) -> impl FnOnce(SessionError) -> StoreError {
@@ -260,6 +268,28 @@ impl Store {
                     self.check = Some(s.check());
                 }
                 self.updated();
+            }
+            StoreCmd::WriteCdf {
+                camera,
+                calibration,
+            } => {
+                let path = self
+                    .profile
+                    .cdf_path(camera)
+                    .ok_or(StoreError::NoCdf { camera })?;
+                crate::calib::write_intrinsics(&path, &calibration).map_err(|source| {
+                    StoreError::Cdf {
+                        path: path.clone(),
+                        source,
+                    }
+                })?;
+                self.reply(StoreEvent::Note(format!(
+                    "camera {camera}: wrote {} (RMS {:.3} px over {} views)",
+                    path.display(),
+                    calibration.rms,
+                    calibration.views.len()
+                )));
+                self.cameras();
             }
         }
         Ok(())

@@ -60,18 +60,21 @@ impl fmt::Display for Level {
     }
 }
 
+/// A `--noise` value that is neither σ ≥ 0 nor `sd`.
+#[derive(Debug, thiserror::Error)]
+#[error("\"{0}\" is not a noise level: give σ ≥ 0 grey levels, or sd for signal-dependent noise")]
+pub struct BadLevel(pub String);
+
 impl std::str::FromStr for Level {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Level, String> {
+    type Err = BadLevel;
+    fn from_str(s: &str) -> Result<Level, BadLevel> {
         let t = s.trim();
         if t.eq_ignore_ascii_case("sd") {
             return Ok(Level::Signal);
         }
         match t.parse::<f64>() {
             Ok(v) if v.is_finite() && v >= 0.0 => Ok(Level::Sigma(v)),
-            _ => Err(format!(
-                "\"{t}\" is not a noise level: give σ ≥ 0 grey levels, or sd for signal-dependent noise"
-            )),
+            _ => Err(BadLevel(t.to_string())),
         }
     }
 }

@@ -1,0 +1,154 @@
+//! The Calibrate screen in the real console (a pty): the simulated cell
+//! shows the plate (`p`), each grab's grid is found and kept (`Space`), the
+//! calibration computed (`Enter`) and accepted (`a`, asked first because
+//! the camera's `.cdf` is there): the new file has the calibration, the old
+//! one is kept beside it as `.bak`.
+
+use vss::formats::cdf::{Status, read_cdf, write_cdf};
+use vss::tui::keymap::{Action, CalibrateAction as CA, GlobalAction, Scope, ScreenId};
+
+use super::tui_harness::Console;
+
+const PROFILE: &str = r#"
+name = "calibration test cell"
+
+[relay]
+settle_ms = 5
+
+[[lights]]
+name = "left"
+relay = 0
+
+[[lighting]]
+letter = "a"
+on = ["left"]
+
+[survey]
+dir = "sessions"
+cameras = 2
+cdf = ["cam1.cdf", "cam2.cdf"]
+
+[sim]
+width = 512
+height = 512
+seed = 1
+noise = 2.0
+"#;
+
+#[test]
+fn a_camera_calibrated_on_the_calibrate_screen() {
+    let mut c = Console::start_with(PROFILE, 120, 40, &[], |dir| {
+        for cam in 1..=2 {
+            let cdf = vss::rig::sim::camera_cdf(cam, 512, 512).unwrap();
+            write_cdf(&dir.join(format!("cam{cam}.cdf")), &cdf).unwrap();
+        }
+    });
+    let dir = c.dir.path().to_path_buf();
+    let before = std::fs::read(dir.join("cam1.cdf")).unwrap();
+    let truth = read_cdf(&dir.join("cam1.cdf"))
+        .unwrap()
+        .camera_model()
+        .unwrap();
+    c.wait_text("Survey", 10);
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
+    );
+    c.wait_text("views kept: 0", 10);
+    let cb = Scope::Screen(ScreenId::Calibrate);
+    c.press(cb, Action::Calibrate(CA::Plate));
+    c.wait_text("plate shown (p)", 10);
+    for n in 1..=6 {
+        c.press(cb, Action::Calibrate(CA::Grab));
+        c.wait("a grid in the new frame", 30, |s| {
+            s.contains("188 corners found")
+        });
+        c.press(cb, Action::Calibrate(CA::Keep));
+        c.wait_text(&format!("views kept: {n}"), 10);
+    }
+    c.press(cb, Action::Calibrate(CA::Centre));
+    c.wait_text("stated, image middle", 10);
+    c.press(cb, Action::Calibrate(CA::Solve));
+    let s = c.wait("the calibration", 30, |s| {
+        s.contains("RMS 0.") && s.contains("worst views")
+    });
+    assert!(s.contains("residuals ×"), "{s}");
+    c.press(cb, Action::Calibrate(CA::Accept));
+    c.wait_text("write S, C, f, D", 10);
+    c.yes();
+    c.wait("the file written", 10, |_| {
+        std::fs::read(dir.join("cam1.cdf")).is_ok_and(|b| b != before)
+    });
+    assert_eq!(std::fs::read(dir.join("cam1.cdf.bak")).unwrap(), before);
+    let got = read_cdf(&dir.join("cam1.cdf")).unwrap();
+    assert_eq!(got.get("D").unwrap().status, Status::Calibrated);
+    assert_eq!(got.get("C").unwrap().status, Status::Stated);
+    assert_eq!(got.get("T").unwrap().status, Status::Calibrated, "T kept");
+    let m = got.camera_model().unwrap();
+    assert!(
+        (m.f - truth.f).abs() / truth.f < 0.005,
+        "f {} against {}",
+        m.f,
+        truth.f
+    );
+    c.send("q");
+    c.wait_exit(10);
+}
+
+/// At 80 × 24: a frame without the plate is not kept and says why, and
+/// two views are refused with what to do, no `.cdf` touched; with eight
+/// the whole solution fits the panel.
+#[test]
+fn too_few_views_and_no_plate_are_refused_at_80_by_24() {
+    let mut c = Console::start_with(PROFILE, 80, 24, &[], |dir| {
+        for cam in 1..=2 {
+            let cdf = vss::rig::sim::camera_cdf(cam, 512, 512).unwrap();
+            write_cdf(&dir.join(format!("cam{cam}.cdf")), &cdf).unwrap();
+        }
+    });
+    let dir = c.dir.path().to_path_buf();
+    let before = std::fs::read(dir.join("cam1.cdf")).unwrap();
+    c.wait_text("Survey", 10);
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
+    );
+    c.wait_text("views kept: 0", 10);
+    let cb = Scope::Screen(ScreenId::Calibrate);
+    c.press(cb, Action::Calibrate(CA::Keep));
+    c.wait_words("no grid of camera 1 to keep", 10);
+    // The bare cell: the grab has no plate in it.
+    c.press(cb, Action::Calibrate(CA::Grab));
+    c.wait_words("grid: the plate is not in view", 30);
+    c.press(cb, Action::Calibrate(CA::Keep));
+    c.wait_words("not kept: the plate is not in view", 10);
+    c.press(cb, Action::Calibrate(CA::Plate));
+    c.wait_text("plate shown (p)", 10);
+    for n in 1..=2 {
+        c.press(cb, Action::Calibrate(CA::Grab));
+        c.wait("a grid in the new frame", 30, |s| s.contains("188 corners"));
+        c.press(cb, Action::Calibrate(CA::Keep));
+        c.wait_text(&format!("views kept: {n}"), 10);
+    }
+    c.press(cb, Action::Calibrate(CA::Solve));
+    c.wait_words("2 usable view(s) of the plate; at least 3 are needed", 30);
+    c.press(cb, Action::Calibrate(CA::Accept));
+    c.wait_words("nothing to accept", 10);
+    assert_eq!(std::fs::read(dir.join("cam1.cdf")).unwrap(), before);
+    assert!(!dir.join("cam1.cdf.bak").exists());
+    // Enough views: every parameter and the worst views fit in 80 × 24.
+    for n in 3..=8 {
+        c.press(cb, Action::Calibrate(CA::Grab));
+        c.wait("a grid in the new frame", 30, |s| s.contains("188 corners"));
+        c.press(cb, Action::Calibrate(CA::Keep));
+        c.wait_text(&format!("views kept: {n}"), 10);
+    }
+    c.press(cb, Action::Calibrate(CA::Solve));
+    // The panel's last rows: the frame is drawn top to bottom.
+    let s = c.wait("the calibration", 30, |s| s.contains("worst views"));
+    for want in ["RMS 0.", "Cx", "f ", "k1", "g4", " view "] {
+        assert!(s.contains(want), "{want} on the screen:\n{s}");
+    }
+    c.send("q");
+    c.wait_exit(10);
+}
