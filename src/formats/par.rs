@@ -106,15 +106,28 @@ fn quoted(s: &str) -> Option<(&str, &str)> {
     Some((s.get(..end)?, s.get(end + 1..)?))
 }
 
-/// Why a quoted name cannot be taken: a control character (the writer
-/// cannot write it back, and it would reach a terminal).
-fn control_char(name: &str, what: &str) -> Option<String> {
-    let (at, c) = name.char_indices().find(|(_, c)| c.is_control())?;
+/// Why `name` cannot stand in a `.par` file, if so: a `"` (the format has
+/// no escape) or a control character. The reader and the writer both ask,
+/// so what reads back is what was written.
+fn name_problem(name: &str, what: &str) -> Option<String> {
+    if let Some(at) = name.chars().position(|c| c == '"') {
+        return Some(format!(
+            "{what} holds a '\"' at character {}: names may not hold quotes",
+            at + 1
+        ));
+    }
+    control_problem(name, what)
+}
+
+/// Why `text` (a name or a value) cannot stand in a `.par` file, if so: a
+/// control character, which would end its line or reach a terminal.
+fn control_problem(text: &str, what: &str) -> Option<String> {
+    let (at, c) = text.chars().enumerate().find(|(_, c)| c.is_control())?;
     Some(format!(
         "{what} holds the control character U+{:04X} at character {}: \
-         names are printable text",
+         .par files hold printable text",
         u32::from(c),
-        name.get(..at).map_or(0, |s| s.chars().count()) + 1
+        at + 1
     ))
 }
 
@@ -154,7 +167,7 @@ pub fn parse_par_spanned(text: &str, path: &Path) -> Result<(ParFile, Vec<usize>
             ),
         ));
     };
-    if let Some(m) = control_char(name, "the set's name") {
+    if let Some(m) = name_problem(name, "the set's name") {
         return Err(err(n1, K::Syntax, m));
     }
     if !tail.trim().is_empty() {
@@ -201,6 +214,9 @@ pub fn parse_par_spanned(text: &str, path: &Path) -> Result<(ParFile, Vec<usize>
         if slot.is_some() {
             return Err(err(n, K::Syntax, format!("value of entry {i} given twice")));
         }
+        if let Some(m) = control_problem(v.trim(), &format!("the value of entry {i}")) {
+            return Err(err(n, K::Syntax, m));
+        }
         *slot = Some((v.trim().to_string(), n));
     }
     for _ in 0..count {
@@ -225,7 +241,7 @@ pub fn parse_par_spanned(text: &str, path: &Path) -> Result<(ParFile, Vec<usize>
                 format!("expected `index \"name\" type`, found \"{}\"", shorten(t)),
             ));
         };
-        if let Some(m) = control_char(dname, "the name") {
+        if let Some(m) = name_problem(dname, "the name") {
             return Err(err(n, K::Syntax, m));
         }
         let Some(ty) = ParType::from_letter(ty.trim()) else {
@@ -330,20 +346,18 @@ pub fn format_par(f: &ParFile) -> String {
 
 /// Why a set cannot be written so that it reads back the same, if so.
 pub fn check_writable(f: &ParFile) -> Option<String> {
-    let bad_text = |s: &str| s.contains('"') || s.chars().any(char::is_control);
-    if bad_text(&f.name) {
-        return Some("the set's name may not hold '\"' or control characters".into());
+    if let Some(m) = name_problem(&f.name, "the set's name") {
+        return Some(m);
     }
     for (i, e) in f.entries.iter().enumerate() {
-        if bad_text(&e.name) {
-            return Some(format!(
-                "entry {i}: the name may not hold '\"' or control characters"
-            ));
+        if let Some(m) = name_problem(&e.name, "the name") {
+            return Some(format!("entry {i}: {m}"));
         }
-        if e.value.chars().any(char::is_control) || e.value.trim() != e.value {
-            return Some(format!(
-                "entry {i}: the value may not hold control characters or outer spaces"
-            ));
+        if let Some(m) = control_problem(&e.value, "the value") {
+            return Some(format!("entry {i}: {m}"));
+        }
+        if e.value.trim() != e.value {
+            return Some(format!("entry {i}: the value may not have outer spaces"));
         }
         if let Some(m) = e.kind.check(&e.value) {
             return Some(format!("entry {i} \"{}\": {m}", e.name));

@@ -325,6 +325,20 @@ fn cases() -> Vec<(&'static str, &'static str, Vec<u8>, K, Location)> {
             Line(3),
         ),
         (
+            "par quote inside the set's name",
+            "par",
+            t("1 \"connect.c|\" f\"vss lens\"\n0 1\n0 \"lens.enabled\" b\n"),
+            K::Syntax,
+            Line(1),
+        ),
+        (
+            "par control character in a value",
+            "par",
+            t("1 \"v[s lsen\"\n0 \u{13}\u{13}0\u{13}2\n0 \"lens.esb\" s\n"),
+            K::Syntax,
+            Line(2),
+        ),
+        (
             "par control character in the set's name",
             "par",
             t("1 \"s\u{1b}[2Jet\"\n0 1\n0 \"a\" i\n"),
