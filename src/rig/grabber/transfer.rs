@@ -36,9 +36,18 @@ use crate::rig::{Link, RigError};
 
 /// The smallest READ a noisy line shrinks blocks to.
 pub const MIN_BLOCK: u32 = 32;
-/// The shortest inter-byte timeout: below this a scheduler tick or a USB
-/// frame looks like a lost byte.
-pub const INTER_BYTE_FLOOR: Duration = Duration::from_millis(2);
+/// The shortest inter-byte timeout: below this a pause that loses nothing
+/// looks like a lost byte. USB-serial adapters hold the last bytes of a
+/// burst until their latency timer runs out (FTDI's default is 16 ms), and
+/// a loaded PC deschedules the reader for several ms; at 2 ms both made a
+/// clean line re-request blocks and shrink them (1.5 wire bytes per
+/// payload byte while the test suite ran beside it). The floor costs time
+/// only when the stream stops, not per lost byte: a block that lost bytes
+/// runs into the next DATA line.
+pub const INTER_BYTE_FLOOR: Duration = Duration::from_millis(20);
+/// The least a failed block is taken to cost when block sizes are chosen
+/// ([`VsgClient::failure_cost`]).
+const FAILURE_COST_FLOOR: Duration = Duration::from_millis(2);
 /// Byte times of silence inside an answer that mean bytes were lost.
 const INTER_BYTE_BYTES: u32 = 8;
 /// Failed blocks in a row after which the frame is given up (at a byte
@@ -431,7 +440,7 @@ impl<P: Link> VsgClient<P> {
             let Some((off, len)) = t.owed.pop_front() else {
                 break;
             };
-            let take = len.min(t.sizer.block(t.byte_time, self.inter_byte.as_secs_f64()));
+            let take = len.min(t.sizer.block(t.byte_time, self.failure_cost(t.byte_time)));
             if take < len {
                 t.owed.push_front((off + take, len - take));
             }
@@ -462,6 +471,17 @@ impl<P: Link> VsgClient<P> {
             }
         }
         Ok(())
+    }
+
+    /// What a failed block costs beyond its bytes, for the block size:
+    /// a block that lost bytes runs into the next DATA line, so it is not
+    /// the inter-byte timeout but a few byte times and a scheduler tick
+    /// ([`FAILURE_COST_FLOOR`]), plus what the line taught the timeout
+    /// beyond its start (a slow adapter's longer gaps).
+    fn failure_cost(&self, byte_time: f64) -> f64 {
+        let learned = self.inter_byte.saturating_sub(self.base_inter_byte);
+        (byte_time * f64::from(INTER_BYTE_BYTES)).max(FAILURE_COST_FLOOR.as_secs_f64())
+            + learned.as_secs_f64()
     }
 
     /// Every request out was given up on after silence inside an answer:
@@ -530,6 +550,7 @@ mod tests {
     #[test]
     fn the_inter_byte_timeout_follows_the_baud_rate() {
         assert_eq!(inter_byte_for(921_600), INTER_BYTE_FLOOR);
-        assert_eq!(inter_byte_for(9600), Duration::from_secs_f64(80.0 / 9600.0));
+        assert_eq!(inter_byte_for(9600), INTER_BYTE_FLOOR);
+        assert_eq!(inter_byte_for(1200), Duration::from_secs_f64(80.0 / 1200.0));
     }
 }
