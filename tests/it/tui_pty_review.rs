@@ -119,6 +119,8 @@ fn keys_that_write_ask_or_stay_apart_from_moving_keys() {
     c.press(SURVEY, Action::Survey(SurveyAction::Accept));
     let s = c.wait_text("survey complete", 10);
     assert!(flat(&s).contains("5 writes the report"), "{s}");
+    // The whole of the next step fits its box at 80 × 24, down to its end.
+    assert!(flat(&s).contains("Enter one more (2)"), "{s}");
     // `o` with a session open shows the picker, Esc goes back.
     c.press(SURVEY, Action::Survey(SurveyAction::OpenPicker));
     c.wait_text("open another session", 5);

@@ -329,11 +329,12 @@ fn step_box(app: &App, area: Rect, buf: &mut Buffer) {
             Phase::Complete => vec![
                 Line::styled("Survey complete.", t.ok()),
                 Line::from(vec![key("5"), Span::raw(" writes the report (e)")]),
+                // One line of at most 44 columns: the box's width at 80.
                 Line::from(vec![
                     key("↑↓ Enter"),
-                    Span::raw(" goes back to an image; "),
+                    Span::raw(" earlier image · "),
                     key("Enter"),
-                    Span::raw(format!(" alone: image {} beyond the plan", w.k)),
+                    Span::raw(format!(" one more ({})", w.k)),
                 ]),
             ],
         }
