@@ -1,0 +1,313 @@
+//! The edge detector's tests: the fast responses against the plain reference
+//! (`reference.rs`) bit for bit, the kernel, steps and subpixel positions,
+//! peaks, key rounding, and small, flat and invalid images.
+
+use super::*;
+use crate::llv::EdgePoint;
+use crate::llv::synth::rng::SplitMix64;
+
+#[test]
+fn key_rounding_is_round_then_clamp() {
+    let plain = |x: f32| x.round().clamp(-FLOAT_KEY_MAX, FLOAT_KEY_MAX) as i16;
+    let mut xs = vec![
+        0.0,
+        -0.0,
+        0.5,
+        -0.5,
+        1.5,
+        -1.5,
+        2.5,
+        0.499_999_97,
+        -0.499_999_97,
+    ];
+    xs.extend([
+        31_999.5, -31_999.5, 32_000.0, 32_000.7, -40_000.0, 1e9, -1e9,
+    ]);
+    // A dense sweep through small values and every half in between.
+    xs.extend((-5000..5000).map(|i| i as f32 * 0.25 + 0.001 * (i % 7) as f32));
+    xs.extend((-2000..2000).map(|i| i as f32 * 16.5));
+    for x in xs {
+        assert_eq!(round_key(x), plain(x), "{x}");
+    }
+}
+
+fn img_from(w: usize, h: usize, f: impl Fn(usize, usize) -> u8) -> GreyImage {
+    let mut d = Vec::with_capacity(w * h);
+    for y in 0..h {
+        for x in 0..w {
+            d.push(f(x, y));
+        }
+    }
+    GreyImage::new(w, h, d).unwrap()
+}
+
+/// A random scene: a few steps of random height and direction, noise of
+/// random amplitude, optionally a validity mask with random invalid
+/// blobs and a few scattered invalid pixels.
+fn random_image(rng: &mut SplitMix64, w: usize, h: usize, masked: bool) -> GreyImage {
+    let (x0, y0) = (
+        (rng.next_u64() % w as u64) as i64,
+        (rng.next_u64() % h as u64) as i64,
+    );
+    let (lv0, lv1, lv2) = (
+        rng.next_u64() % 256,
+        rng.next_u64() % 256,
+        rng.next_u64() % 256,
+    );
+    let noise = 1 + rng.next_u64() % 40;
+    let mut img = img_from(w, h, |x, y| {
+        let (x, y) = (x as i64, y as i64);
+        let base = if x + y / 3 < x0 {
+            lv0
+        } else if y - x / 2 < y0 {
+            lv1
+        } else {
+            lv2
+        };
+        let n = rng_at(x as u64, y as u64, noise);
+        (base as i64 + n).clamp(0, 255) as u8
+    });
+    if masked {
+        let mut mask = vec![true; w * h];
+        for _ in 0..3 {
+            let (cx, cy) = (rng.next_u64() % w as u64, rng.next_u64() % h as u64);
+            let rad = 1 + rng.next_u64() % 6;
+            for y in 0..h as u64 {
+                for x in 0..w as u64 {
+                    if x.abs_diff(cx).pow(2) + y.abs_diff(cy).pow(2) <= rad * rad {
+                        mask[(y * w as u64 + x) as usize] = false;
+                    }
+                }
+            }
+        }
+        for _ in 0..4 {
+            mask[(rng.next_u64() % (w * h) as u64) as usize] = false;
+        }
+        img.set_valid_mask(Some(mask)).unwrap();
+    }
+    img
+}
+
+/// Deterministic noise in `-amp..=amp` at a pixel.
+fn rng_at(x: u64, y: u64, amp: u64) -> i64 {
+    let mut r = SplitMix64::new((x << 32 | y) ^ 0x9E37_79B9_7F4A_7C15);
+    r.next_u64();
+    (r.next_u64() % (2 * amp + 1)) as i64 - amp as i64
+}
+
+fn same_bits(a: &[f32], b: &[f32]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(u, v)| u.to_bits() == v.to_bits() || (u.is_nan() && v.is_nan()))
+}
+
+/// Same header and the same points, bit for bit, in the same order.
+fn same_points(a: &EdgePoints, b: &EdgePoints) -> bool {
+    let bits = |p: &EdgePoint| (p.x.to_bits(), p.y.to_bits(), p.response.to_bits());
+    (a.dir, a.width, a.height) == (b.dir, b.width, b.height)
+        && a.points.iter().map(bits).eq(b.points.iter().map(bits))
+}
+
+#[test]
+fn fast_responses_equal_the_reference_bit_for_bit() {
+    let mut rng = SplitMix64::new(0x1234_5678_9ABC_DEF1);
+    let (mut fast, mut slow) = (Response::default(), Response::default());
+    let (mut fs, mut ss) = (
+        ResponseScratch::default(),
+        reference::ResponseScratch::default(),
+    );
+    for (w, h) in [(16, 16), (37, 53), (130, 17), (17, 130), (64, 40)] {
+        for masked in [false, true] {
+            let img = random_image(&mut rng, w, h, masked);
+            for a in 3..=7 {
+                for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
+                    response_into(&img, dir, a, &mut fast, &mut fs).unwrap();
+                    reference::response_into(&img, dir, a, &mut slow, &mut ss).unwrap();
+                    assert_eq!((fast.width, fast.height, fast.dir), (w, h, dir));
+                    assert!(
+                        same_bits(&fast.data, &slow.data),
+                        "{w}x{h} masked={masked} a={a} {dir:?}"
+                    );
+                    // The exact form (reusing the same buffer, as the
+                    // pipeline does) reads the same values.
+                    exact_response_into(&img, dir, a, &mut fast, &mut fs).unwrap();
+                    assert_eq!(fast.is_exact(), a <= 5);
+                    assert!(fast.covers(w, h));
+                    let values: Vec<f32> = (0..w * h).map(|i| fast.value(i)).collect();
+                    assert!(
+                        same_bits(&values, &slow.data),
+                        "exact: {w}x{h} masked={masked} a={a} {dir:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The `f32` response, read as keys, gives the points of the exact
+/// sums: bit for bit at A = 4 (its keys are the sums doubled), within a
+/// hair of subpixel elsewhere (the order of magnitudes is the same).
+#[test]
+fn float_and_exact_responses_give_the_same_points() {
+    let mut rng = SplitMix64::new(0xDEAD_BEEF_0BAD_F00D);
+    let mut rs = ResponseScratch::default();
+    let mut kept = 0;
+    for (w, h) in [(16, 16), (37, 53), (130, 17), (96, 80)] {
+        for masked in [false, true] {
+            let img = random_image(&mut rng, w, h, masked);
+            for a in 3..=5 {
+                for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
+                    let (mut f, mut e) = (Response::default(), Response::default());
+                    response_into(&img, dir, a, &mut f, &mut rs).unwrap();
+                    exact_response_into(&img, dir, a, &mut e, &mut rs).unwrap();
+                    let p = EdgeParams {
+                        half_width: a as u32,
+                        noise_sigmas: 0.0,
+                        per_region: 50,
+                        ..EdgeParams::default()
+                    };
+                    let (pf, pe) = (peaks(&f, &p), peaks(&e, &p));
+                    kept += pe.points.len();
+                    if a == 4 {
+                        assert!(same_points(&pf, &pe), "{w}x{h} {masked} {dir:?}");
+                    } else {
+                        assert_eq!(pf.points.len(), pe.points.len());
+                        for (u, v) in pf.points.iter().zip(&pe.points) {
+                            assert!((u.x - v.x).abs() + (u.y - v.y).abs() < 0.01);
+                            assert!((u.response - v.response).abs() < 5e-3);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(kept > 1000, "the cases keep points: {kept}");
+}
+
+#[test]
+fn kernel_sums_to_zero_and_step_gives_one_minus_inverse_square() {
+    for a in 3..=7 {
+        let k = kernel(a);
+        assert_eq!(k.len(), 2 * a + 1);
+        let sum: f64 = k.iter().map(|&v| v as f64).sum();
+        assert!(sum.abs() < 1e-6, "A={a}: sum {sum}");
+        // A unit step 0 → 1 at x: response = Σ_{t<0} φ'(t).
+        let step: f64 = k[..a].iter().map(|&v| v as f64).sum();
+        let want = 1.0 - 1.0 / (a * a) as f64;
+        assert!((step - want).abs() < 1e-6, "A={a}: {step} vs {want}");
+        for t in 0..=a {
+            assert_eq!(k[a + t], -k[a - t], "antisymmetric");
+        }
+    }
+}
+
+#[test]
+fn step_responses_have_the_right_sign_and_size() {
+    let img = img_from(32, 20, |x, _| if x < 16 { 50 } else { 150 });
+    let r = response(&img, ScanDir::Horizontal, 4).unwrap();
+    let want = 100.0 * (1.0 - 1.0 / 16.0);
+    assert!((r.get(15, 5).unwrap() - want).abs() < 1e-4);
+    assert!((r.get(16, 5).unwrap() - want).abs() < 1e-4);
+    assert!(r.get(3, 5).is_none() && r.get(28, 5).is_none());
+    let rv = response(&img, ScanDir::Vertical, 4).unwrap();
+    assert_eq!(rv.get(15, 10), Some(0.0));
+    // Light → dark is negative, vertically too.
+    let img = img_from(20, 32, |_, y| if y < 16 { 200 } else { 10 });
+    let rv = response(&img, ScanDir::Vertical, 3).unwrap();
+    assert!((rv.get(7, 15).unwrap() + 190.0 * (1.0 - 1.0 / 9.0)).abs() < 1e-4);
+}
+
+#[test]
+fn a_step_gives_one_point_per_row_at_the_step() {
+    let img = img_from(40, 30, |x, _| if x < 20 { 30 } else { 200 });
+    let e = detect(&img, ScanDir::Horizontal, &EdgeParams::default()).unwrap();
+    assert_eq!(e.points.len(), 30);
+    for p in &e.points {
+        assert!((p.x - 19.5).abs() < 1e-6, "{p:?}");
+        assert!(p.response > 150.0);
+    }
+    // Lexical order.
+    assert!(e.points.windows(2).all(|w| w[0].y < w[1].y));
+    let ev = detect(&img, ScanDir::Vertical, &EdgeParams::default()).unwrap();
+    assert!(ev.points.is_empty());
+}
+
+#[test]
+fn subpixel_follows_an_antialiased_edge() {
+    // A step at x = 20.3 (pixel centres at integers): coverage-weighted.
+    for &pos in &[20.0f64, 20.25, 20.5, 20.8] {
+        let img = img_from(48, 20, |x, _| {
+            let lo = x as f64 - 0.5;
+            let cover = (x as f64 + 0.5 - pos.max(lo)).clamp(0.0, 1.0);
+            (40.0 + 160.0 * cover).round() as u8
+        });
+        let e = detect(&img, ScanDir::Horizontal, &EdgeParams::default()).unwrap();
+        assert_eq!(e.points.len(), 20);
+        let x = e.points[0].x as f64;
+        assert!((x - pos).abs() < 0.12, "step at {pos}: found {x}");
+    }
+}
+
+#[test]
+fn peaks_are_one_pixel_thick_on_a_ramp_and_thresholded_per_row() {
+    // A ramp of 4 px: one peak per row, at the ramp's centre.
+    let img = img_from(40, 20, |x, _| (x.clamp(13, 17) * 10) as u8);
+    let e = detect(&img, ScanDir::Horizontal, &EdgeParams::default()).unwrap();
+    assert_eq!(e.points.len(), 20);
+    assert!(e.points.iter().all(|p| (p.x - 15.0).abs() < 1e-5));
+    // Noise-like alternating small peaks: M = 2 keeps the two strongest.
+    let img = img_from(64, 16, |x, _| {
+        if x % 8 < 4 {
+            100
+        } else {
+            100 + (x / 8) as u8 * 3 + 6
+        }
+    });
+    let p = EdgeParams {
+        per_region: 2,
+        noise_sigmas: 0.0,
+        ..EdgeParams::default()
+    };
+    let e = detect(&img, ScanDir::Horizontal, &p).unwrap();
+    for y in 0..16 {
+        let n = e.points.iter().filter(|q| q.y == y as f32).count();
+        assert!((2..=3).contains(&n), "row {y}: {n} points");
+    }
+}
+
+#[test]
+fn no_panic_on_small_flat_and_invalid_images() {
+    let p = EdgeParams::default();
+    let flat = GreyImage::filled(16, 16, 77).unwrap();
+    for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
+        for a in 3..=7 {
+            let r = response(&flat, dir, a).unwrap();
+            assert_eq!(peaks(&r, &p).points.len(), 0);
+        }
+    }
+    let mut img = img_from(16, 16, |x, y| ((x * 37 + y * 11) % 256) as u8);
+    img.set_valid_mask(Some(vec![false; 256])).unwrap();
+    for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
+        let r = response(&img, dir, 7).unwrap();
+        assert!(r.data.iter().all(|v| v.is_nan()));
+        assert!(peaks(&r, &p).points.is_empty());
+    }
+    assert!(response(&GreyImage::filled(15, 40, 0).unwrap(), ScanDir::Vertical, 4).is_err());
+    assert!(response(&flat, ScanDir::Vertical, 8).is_err());
+}
+
+#[test]
+fn invalid_pixels_suppress_responses_around_them() {
+    let mut img = img_from(32, 32, |x, _| if x < 16 { 0 } else { 200 });
+    let mut mask = vec![true; 32 * 32];
+    mask[10 * 32 + 16] = false;
+    img.set_valid_mask(Some(mask)).unwrap();
+    let rh = response(&img, ScanDir::Horizontal, 4).unwrap();
+    assert!(rh.get(15, 10).is_none() && rh.get(12, 10).is_none());
+    assert!(rh.get(11, 10).is_some() && rh.get(15, 9).is_some());
+    let rv = response(&img, ScanDir::Vertical, 4).unwrap();
+    assert!(rv.get(16, 6).is_none() && rv.get(16, 14).is_none());
+    assert!(rv.get(16, 5).is_some() && rv.get(16, 15).is_some());
+    assert!(rv.get(17, 10).is_some());
+}
