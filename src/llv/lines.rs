@@ -97,11 +97,7 @@ pub struct LineScratch {
     response: ResponseBufs,
     points: PointBufs,
     seeds: Vec<Cand>,
-    fwd: Vec<TrackPoint>,
-    back: Vec<TrackPoint>,
-    chain: Vec<TrackPoint>,
-    split: split::SplitScratch,
-    z: Vec<f32>,
+    tracks: Tracks,
     keys: super::edges::KeyBuf,
     /// The peak map, when the one given does not fit the parameters.
     map: PeakMap,
@@ -124,13 +120,6 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
     let mut src = s.points.peaks();
     s.seeds.clear();
     s.seeds.extend((0..src.len()).map(|i| src.point(i)));
-    let mut t = Tracks {
-        fwd: &mut s.fwd,
-        back: &mut s.back,
-        chain: &mut s.chain,
-        split: &mut s.split,
-        z: &mut s.z,
-    };
     follow(
         &mut src,
         &s.seeds,
@@ -138,7 +127,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
         None,
         DEFAULT_TRIM,
         vertical,
-        &mut t,
+        &mut s.tracks,
         out,
     );
 }
@@ -238,13 +227,6 @@ fn track_keys(
         .sort_unstable_by(|a, b| a.v.cmp(&b.v).then(a.u.total_cmp(&b.u)));
     s.seeds.dedup_by(|a, b| a.id == b.id);
     let nfa = nfa::Nfa::new(w, h, half_width, p.search_width, p.track_sigmas);
-    let mut t = Tracks {
-        fwd: &mut s.fwd,
-        back: &mut s.back,
-        chain: &mut s.chain,
-        split: &mut s.split,
-        z: &mut s.z,
-    };
     follow(
         &mut src,
         &s.seeds,
@@ -252,19 +234,20 @@ fn track_keys(
         Some(&nfa),
         half_width,
         vertical,
-        &mut t,
+        &mut s.tracks,
         out,
     );
     src.finish(&mut s.response);
 }
 
 /// The per-track buffers.
-struct Tracks<'a> {
-    fwd: &'a mut Vec<TrackPoint>,
-    back: &'a mut Vec<TrackPoint>,
-    chain: &'a mut Vec<TrackPoint>,
-    split: &'a mut split::SplitScratch,
-    z: &'a mut Vec<f32>,
+#[derive(Clone, Debug, Default)]
+struct Tracks {
+    fwd: Vec<TrackPoint>,
+    back: Vec<TrackPoint>,
+    chain: Vec<TrackPoint>,
+    split: split::SplitScratch,
+    z: Vec<f32>,
 }
 
 /// Follows a track from every start not yet taken, and keeps its pieces.
@@ -300,7 +283,7 @@ fn follow<P: Peaks>(
         fit.add(Point::new(seed.u, seed.v as f64));
         // The first step fixes the initial slope.
         let mut slope = None;
-        for (dir, list) in [(1i64, &mut *t.fwd), (-1, &mut *t.back)] {
+        for (dir, list) in [(1i64, &mut t.fwd), (-1, &mut t.back)] {
             for i in 1..=gap {
                 let Some(v) = line_at(seed.v, dir * i as i64, src.lines()) else {
                     break;
@@ -321,10 +304,20 @@ fn follow<P: Peaks>(
         let Some(slope) = slope else { continue };
         let seed_point = TrackPoint::of(seed);
         let last_fwd = t.fwd.last().copied().unwrap_or(seed_point);
-        walk(src, &mut fit, last_fwd, 1, slope, positive, sw, gap, t.fwd);
+        walk(
+            src, &mut fit, last_fwd, 1, slope, positive, sw, gap, &mut t.fwd,
+        );
         let last_back = t.back.last().copied().unwrap_or(seed_point);
         walk(
-            src, &mut fit, last_back, -1, slope, positive, sw, gap, t.back,
+            src,
+            &mut fit,
+            last_back,
+            -1,
+            slope,
+            positive,
+            sw,
+            gap,
+            &mut t.back,
         );
         t.chain.clear();
         t.chain.extend(t.back.iter().rev());
@@ -418,14 +411,14 @@ fn keep_pieces(
     vertical: bool,
     out: &mut Vec<Segment>,
 ) {
-    trim_weak_ends(t.chain, t.z);
+    trim_weak_ends(&mut t.chain, &mut t.z);
     if t.chain.len() < 2 {
         return;
     }
-    split::pieces(t.chain, trim, t.split);
+    split::pieces(&t.chain, trim, &mut t.split);
     for r in t.split.ranges() {
         let piece = &t.chain[r.clone()];
-        if let Some(s) = segment_of(piece, p, nfa, trim, min_angle, vertical, t.z) {
+        if let Some(s) = segment_of(piece, p, nfa, trim, min_angle, vertical, &mut t.z) {
             out.push(s);
         }
     }

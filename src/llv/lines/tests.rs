@@ -197,20 +197,7 @@ fn reading_peaks_where_tracks_look_equals_listing_them_all() {
             starts.dedup_by(|a, b| a.id == b.id);
             let nfa = nfa::Nfa::new(w, h, 4, p.search_width, p.track_sigmas);
             let mut plain = Vec::new();
-            let (mut fwd, mut back, mut chain, mut sp, mut z) = (
-                Vec::new(),
-                Vec::new(),
-                Vec::new(),
-                split::SplitScratch::default(),
-                Vec::new(),
-            );
-            let mut t = Tracks {
-                fwd: &mut fwd,
-                back: &mut back,
-                chain: &mut chain,
-                split: &mut sp,
-                z: &mut z,
-            };
+            let mut t = Tracks::default();
             follow(
                 &mut src,
                 &starts,
