@@ -10,7 +10,7 @@
 use divan::{Bencher, black_box};
 use vss::llv::connect::{ConnectScratch, connect_into};
 use vss::llv::edges::{
-    NoiseMap, PeakMap, PeakScratch, Response, ResponseScratch, detect_into, exact_response_into,
+    NoiseMap, PeakMap, PeakScratch, Response, ResponseScratch, Starts, detect_into, response_into,
 };
 use vss::llv::lens::{CameraModel, LensMap, correct_into};
 use vss::llv::lines::{LineScratch, track_into};
@@ -72,14 +72,19 @@ fn edges_both_directions(b: Bencher, n: usize) {
     let (mut eh, mut ev) = (EdgePoints::default(), EdgePoints::default());
     let (mut nh, mut nv) = (NoiseMap::default(), NoiseMap::default());
     let (mut mh, mut mv) = (PeakMap::default(), PeakMap::default());
+    let (mut sh, mut sv) = (Starts::new(), Starts::new());
     let mut counts = ResponseScratch::default();
     let mut ps = PeakScratch::default();
     b.bench_local(|| {
         let img = black_box(&img);
-        exact_response_into(img, ScanDir::Horizontal, 4, &mut rh, &mut counts).expect("size");
-        exact_response_into(img, ScanDir::Vertical, 4, &mut rv, &mut counts).expect("size");
-        detect_into(&rh, &p.edges, t, &mut nh, &mut mh, &mut eh, &mut ps);
-        detect_into(&rv, &p.edges, t, &mut nv, &mut mv, &mut ev, &mut ps);
+        response_into(img, ScanDir::Horizontal, 4, &mut rh, &mut counts).expect("size");
+        response_into(img, ScanDir::Vertical, 4, &mut rv, &mut counts).expect("size");
+        detect_into(
+            &rh, &p.edges, t, &mut nh, &mut mh, &mut eh, &mut sh, &mut ps,
+        );
+        detect_into(
+            &rv, &p.edges, t, &mut nv, &mut mv, &mut ev, &mut sv, &mut ps,
+        );
     });
 }
 
@@ -90,8 +95,9 @@ fn lines_both_directions(b: Bencher, n: usize) {
     let p = Params::default();
     let mut s = LineScratch::default();
     let (mut lh, mut lv) = (Vec::new(), Vec::new());
-    // The peak maps as the edge stage leaves them.
+    // The peak maps and starts as the edge stage leaves them.
     let (mut mh, mut mv) = (PeakMap::default(), PeakMap::default());
+    let (mut sh, mut sv) = (Starts::new(), Starts::new());
     let (mut nh, mut nv) = (NoiseMap::default(), NoiseMap::default());
     let (mut eh, mut ev) = (EdgePoints::default(), EdgePoints::default());
     let (t, mut ps) = (p.lines.track_sigmas, PeakScratch::default());
@@ -102,6 +108,7 @@ fn lines_both_directions(b: Bencher, n: usize) {
         &mut nh,
         &mut mh,
         &mut eh,
+        &mut sh,
         &mut ps,
     );
     detect_into(
@@ -111,13 +118,14 @@ fn lines_both_directions(b: Bencher, n: usize) {
         &mut nv,
         &mut mv,
         &mut ev,
+        &mut sv,
         &mut ps,
     );
     let (f, a) = (p.edges.floor, p.edges.half_width as usize);
     b.bench_local(|| {
         let (rh, rv) = (black_box(&o.response_h), black_box(&o.response_v));
-        track_into(rh, &nh, &mh, &eh, f, a, &p.lines, &mut lh, &mut s);
-        track_into(rv, &nv, &mv, &ev, f, a, &p.lines, &mut lv, &mut s);
+        track_into(rh, &nh, &mh, &eh, &sh, f, a, &p.lines, &mut lh, &mut s);
+        track_into(rv, &nv, &mv, &ev, &sv, f, a, &p.lines, &mut lv, &mut s);
     });
 }
 

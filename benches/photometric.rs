@@ -6,7 +6,7 @@
 //! line extraction and CONNECT.
 
 use divan::{Bencher, black_box};
-use vss::llv::edges::{NoiseMap, PeakMap, PeakScratch, Response, detect_into};
+use vss::llv::edges::{NoiseMap, PeakMap, PeakScratch, Response, Starts, detect_into};
 use vss::llv::photometric::{PhotoScratch, combined_response, combined_response_into};
 use vss::llv::pipeline::{Input, Workspace};
 use vss::llv::synth::{self, PointLight, RenderOptions};
@@ -63,6 +63,7 @@ fn combined_edges_both_directions(b: Bencher) {
     let (mut eh, mut ev) = (EdgePoints::default(), EdgePoints::default());
     let (mut nh, mut nv) = (NoiseMap::default(), NoiseMap::default());
     let (mut mh, mut mv) = (PeakMap::default(), PeakMap::default());
+    let (mut sh, mut sv) = (Starts::new(), Starts::new());
     let t = p.lines.track_sigmas;
     b.bench_local(|| {
         let (lit, amb) = (black_box(&lit), black_box(&amb));
@@ -77,8 +78,12 @@ fn combined_edges_both_directions(b: Bencher) {
         .expect("same size");
         combined_response_into(lit, Some(amb), ScanDir::Vertical, &p.edges, &mut rv, &mut s)
             .expect("same size");
-        detect_into(&rh, &p.edges, t, &mut nh, &mut mh, &mut eh, &mut ps);
-        detect_into(&rv, &p.edges, t, &mut nv, &mut mv, &mut ev, &mut ps);
+        detect_into(
+            &rh, &p.edges, t, &mut nh, &mut mh, &mut eh, &mut sh, &mut ps,
+        );
+        detect_into(
+            &rv, &p.edges, t, &mut nv, &mut mv, &mut ev, &mut sv, &mut ps,
+        );
     });
 }
 

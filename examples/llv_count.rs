@@ -18,8 +18,8 @@
 
 use vss::llv::connect::{ConnectScratch, connect_into};
 use vss::llv::edges::{
-    KeyBuf, NoiseMap, NoiseScratch, PeakMap, PeakScratch, Response, ResponseScratch, detect_into,
-    exact_response_into, peaks_into,
+    NoiseMap, NoiseScratch, PeakMap, PeakScratch, Response, ResponseScratch, Starts, detect_into,
+    response_into,
 };
 use vss::llv::lines::{LineScratch, track_into};
 use vss::llv::pipeline::{Input, Workspace};
@@ -60,28 +60,41 @@ fn main() {
     let (mut rh, mut rv) = (Response::default(), Response::default());
     let (mut eh, mut ev) = (EdgePoints::default(), EdgePoints::default());
     let (mut nh, mut nv) = (NoiseMap::default(), NoiseMap::default());
-    let (mut mh, mut mv) = (PeakMap::default(), PeakMap::default());
-    // The peak maps of the warm outputs, for the line stage alone.
+    let (mut sh, mut sv) = (Starts::new(), Starts::new());
+    // The starts of the warm outputs, for the line stage alone.
+    let (mut wsh, mut wsv) = (Starts::new(), Starts::new());
     let (mut wmh, mut wmv) = (PeakMap::default(), PeakMap::default());
-    for (r, nm, m) in [
-        (&warm.response_h, &warm.noise_h, &mut wmh),
-        (&warm.response_v, &warm.noise_v, &mut wmv),
+    let (mut mh, mut mv) = (PeakMap::default(), PeakMap::default());
+    let t = p.lines.track_sigmas;
+    for (r, e, st, m) in [
+        (
+            &warm.response_h,
+            &mut EdgePoints::default(),
+            &mut wsh,
+            &mut wmh,
+        ),
+        (
+            &warm.response_v,
+            &mut EdgePoints::default(),
+            &mut wsv,
+            &mut wmv,
+        ),
     ] {
-        let mut kb = KeyBuf::default();
-        let k = r.keys(&mut kb);
-        m.build_into(
-            &k,
-            nm,
-            p.edges.floor,
-            p.lines.track_sigmas,
-            p.edges.noise_sigmas,
+        let mut nm = NoiseMap::default();
+        detect_into(
+            r,
+            &p.edges,
+            t,
+            &mut nm,
+            m,
+            e,
+            st,
             &mut PeakScratch::default(),
         );
     }
     let mut rs = ResponseScratch::default();
     let mut ps = PeakScratch::default();
     let mut ns = NoiseScratch::default();
-    let (mut kh, mut kv) = (KeyBuf::default(), KeyBuf::default());
     let mut ls = LineScratch::default();
     let (mut lh, mut lv) = (Vec::new(), Vec::new());
     let (mut joined, mut cs) = (Vec::new(), ConnectScratch::default());
@@ -108,39 +121,41 @@ fn main() {
                 check += ws.outputs().lines.len();
             }
             "edges" | "response" => {
-                exact_response_into(&img, ScanDir::Horizontal, a, &mut rh, &mut rs).expect("size");
-                exact_response_into(&img, ScanDir::Vertical, a, &mut rv, &mut rs).expect("size");
+                response_into(&img, ScanDir::Horizontal, a, &mut rh, &mut rs).expect("size");
+                response_into(&img, ScanDir::Vertical, a, &mut rv, &mut rs).expect("size");
                 if stage == "edges" {
-                    let t = p.lines.track_sigmas;
-                    detect_into(&rh, &p.edges, t, &mut nh, &mut mh, &mut eh, &mut ps);
-                    detect_into(&rv, &p.edges, t, &mut nv, &mut mv, &mut ev, &mut ps);
+                    detect_into(
+                        &rh, &p.edges, t, &mut nh, &mut mh, &mut eh, &mut sh, &mut ps,
+                    );
+                    detect_into(
+                        &rv, &p.edges, t, &mut nv, &mut mv, &mut ev, &mut sv, &mut ps,
+                    );
                 }
                 check += eh.points.len() + ev.points.len();
             }
             "noise" => {
-                nh.estimate_into(&warm.response_h.keys(&mut kh), &mut ns);
-                nv.estimate_into(&warm.response_v.keys(&mut kv), &mut ns);
+                nh.estimate_into(&warm.response_h, &mut ns);
+                nv.estimate_into(&warm.response_v, &mut ns);
                 check += nh.tiles().0;
             }
             "peaks" => {
-                let t = p.lines.track_sigmas.min(p.edges.noise_sigmas);
-                for (r, nm, m, e) in [
-                    (&warm.response_h, &warm.noise_h, &mut mh, &mut eh),
-                    (&warm.response_v, &warm.noise_v, &mut mv, &mut ev),
+                for (r, nm, m, e, st) in [
+                    (&warm.response_h, &warm.noise_h, &mut mh, &mut eh, &mut sh),
+                    (&warm.response_v, &warm.noise_v, &mut mv, &mut ev, &mut sv),
                 ] {
-                    let k = r.keys(&mut kh);
-                    m.build_into(&k, nm, p.edges.floor, t, p.edges.noise_sigmas, &mut ps);
-                    peaks_into(&k, nm, m, &p.edges, e, &mut ps);
+                    m.build_into(r, nm, p.edges.floor, t, &mut ps);
+                    vss::llv::edges::peaks::points_into(r, nm, &p.edges, None, e, st, &mut ps);
                     check += e.points.len();
                 }
             }
             "lines" => {
-                for (r, nm, m, e, out) in [
+                for (r, nm, m, e, st, out) in [
                     (
                         &warm.response_h,
                         &warm.noise_h,
                         &wmh,
                         &warm.edges_h,
+                        &wsh,
                         &mut lh,
                     ),
                     (
@@ -148,10 +163,11 @@ fn main() {
                         &warm.noise_v,
                         &wmv,
                         &warm.edges_v,
+                        &wsv,
                         &mut lv,
                     ),
                 ] {
-                    track_into(r, nm, m, e, p.edges.floor, a, &p.lines, out, &mut ls);
+                    track_into(r, nm, m, e, st, p.edges.floor, a, &p.lines, out, &mut ls);
                 }
                 check += lh.len() + lv.len();
             }

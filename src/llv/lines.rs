@@ -48,7 +48,7 @@ pub mod nfa;
 pub mod source;
 mod split;
 
-use super::edges::{Keys, NoiseMap, PeakMap, PeakScratch, Response};
+use super::edges::{NoiseMap, PeakMap, PeakScratch, Response};
 use super::fit::LineFit;
 use super::params::LineParams;
 use super::{EdgePoints, Point, ScanDir, Segment};
@@ -96,9 +96,12 @@ impl TrackPoint {
 pub struct LineScratch {
     response: ResponseBufs,
     points: PointBufs,
-    seeds: Vec<Cand>,
+    seeds: Vec<u32>,
+    /// Starts found again from their points (sort keys), and the
+    /// counting sort's column counts.
+    sorted: Vec<u32>,
+    order: Vec<u32>,
     tracks: Tracks,
-    keys: super::edges::KeyBuf,
     /// The peak map, when the one given does not fit the parameters.
     map: PeakMap,
     peaks: PeakScratch,
@@ -119,7 +122,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
     s.points.file(e);
     let mut src = s.points.peaks();
     s.seeds.clear();
-    s.seeds.extend((0..src.len()).map(|i| src.point(i)));
+    s.seeds.extend(0..src.len() as u32);
     follow(
         &mut src,
         &s.seeds,
@@ -133,9 +136,11 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
 }
 
 /// Segments of one scan direction of an image: the pipeline's extractor.
-/// `seeds` are the direction's edge points (`edges::peaks`), `noise` its
-/// noise map, `map` its peak map (`edges::detect_into`; made again here
-/// unless it holds the peaks above `floor` and `p.track_sigmas`),
+/// `seeds` are the direction's edge points (`edges::detect_into`) and
+/// `starts` their pixels (as it gives them; when they do not match the
+/// points, each point's pixel is found again), `noise` its noise map,
+/// `map` its peak map (made again here unless it holds the peaks above
+/// `floor` and `p.track_sigmas`), `floor` the edges' floor `T`,
 /// `half_width` the kernel's `A`.
 #[allow(clippy::too_many_arguments)]
 pub fn track_into(
@@ -143,36 +148,7 @@ pub fn track_into(
     noise: &NoiseMap,
     map: &PeakMap,
     seeds: &EdgePoints,
-    floor: f64,
-    half_width: usize,
-    p: &LineParams,
-    out: &mut Vec<Segment>,
-    s: &mut LineScratch,
-) {
-    let mut keybuf = std::mem::take(&mut s.keys);
-    track_keys_into(
-        &resp.keys(&mut keybuf),
-        noise,
-        map,
-        seeds,
-        floor,
-        half_width,
-        p,
-        out,
-        s,
-    );
-    s.keys = keybuf;
-}
-
-/// [`track_into`] on a response's keys ([`Response::keys`]), for a caller
-/// that has them already (the pipeline, which quantises an `f32` response
-/// once for the edge points and the line extractor).
-#[allow(clippy::too_many_arguments)]
-pub fn track_keys_into(
-    k: &Keys,
-    noise: &NoiseMap,
-    map: &PeakMap,
-    seeds: &EdgePoints,
+    starts: &[u32],
     floor: f64,
     half_width: usize,
     p: &LineParams,
@@ -180,52 +156,73 @@ pub fn track_keys_into(
     s: &mut LineScratch,
 ) {
     out.clear();
-    let mut own = std::mem::take(&mut s.map);
-    let map = if map.fits(k, floor, p.track_sigmas) {
-        map
-    } else {
-        let t = p.track_sigmas;
-        own.build_into(k, noise, floor, t, t, &mut s.peaks);
-        &own
-    };
-    track_keys(k, noise, map, seeds, half_width, p, out, s);
-    s.map = own;
-}
-
-#[allow(clippy::too_many_arguments)]
-fn track_keys(
-    k: &Keys,
-    noise: &NoiseMap,
-    map: &PeakMap,
-    seeds: &EdgePoints,
-    half_width: usize,
-    p: &LineParams,
-    out: &mut Vec<Segment>,
-    s: &mut LineScratch,
-) {
-    let (w, h) = (k.width, k.height);
-    if w < 3 || h < 3 || k.keys.len() != w * h {
+    let (w, h) = (resp.width, resp.height);
+    if w < 3 || h < 3 || !resp.covers(w, h) {
         return;
     }
-    let vertical = k.dir == ScanDir::Vertical;
-    let mut src = ResponsePeaks::new(*k, noise, map, &mut s.response);
+    let vertical = resp.dir == ScanDir::Vertical;
+    let mut own = std::mem::take(&mut s.map);
+    let map = if map.fits(resp, floor, p.track_sigmas) {
+        map
+    } else {
+        own.build_into(resp, noise, floor, p.track_sigmas, &mut s.peaks);
+        &own
+    };
+    let mut src = ResponsePeaks::new(resp, noise, map, &mut s.response);
     s.seeds.clear();
-    for e in &seeds.points {
-        let (u, v) = if vertical { (e.y, e.x) } else { (e.x, e.y) };
-        let r = (v + 0.5).floor();
-        if !(u.is_finite() && r >= 0.0 && (r as usize) < src.lines()) {
-            continue;
+    if starts.len() == seeds.points.len() {
+        // In scan order: the starts are in image order, which is the
+        // horizontal scan's; a vertical scan's are put in column order by
+        // a counting sort on the column (stable, so rows stay ascending).
+        if vertical {
+            s.order.clear();
+            s.order.resize(w + 1, 0);
+            for &i in starts {
+                s.order[i as usize % w + 1] += 1;
+            }
+            for x in 0..w {
+                s.order[x + 1] += s.order[x];
+            }
+            s.seeds.clear();
+            s.seeds.resize(starts.len(), 0);
+            for &i in starts {
+                let x = i as usize % w;
+                s.seeds[s.order[x] as usize] = i;
+                s.order[x] += 1;
+            }
+        } else {
+            s.seeds.extend_from_slice(starts);
         }
-        let positive = e.response > 0.0;
-        // The seed's pixel: the peak at or next to its position.
-        if let Some(c) = src.strongest(r as usize, f64::from(u), 0.5, positive) {
-            s.seeds.push(c);
+    } else {
+        s.sorted.clear();
+        for e in &seeds.points {
+            let (u, v) = if vertical { (e.y, e.x) } else { (e.x, e.y) };
+            let r = (v + 0.5).floor();
+            if !(u.is_finite() && r >= 0.0 && (r as usize) < src.lines()) {
+                continue;
+            }
+            // The seed's pixel: the peak at or next to its position.
+            if let Some(c) = src.strongest(r as usize, f64::from(u), 0.5, e.response > 0.0) {
+                s.sorted.push(if vertical {
+                    (c.v * h + c.id / w) as u32
+                } else {
+                    c.id as u32
+                });
+            }
         }
+        // In scan order (a vertical scan's by column, then row), as
+        // image indices.
+        s.sorted.sort_unstable();
+        s.seeds.extend(s.sorted.iter().map(|&k| {
+            if vertical {
+                let (x, y) = (k as usize / h, k as usize % h);
+                (y * w + x) as u32
+            } else {
+                k
+            }
+        }));
     }
-    // (Unstable: no buffer; two starts never share a position.)
-    s.seeds
-        .sort_unstable_by(|a, b| a.v.cmp(&b.v).then(a.u.total_cmp(&b.u)));
-    s.seeds.dedup_by(|a, b| a.id == b.id);
+    s.seeds.dedup();
     let nfa = nfa::Nfa::new(w, h, half_width, p.search_width, p.track_sigmas);
     follow(
         &mut src,
@@ -238,6 +235,7 @@ fn track_keys(
         out,
     );
     src.finish(&mut s.response);
+    s.map = own;
 }
 
 /// The per-track buffers.
@@ -254,7 +252,7 @@ struct Tracks {
 #[allow(clippy::too_many_arguments)]
 fn follow<P: Peaks>(
     src: &mut P,
-    seeds: &[Cand],
+    seeds: &[u32],
     p: &LineParams,
     nfa: Option<&nfa::Nfa>,
     trim: usize,
@@ -271,10 +269,14 @@ fn follow<P: Peaks>(
     // Every slope the angle test admits, for the first step.
     let steep = (1.0 / min_angle.clamp(1e-3, std::f64::consts::FRAC_PI_2).tan()).min(MAX_SLOPE);
     let gap = p.max_gap.max(1) as usize;
-    for seed in seeds {
-        if src.is_taken(seed) {
+    for &id in seeds {
+        if src.is_taken(id as usize) {
             continue;
         }
+        let Some(seed) = src.seed(id as usize) else {
+            continue;
+        };
+        let seed = &seed;
         src.take(seed);
         let positive = seed.response > 0.0;
         t.fwd.clear();

@@ -15,12 +15,11 @@ use serde::Serialize;
 use super::connect::{ConnectScratch, connect_into};
 use super::corners::{CornerScratch, close_corners_with};
 use super::edges::{
-    KeyBuf, NoiseMap, PeakMap, PeakScratch, Response, ResponseScratch, detect_keys_into,
-    exact_response_into,
+    NoiseMap, PeakMap, PeakScratch, Response, ResponseScratch, Starts, detect_into, response_into,
 };
 use super::image::GreyImage;
 use super::lens::{LensMap, correct_into};
-use super::lines::{LineScratch, extract_into, track_keys_into};
+use super::lines::{LineScratch, extract_into, track_into};
 use super::params::{Params, Stage};
 use super::photometric::{PhotoScratch, combined_response_into};
 use super::{EdgePoints, LlvError, ScanDir, Segment};
@@ -343,11 +342,10 @@ struct DirScratch {
     response: ResponseScratch,
     photo: PhotoScratch,
     peaks: PeakScratch,
-    /// The peaks the edge points and the line extractor are taken from.
+    /// The pixels of the edge points, where the line extractor starts,
+    /// and the peaks it may follow.
+    starts: Starts,
     map: PeakMap,
-    /// The response's keys, when it is an `f32` one (several lightings):
-    /// quantised once a run for the edge points and the line extractor.
-    keys: KeyBuf,
     lines: LineScratch,
     /// The direction's extracted lines.
     segs: Vec<Segment>,
@@ -386,7 +384,7 @@ impl Job<'_> {
         if self.from <= Stage::Edges && self.response {
             let a = p.edges.half_width as usize;
             match (images, ambient) {
-                ([img], None) => exact_response_into(img, o.dir, a, o.response, &mut o.s.response)?,
+                ([img], None) => response_into(img, o.dir, a, o.response, &mut o.s.response)?,
                 _ => combined_response_into(
                     images,
                     ambient,
@@ -397,27 +395,26 @@ impl Job<'_> {
                 )?,
             }
         }
-        // (Free for one image's exact response; an `f32` one is quantised
-        // here, once for both readers.)
-        let k = o.response.keys(&mut o.s.keys);
         if self.from <= Stage::Edges {
-            detect_keys_into(
-                &k,
+            detect_into(
+                o.response,
                 &p.edges,
                 p.lines.track_sigmas,
                 o.noise,
                 &mut o.s.map,
                 o.edges,
+                &mut o.s.starts,
                 &mut o.s.peaks,
             );
             edges_us = micros(t);
         }
         let t = Instant::now();
-        track_keys_into(
-            &k,
+        track_into(
+            o.response,
             o.noise,
             &o.s.map,
             o.edges,
+            &o.s.starts,
             p.edges.floor,
             p.edges.half_width as usize,
             &p.lines,

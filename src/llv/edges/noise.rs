@@ -18,7 +18,7 @@
 //! every fourth line (1/8 of the pixels; 512 samples a 64 × 64 tile, for a
 //! median within about 6 %).
 
-use super::{Keys, NONE};
+use super::{NONE, Response, key};
 
 /// Tile side (px) of the noise estimate; an image side shorter than two
 /// tiles is one tile.
@@ -99,6 +99,19 @@ impl NoiseMap {
         ty * self.nx + tx
     }
 
+    /// The tile column of every image column `0..w` into `out` (the tile
+    /// of `(x, y)` is `row_of(y) + out[x]`; clamped into the map).
+    pub fn columns_into(&self, w: usize, out: &mut Vec<u32>) {
+        out.clear();
+        out.extend((0..w).map(|x| ((x / self.tw.max(1)).min(self.nx.max(1) - 1)) as u32));
+    }
+
+    /// The first tile of the row of tiles of image row `y`.
+    #[inline]
+    pub fn row_of(&self, y: usize) -> usize {
+        (y / self.th.max(1)).min(self.ny.max(1) - 1) * self.nx
+    }
+
     /// σ of tile `t` (grey levels).
     #[inline]
     pub fn sigma(&self, t: usize) -> f32 {
@@ -120,18 +133,18 @@ impl NoiseMap {
     }
 
     /// Estimates the map of a response (see the module doc).
-    pub fn estimate(k: &Keys) -> Self {
+    pub fn estimate(r: &Response) -> Self {
         let mut m = NoiseMap::default();
-        m.estimate_into(k, &mut NoiseScratch::default());
+        m.estimate_into(r, &mut NoiseScratch::default());
         m
     }
 
     /// [`NoiseMap::estimate`] into reusable buffers.
-    pub fn estimate_into(&mut self, k: &Keys, s: &mut NoiseScratch) {
-        let (w, h) = (k.width, k.height);
+    pub fn estimate_into(&mut self, r: &Response, s: &mut NoiseScratch) {
+        let (w, h) = (r.width, r.height);
         self.shape(w, h);
         self.global = 0.0;
-        if w == 0 || h == 0 || k.keys.len() != w * h {
+        if w == 0 || h == 0 || !r.covers(w, h) {
             return;
         }
         s.known.clear();
@@ -151,12 +164,12 @@ impl NoiseMap {
                 let mut n = 0usize;
                 let mut y = y0 + 1;
                 while y < y1 {
-                    let row = &k.keys[y * w..(y + 1) * w];
+                    let row = &r.sums()[y * w..(y + 1) * w];
                     let mut x = x0;
                     while x < x1 {
-                        let key = row[x];
-                        if key != NONE {
-                            hist[(key.max(0) as usize).min(BINS - 1)] += 1;
+                        let v = row[x];
+                        if v != NONE {
+                            hist[(key(v) as usize).min(BINS - 1)] += 1;
                             n += 1;
                         }
                         x += COLUMN_STEP;
@@ -165,7 +178,7 @@ impl NoiseMap {
                 }
                 let t = ty * self.nx + tx;
                 self.sigma[t] = if n >= MIN_SAMPLES {
-                    let sigma = median_bin(hist, n) * k.scale * MEDIAN_TO_SIGMA;
+                    let sigma = median_bin(hist, n) * r.scale() * MEDIAN_TO_SIGMA;
                     s.known.push(sigma);
                     sigma
                 } else {
@@ -207,7 +220,7 @@ fn median_bin(hist: &[u16], n: usize) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::llv::edges::{KeyBuf, Response, ResponseScratch, exact_response_into};
+    use crate::llv::edges::response;
     use crate::llv::synth::rng::SplitMix64;
     use crate::llv::{GreyImage, ScanDir};
 
@@ -227,10 +240,7 @@ mod tests {
     }
 
     fn map_of(img: &GreyImage, dir: ScanDir) -> NoiseMap {
-        let mut r = Response::default();
-        exact_response_into(img, dir, 4, &mut r, &mut ResponseScratch::default()).unwrap();
-        let mut buf = KeyBuf::default();
-        NoiseMap::estimate(&r.keys(&mut buf))
+        NoiseMap::estimate(&response(img, dir, 4).unwrap())
     }
 
     /// Kernel norm ‖φ'‖ for A = 4.

@@ -4,7 +4,7 @@
 
 use super::super::image::GreyImage;
 use super::super::{LlvError, ScanDir};
-use super::{Response, check_half_width};
+use super::check_half_width;
 
 /// Buffers of the reference response.
 #[derive(Default)]
@@ -13,7 +13,8 @@ pub struct ResponseScratch {
     pixels: Vec<f32>,
 }
 
-/// [`response`] into reusable buffers.
+/// The Lee response of `img` along `dir` in grey levels, NaN where there
+/// is none, in image order, into `out`.
 ///
 /// The antisymmetry of the kernel halves the work:
 /// `E(x) = Σ_{s=1..A} c_s (Img(x+s) - Img(x-s))` with `c_s = 6 s (A-s)`
@@ -22,17 +23,14 @@ pub fn response_into(
     img: &GreyImage,
     dir: ScanDir,
     a: usize,
-    out: &mut Response,
+    out: &mut Vec<f32>,
     scratch: &mut ResponseScratch,
 ) -> Result<(), LlvError> {
     check_half_width(a)?;
     img.check_stage_size()?;
     let (w, h) = img.size();
-    out.width = w;
-    out.height = h;
-    out.dir = dir;
-    out.data.clear();
-    out.data.resize(w * h, f32::NAN);
+    out.clear();
+    out.resize(w * h, f32::NAN);
     let mut coef = [0f32; 7];
     for (s, v) in coef.iter_mut().enumerate().take(a) {
         *v = (6 * (s + 1) * (a - s - 1)) as f32;
@@ -45,7 +43,7 @@ pub fn response_into(
     match dir {
         ScanDir::Horizontal => {
             if w > 2 * a {
-                for (row, orow) in px.chunks_exact(w).zip(out.data.chunks_exact_mut(w)) {
+                for (row, orow) in px.chunks_exact(w).zip(out.chunks_exact_mut(w)) {
                     let o = &mut orow[a..w - a];
                     o.fill(0.0);
                     let n = o.len();
@@ -67,7 +65,7 @@ pub fn response_into(
         ScanDir::Vertical => {
             if h > 2 * a {
                 for y in a..h - a {
-                    let orow = &mut out.data[y * w..(y + 1) * w];
+                    let orow = &mut out[y * w..(y + 1) * w];
                     orow.fill(0.0);
                     for (k, &cs) in c.iter().enumerate() {
                         let s = k + 1;
@@ -85,7 +83,7 @@ pub fn response_into(
         }
     }
     if let Some(mask) = img.valid_mask() {
-        mask_invalid(mask, w, h, dir, a, &mut out.data, &mut scratch.counts);
+        mask_invalid(mask, w, h, dir, a, out, &mut scratch.counts);
     }
     Ok(())
 }

@@ -1,23 +1,18 @@
 //! The Lee convolution of one output row, shared by the single-image
 //! response ([`super::response_into`]) and the photometric combination
-//! (`photometric.rs`), so both compute the same `f32` bit for bit.
+//! (`photometric.rs`), so both compute the same sums.
 //!
 //! By antisymmetry, `E = (Σ_{s=1..A-1} c_s (hi_s − lo_s)) / A³` with
 //! `c_s = 6 s (A − s)` (`c_A = 0`), where `hi_s`/`lo_s` are the pixels `s`
 //! steps after/before along the scan. Each output is computed in registers
 //! over all taps (the half-width is a const generic, so the tap loop is
-//! unrolled) in blocks of [`BLK`] outputs, then scaled once. The integer sum
-//! is exact, so it is the same whatever the lane type:
-//! - `A ≤ 5`: `Σ c_s · 255 ≤ 30 600 < 2¹⁵`, so `i16` lanes (eight per SSE2
-//!   register, no widening per tap);
+//! unrolled) in blocks of [`BLK`] outputs. The integer sum is exact, so it
+//! is the same whatever the lane type:
+//! - `A ≤ 5`: `Σ c_s · 255 ≤ 30 600 < 2¹⁵`, so `i16` lanes (no widening per
+//!   tap);
 //! - `A = 6, 7`: up to `336 · 255`, so `i32` lanes.
-//!
-//! `(sum as f32) · (1/A³)` is then one rounding, the same as the former
-//! `f32` accumulation of whole numbers followed by the same scaling.
-//!
-//! For `A ≤ 5` the single-image path keeps the sums themselves
-//! ([`lee_row_exact`]): the `i16` sum and its magnitude, without the
-//! conversion to `f32`, which the peak finder then does only at candidates.
+
+use super::SUM_MAX;
 
 /// Outputs per block: eight SSE2 registers of `i16` accumulators; fewer
 /// outputs per block spend as much on slicing the taps as on arithmetic.
@@ -67,41 +62,6 @@ impl<'a> Taps<'a> {
     }
 }
 
-/// Writes the Lee response with half-width `a` (3–7) of every output of
-/// `out` (its length is the number of outputs). Leaves `out` untouched if
-/// the taps are too short (a caller's bug, never reached from the stages).
-pub(crate) fn lee_row(taps: &Taps, a: usize, out: &mut [f32]) {
-    if !taps.covers(a, out.len()) {
-        debug_assert!(false, "taps shorter than the output row");
-        return;
-    }
-    match a {
-        3 => row_i16::<3>(taps, out),
-        4 => row_i16::<4>(taps, out),
-        5 => row_i16::<5>(taps, out),
-        6 => row_i32::<6>(taps, out),
-        7 => row_i32::<7>(taps, out),
-        _ => debug_assert!(false, "half-width {a} outside 3..=7"),
-    }
-}
-
-/// Writes the exact Lee sums `S` (the response is `S · 1/A³`) of every
-/// output of `sums` and their magnitudes `|S|` into `keys` (as long), for a
-/// half-width `a` of 3–5, whose sums fit `i16`; false (nothing written) for
-/// any other, or if the taps are too short.
-pub(crate) fn lee_row_exact(taps: &Taps, a: usize, sums: &mut [i16], keys: &mut [i16]) -> bool {
-    if sums.len() != keys.len() || !taps.covers(a, sums.len()) {
-        return false;
-    }
-    match a {
-        3 => row_exact::<3>(taps, sums, keys),
-        4 => row_exact::<4>(taps, sums, keys),
-        5 => row_exact::<5>(taps, sums, keys),
-        _ => return false,
-    }
-    true
-}
-
 /// `c_s = 6 s (A − s)` for `s = 0..8` (only `1..A` is used).
 const fn coef(a: usize, s: usize) -> i32 {
     if s == 0 || s >= a {
@@ -111,57 +71,123 @@ const fn coef(a: usize, s: usize) -> i32 {
     }
 }
 
+/// Grey levels of one unit of an exact sum: `1/A³`.
 pub(crate) fn scale(a: usize) -> f32 {
     1.0 / (a * a * a) as f32
 }
 
-/// One output, exactly: the fallback for rows shorter than a block.
-#[inline]
-fn one(taps: &Taps, a: usize, j: usize) -> f32 {
-    one_sum(taps, a, j) as f32 * scale(a)
+/// The largest magnitude of an exact sum with half-width `a`: `255 Σ c_s`.
+pub(crate) fn max_sum(a: usize) -> i64 {
+    255 * (1..a).map(|s| i64::from(coef(a, s))).sum::<i64>()
+}
+
+/// The bits a sum of `terms` responses' magnitudes (each at most
+/// [`max_sum`]) is shifted right by so that it fits [`SUM_MAX`]: 0 for
+/// one image with `A ≤ 5`.
+pub(crate) fn shift(a: usize, terms: u32) -> u32 {
+    let top = max_sum(a) * i64::from(terms.max(1));
+    let mut k = 0;
+    while top > i64::from(SUM_MAX) << k {
+        k += 1;
+    }
+    k
+}
+
+/// Writes the exact sums `S` (the response is `S / A³`) of every output of
+/// `out` for a half-width `a` of 3–5, whose sums fit `i16`; false (nothing
+/// written) for any other, or if the taps are too short.
+#[multiversion::multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt", "x86_64+sse4.1"))]
+pub(crate) fn sums_i16(taps: &Taps, a: usize, out: &mut [i16]) -> bool {
+    if !taps.covers(a, out.len()) {
+        return false;
+    }
+    match a {
+        3 => row_exact::<3>(taps, out),
+        4 => row_exact::<4>(taps, out),
+        5 => row_exact::<5>(taps, out),
+        _ => return false,
+    }
+    true
+}
+
+/// Writes the exact sums of every output of `out` for any half-width 3–7
+/// (in `i16` lanes where they fit, then widened). Leaves `out` untouched
+/// if the taps are too short (a caller's bug, never reached from the
+/// stages).
+#[multiversion::multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt", "x86_64+sse4.1"))]
+pub(crate) fn sums_i32(taps: &Taps, a: usize, out: &mut [i32]) {
+    if !taps.covers(a, out.len()) {
+        debug_assert!(false, "taps shorter than the output row");
+        return;
+    }
+    match a {
+        3 => widen_exact::<3>(taps, out),
+        4 => widen_exact::<4>(taps, out),
+        5 => widen_exact::<5>(taps, out),
+        6 => row_wide::<6>(taps, out),
+        7 => row_wide::<7>(taps, out),
+        _ => debug_assert!(false, "half-width {a} outside 3..=7"),
+    }
+}
+
+/// `v / 2^shift` rounded half away from zero and clamped to ±[`SUM_MAX`],
+/// as `i16`.
+#[inline(always)]
+pub(crate) fn narrow_one(v: i32, shift: u32) -> i16 {
+    let r = if shift == 0 {
+        v
+    } else {
+        let half = 1 << (shift - 1);
+        let m = (v.unsigned_abs() as i32 + half) >> shift;
+        if v < 0 { -m } else { m }
+    };
+    r.clamp(-SUM_MAX, SUM_MAX) as i16
+}
+
+/// [`narrow_one`] of every value of `wide` into `out` (as long).
+#[multiversion::multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt", "x86_64+sse4.1"))]
+pub(crate) fn narrow(wide: &[i32], shift: u32, out: &mut [i16]) {
+    for (o, &v) in out.iter_mut().zip(wide) {
+        *o = narrow_one(v, shift);
+    }
 }
 
 /// The exact sum of output `j`.
-#[inline]
+#[inline(always)]
 fn one_sum(taps: &Taps, a: usize, j: usize) -> i32 {
     (1..a)
         .map(|s| coef(a, s) * (i32::from(taps.hi[s][j]) - i32::from(taps.lo[s][j])))
         .sum()
 }
 
-/// Runs `block(i, out)` on blocks of [`BLK`] outputs starting at `i` that
-/// cover the row, the last one overlapping its predecessor (recomputed
-/// outputs are identical); rows shorter than a block go output by output.
 #[inline(always)]
-fn by_blocks(taps: &Taps, a: usize, out: &mut [f32], mut block: impl FnMut(usize, &mut [f32])) {
+fn row_exact<const A: usize>(taps: &Taps, out: &mut [i16]) {
     let n = out.len();
     if n < BLK {
         for (j, o) in out.iter_mut().enumerate() {
-            *o = one(taps, a, j);
+            // |acc| ≤ 30 600 for A ≤ 5.
+            *o = one_sum(taps, A, j) as i16;
         }
         return;
     }
     for i in block_starts(n) {
-        block(i, out);
+        out[i..i + BLK].copy_from_slice(&block_i16::<A>(taps, i));
     }
 }
 
-fn row_exact<const A: usize>(taps: &Taps, sums: &mut [i16], keys: &mut [i16]) {
-    let n = sums.len();
+#[inline(always)]
+fn widen_exact<const A: usize>(taps: &Taps, out: &mut [i32]) {
+    let n = out.len();
     if n < BLK {
-        for (j, (s, k)) in sums.iter_mut().zip(keys.iter_mut()).enumerate() {
-            // |acc| ≤ 30 600 for A ≤ 5.
-            let acc = one_sum(taps, A, j);
-            *s = acc as i16;
-            *k = acc.unsigned_abs() as i16;
+        for (j, o) in out.iter_mut().enumerate() {
+            *o = one_sum(taps, A, j);
         }
         return;
     }
     for i in block_starts(n) {
-        let acc = sums_i16::<A>(taps, i);
-        sums[i..i + BLK].copy_from_slice(&acc);
-        for (k, &v) in keys[i..i + BLK].iter_mut().zip(&acc) {
-            *k = v.wrapping_abs();
+        let acc = block_i16::<A>(taps, i);
+        for (o, &v) in out[i..i + BLK].iter_mut().zip(&acc) {
+            *o = i32::from(v);
         }
     }
 }
@@ -169,7 +195,7 @@ fn row_exact<const A: usize>(taps: &Taps, sums: &mut [i16], keys: &mut [i16]) {
 /// The exact sums of the [`BLK`] outputs from `i`, in `i16` lanes (`A ≤
 /// 5`; the taps cover them).
 #[inline(always)]
-fn sums_i16<const A: usize>(taps: &Taps, i: usize) -> [i16; BLK] {
+fn block_i16<const A: usize>(taps: &Taps, i: usize) -> [i16; BLK] {
     let mut acc = [0i16; BLK];
     for s in 1..A {
         let c = coef(A, s) as i16;
@@ -189,19 +215,16 @@ fn block_starts(n: usize) -> impl Iterator<Item = usize> {
     (0..last).step_by(BLK).chain(std::iter::once(last))
 }
 
-fn row_i16<const A: usize>(taps: &Taps, out: &mut [f32]) {
-    let sc = scale(A);
-    by_blocks(taps, A, out, |i, out| {
-        let acc = sums_i16::<A>(taps, i);
-        for (o, &v) in out[i..i + BLK].iter_mut().zip(&acc) {
-            *o = v as f32 * sc;
+#[inline(always)]
+fn row_wide<const A: usize>(taps: &Taps, out: &mut [i32]) {
+    let n = out.len();
+    if n < BLK {
+        for (j, o) in out.iter_mut().enumerate() {
+            *o = one_sum(taps, A, j);
         }
-    });
-}
-
-fn row_i32<const A: usize>(taps: &Taps, out: &mut [f32]) {
-    let sc = scale(A);
-    by_blocks(taps, A, out, |i, out| {
+        return;
+    }
+    for i in block_starts(n) {
         let mut acc = [0i32; BLK];
         for s in 1..A {
             let c = coef(A, s);
@@ -211,10 +234,8 @@ fn row_i32<const A: usize>(taps: &Taps, out: &mut [f32]) {
                 *o += c * (i32::from(h) - i32::from(l));
             }
         }
-        for (o, &v) in out[i..i + BLK].iter_mut().zip(&acc) {
-            *o = v as f32 * sc;
-        }
-    });
+        out[i..i + BLK].copy_from_slice(&acc);
+    }
 }
 
 #[cfg(test)]
@@ -222,7 +243,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn exact_rows_scale_to_the_float_rows_bit_for_bit() {
+    fn rows_equal_the_tap_by_tap_sum_for_every_length() {
         let mut rng = crate::llv::synth::rng::SplitMix64::new(11);
         // Extremes too: 0/255 steps give the largest sums.
         let src: Vec<u8> = (0..300)
@@ -236,44 +257,46 @@ mod tests {
             for len in 2 * a + 1..=300 {
                 let row = &src[..len];
                 let n = len - 2 * a;
-                let mut want = vec![f32::NAN; n];
-                lee_row(&Taps::horizontal(row, a), a, &mut want);
-                let (mut sums, mut keys) = (vec![0i16; n], vec![0i16; n]);
-                let done = lee_row_exact(&Taps::horizontal(row, a), a, &mut sums, &mut keys);
+                let want: Vec<i32> = (0..n)
+                    .map(|j| {
+                        let x = j + a;
+                        (1..=a)
+                            .map(|s| {
+                                (6 * s * (a - s)) as i32 * (row[x + s] as i32 - row[x - s] as i32)
+                            })
+                            .sum()
+                    })
+                    .collect();
+                let mut wide = vec![0i32; n];
+                sums_i32(&Taps::horizontal(row, a), a, &mut wide);
+                assert_eq!(wide, want, "a={a} len={len}");
+                let mut narrow16 = vec![0i16; n];
+                let done = sums_i16(&Taps::horizontal(row, a), a, &mut narrow16);
                 assert_eq!(done, a <= 5, "a={a}");
-                if !done {
-                    continue;
-                }
-                for j in 0..n {
-                    let e = sums[j] as f32 * scale(a);
-                    assert_eq!(e.to_bits(), want[j].to_bits(), "a={a} len={len} j={j}");
-                    assert_eq!(i32::from(keys[j]), i32::from(sums[j]).abs());
+                if done {
+                    assert!(narrow16.iter().zip(&want).all(|(&s, &w)| i32::from(s) == w));
                 }
             }
         }
     }
 
     #[test]
-    fn rows_equal_the_tap_by_tap_float_sum_for_every_length() {
-        let mut rng = crate::llv::synth::rng::SplitMix64::new(7);
-        let src: Vec<u8> = (0..200).map(|_| rng.next_u64() as u8).collect();
+    fn shifts_fit_the_largest_sums_and_round_half_away_from_zero() {
+        assert_eq!((shift(3, 1), shift(4, 1), shift(5, 1)), (0, 0, 0));
+        assert_eq!((shift(6, 1), shift(7, 1)), (1, 2));
+        assert_eq!(shift(4, 8), 2);
+        assert_eq!(shift(5, 8), 3);
         for a in 3..=7 {
-            for len in 2 * a + 1..=200 {
-                let row = &src[..len];
-                let n = len - 2 * a;
-                let mut out = vec![f32::NAN; n];
-                lee_row(&Taps::horizontal(row, a), a, &mut out);
-                for (j, &v) in out.iter().enumerate() {
-                    let x = j + a;
-                    let mut want = 0f32;
-                    for s in 1..=a {
-                        let c = (6 * s * (a - s)) as f32;
-                        want += c * (row[x + s] as f32 - row[x - s] as f32);
-                    }
-                    want *= 1.0 / (a * a * a) as f32;
-                    assert_eq!(v.to_bits(), want.to_bits(), "a={a} len={len} j={j}");
-                }
+            for terms in 1..=10 {
+                let k = shift(a, terms);
+                assert!(max_sum(a) * i64::from(terms) <= i64::from(SUM_MAX) << k);
             }
         }
+        assert_eq!(narrow_one(5, 1), 3);
+        assert_eq!(narrow_one(-5, 1), -3);
+        assert_eq!(narrow_one(4, 1), 2);
+        assert_eq!(narrow_one(-6, 2), -2);
+        assert_eq!(narrow_one(1_000_000, 0), SUM_MAX as i16);
+        assert_eq!(narrow_one(-1_000_000, 3), -SUM_MAX as i16);
     }
 }

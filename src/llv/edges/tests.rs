@@ -1,35 +1,9 @@
 //! The edge detector's tests: the fast responses against the plain reference
-//! (`reference.rs`) bit for bit, the kernel, steps and subpixel positions,
-//! peaks, key rounding, and small, flat and invalid images.
+//! (`reference.rs`), the kernel, steps and subpixel positions, peaks, and
+//! small, flat and invalid images.
 
 use super::*;
-use crate::llv::EdgePoint;
 use crate::llv::synth::rng::SplitMix64;
-
-#[test]
-fn key_rounding_is_round_then_clamp() {
-    let plain = |x: f32| x.round().clamp(-FLOAT_KEY_MAX, FLOAT_KEY_MAX) as i16;
-    let mut xs = vec![
-        0.0,
-        -0.0,
-        0.5,
-        -0.5,
-        1.5,
-        -1.5,
-        2.5,
-        0.499_999_97,
-        -0.499_999_97,
-    ];
-    xs.extend([
-        31_999.5, -31_999.5, 32_000.0, 32_000.7, -40_000.0, 1e9, -1e9,
-    ]);
-    // A dense sweep through small values and every half in between.
-    xs.extend((-5000..5000).map(|i| i as f32 * 0.25 + 0.001 * (i % 7) as f32));
-    xs.extend((-2000..2000).map(|i| i as f32 * 16.5));
-    for x in xs {
-        assert_eq!(round_key(x), plain(x), "{x}");
-    }
-}
 
 fn img_from(w: usize, h: usize, f: impl Fn(usize, usize) -> u8) -> GreyImage {
     let mut d = Vec::with_capacity(w * h);
@@ -102,17 +76,13 @@ fn same_bits(a: &[f32], b: &[f32]) -> bool {
             .all(|(u, v)| u.to_bits() == v.to_bits() || (u.is_nan() && v.is_nan()))
 }
 
-/// Same header and the same points, bit for bit, in the same order.
-fn same_points(a: &EdgePoints, b: &EdgePoints) -> bool {
-    let bits = |p: &EdgePoint| (p.x.to_bits(), p.y.to_bits(), p.response.to_bits());
-    (a.dir, a.width, a.height) == (b.dir, b.width, b.height)
-        && a.points.iter().map(bits).eq(b.points.iter().map(bits))
-}
-
+/// The stored sums read as the reference's `f32` values: bit for bit for
+/// `A ≤ 5` (exact sums), within half a stored unit for `A` = 6, 7 (sums
+/// halved or quartered); no response in the same places.
 #[test]
-fn fast_responses_equal_the_reference_bit_for_bit() {
+fn fast_responses_equal_the_reference() {
     let mut rng = SplitMix64::new(0x1234_5678_9ABC_DEF1);
-    let (mut fast, mut slow) = (Response::default(), Response::default());
+    let (mut fast, mut slow) = (Response::default(), Vec::new());
     let (mut fs, mut ss) = (
         ResponseScratch::default(),
         reference::ResponseScratch::default(),
@@ -125,64 +95,25 @@ fn fast_responses_equal_the_reference_bit_for_bit() {
                     response_into(&img, dir, a, &mut fast, &mut fs).unwrap();
                     reference::response_into(&img, dir, a, &mut slow, &mut ss).unwrap();
                     assert_eq!((fast.width, fast.height, fast.dir), (w, h, dir));
-                    assert!(
-                        same_bits(&fast.data, &slow.data),
-                        "{w}x{h} masked={masked} a={a} {dir:?}"
-                    );
-                    // The exact form (reusing the same buffer, as the
-                    // pipeline does) reads the same values.
-                    exact_response_into(&img, dir, a, &mut fast, &mut fs).unwrap();
-                    assert_eq!(fast.is_exact(), a <= 5);
                     assert!(fast.covers(w, h));
                     let values: Vec<f32> = (0..w * h).map(|i| fast.value(i)).collect();
-                    assert!(
-                        same_bits(&values, &slow.data),
-                        "exact: {w}x{h} masked={masked} a={a} {dir:?}"
-                    );
-                }
-            }
-        }
-    }
-}
-
-/// The `f32` response, read as keys, gives the points of the exact
-/// sums: bit for bit at A = 4 (its keys are the sums doubled), within a
-/// hair of subpixel elsewhere (the order of magnitudes is the same).
-#[test]
-fn float_and_exact_responses_give_the_same_points() {
-    let mut rng = SplitMix64::new(0xDEAD_BEEF_0BAD_F00D);
-    let mut rs = ResponseScratch::default();
-    let mut kept = 0;
-    for (w, h) in [(16, 16), (37, 53), (130, 17), (96, 80)] {
-        for masked in [false, true] {
-            let img = random_image(&mut rng, w, h, masked);
-            for a in 3..=5 {
-                for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
-                    let (mut f, mut e) = (Response::default(), Response::default());
-                    response_into(&img, dir, a, &mut f, &mut rs).unwrap();
-                    exact_response_into(&img, dir, a, &mut e, &mut rs).unwrap();
-                    let p = EdgeParams {
-                        half_width: a as u32,
-                        noise_sigmas: 0.0,
-                        per_region: 50,
-                        ..EdgeParams::default()
-                    };
-                    let (pf, pe) = (peaks(&f, &p), peaks(&e, &p));
-                    kept += pe.points.len();
-                    if a == 4 {
-                        assert!(same_points(&pf, &pe), "{w}x{h} {masked} {dir:?}");
+                    if a <= 5 {
+                        assert!(
+                            same_bits(&values, &slow),
+                            "{w}x{h} masked={masked} a={a} {dir:?}"
+                        );
                     } else {
-                        assert_eq!(pf.points.len(), pe.points.len());
-                        for (u, v) in pf.points.iter().zip(&pe.points) {
-                            assert!((u.x - v.x).abs() + (u.y - v.y).abs() < 0.01);
-                            assert!((u.response - v.response).abs() < 5e-3);
+                        for (u, v) in values.iter().zip(&slow) {
+                            assert_eq!(u.is_nan(), v.is_nan());
+                            if !u.is_nan() {
+                                assert!((u - v).abs() <= 0.5 * fast.scale() + 1e-4, "{u} {v}");
+                            }
                         }
                     }
                 }
             }
         }
     }
-    assert!(kept > 1000, "the cases keep points: {kept}");
 }
 
 #[test]
@@ -290,7 +221,7 @@ fn no_panic_on_small_flat_and_invalid_images() {
     img.set_valid_mask(Some(vec![false; 256])).unwrap();
     for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
         let r = response(&img, dir, 7).unwrap();
-        assert!(r.data.iter().all(|v| v.is_nan()));
+        assert!(r.sums().iter().all(|&v| v == NONE));
         assert!(peaks(&r, &p).points.is_empty());
     }
     assert!(response(&GreyImage::filled(15, 40, 0).unwrap(), ScanDir::Vertical, 4).is_err());

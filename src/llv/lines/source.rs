@@ -6,7 +6,7 @@
 //! line (for `EdgeH` that is `(x, y)`; for `EdgeV`, `(y, x)`).
 
 use crate::llv::edges::peaks::subpixel;
-use crate::llv::edges::{Keys, NoiseMap, PeakMap};
+use crate::llv::edges::{NONE, NoiseMap, PeakMap, Response, key};
 use crate::llv::{EdgePoints, ScanDir};
 
 /// A point the tracker may take: its position, signed response (grey
@@ -31,15 +31,21 @@ pub trait Peaks {
     /// then smaller).
     fn strongest(&self, v: usize, u: f64, reach: f64, positive: bool) -> Option<Cand>;
     fn take(&mut self, c: &Cand);
-    fn is_taken(&self, c: &Cand) -> bool;
+    /// Whether the point with this identity is taken.
+    fn is_taken(&self, id: usize) -> bool;
+    /// The point with this identity, to start a track from.
+    fn seed(&self, id: usize) -> Option<Cand>;
 }
 
 /// Peaks read from a response: local maxima of `|E|` along the scan above
 /// `track_sigmas` noise sigmas of their tile (and the floor), as the edge
-/// points are, only with a lower threshold. Nothing is listed in advance:
-/// a scan line is read only where a track looks.
+/// points are, only with a lower threshold: the [`PeakMap`] the edge stage
+/// made in its pass. A search window is one word of it; a point's
+/// position, response and noise sigmas are read from the response only
+/// for the peaks in the window.
 pub struct ResponsePeaks<'a> {
-    k: Keys<'a>,
+    sums: &'a [i16],
+    scale: f32,
     /// Index steps along the scan and from one scan line to the next.
     step_u: usize,
     step_v: usize,
@@ -47,70 +53,75 @@ pub struct ResponsePeaks<'a> {
     nlines: usize,
     /// Per tile, `scale / σ`.
     inv_sigma: Vec<f32>,
-    /// Tile of each column and of each row (image frame).
-    tile_x: Vec<u16>,
-    tile_y: Vec<u32>,
-    /// The unused peaks above the threshold, by polarity: bit `i` for
-    /// image index `i` (found once a call, sixteen pixels at a time; a
-    /// track then reads a bit where it looks, and clears it).
-    pos: Vec<u64>,
-    neg: Vec<u64>,
+    /// The tile of scan position `(u, v)` is `tile_u[u] + tile_v[v]`.
+    tile_u: Vec<u32>,
+    tile_v: Vec<u32>,
+    /// The peaks not yet taken (a copy of the map's, cleared as tracks
+    /// take them), and the map itself.
+    map: PeakMap,
+    orig: &'a PeakMap,
 }
 
 /// Reusable buffers of [`ResponsePeaks`].
 #[derive(Clone, Debug, Default)]
 pub struct ResponseBufs {
     inv_sigma: Vec<f32>,
-    tile_x: Vec<u16>,
-    tile_y: Vec<u32>,
-    pos: Vec<u64>,
-    neg: Vec<u64>,
+    tile_u: Vec<u32>,
+    tile_v: Vec<u32>,
+    map: PeakMap,
 }
 
 impl<'a> ResponsePeaks<'a> {
-    /// Reads the peaks of `k` from `map` (its peaks above the tracking
-    /// threshold, which the caller checked).
-    pub fn new(k: Keys<'a>, noise: &NoiseMap, map: &PeakMap, b: &mut ResponseBufs) -> Self {
-        let (w, h) = (k.width, k.height);
+    /// The peaks of `r` in `map` (made for it: [`PeakMap::fits`]), with the
+    /// noise sigmas of their tile of `noise`.
+    pub fn new(r: &'a Response, noise: &NoiseMap, map: &'a PeakMap, b: &mut ResponseBufs) -> Self {
+        let (w, h) = (r.width, r.height);
         let (nx, ny) = noise.tiles();
         b.inv_sigma.clear();
         for t in 0..nx * ny {
             let s = noise.sigma(t);
-            b.inv_sigma
-                .push(if s > 0.0 { k.scale / s } else { f32::INFINITY });
+            b.inv_sigma.push(if s > 0.0 {
+                r.scale() / s
+            } else {
+                f32::INFINITY
+            });
         }
-        b.tile_x.clear();
-        b.tile_x.extend((0..w).map(|x| noise.tile_of(x, 0) as u16));
-        b.tile_y.clear();
-        b.tile_y.extend((0..h).map(|y| noise.tile_of(0, y) as u32));
-        // Taken points are cleared from these copies.
-        b.pos.clone_from(&map.pos);
-        b.neg.clone_from(&map.neg);
-        let (step_u, step_v, len_u, nlines) = match k.dir {
+        let (cols, rows) = (&mut b.tile_u, &mut b.tile_v);
+        let (cols, rows) = if r.dir == ScanDir::Horizontal {
+            (cols, rows)
+        } else {
+            (rows, cols)
+        };
+        noise.columns_into(w, cols);
+        rows.clear();
+        rows.extend((0..h).map(|y| noise.row_of(y) as u32));
+        b.map.copy_from(map);
+        let (step_u, step_v, len_u, nlines) = match r.dir {
             ScanDir::Horizontal => (1, w, w, h),
             ScanDir::Vertical => (w, 1, h, w),
         };
+        let sums = if r.covers(w, h) { r.sums() } else { &[] };
         ResponsePeaks {
-            k,
+            sums,
+            scale: r.scale(),
             step_u,
             step_v,
             len_u,
-            nlines,
+            nlines: if sums.is_empty() { 0 } else { nlines },
             inv_sigma: std::mem::take(&mut b.inv_sigma),
-            tile_x: std::mem::take(&mut b.tile_x),
-            tile_y: std::mem::take(&mut b.tile_y),
-            pos: std::mem::take(&mut b.pos),
-            neg: std::mem::take(&mut b.neg),
+            tile_u: std::mem::take(&mut b.tile_u),
+            tile_v: std::mem::take(&mut b.tile_v),
+            map: std::mem::take(&mut b.map),
+            orig: map,
         }
     }
 
     /// Gives the buffers back.
     pub fn finish(self, b: &mut ResponseBufs) {
         b.inv_sigma = self.inv_sigma;
-        b.tile_x = self.tile_x;
-        b.tile_y = self.tile_y;
-        b.pos = self.pos;
-        b.neg = self.neg;
+        b.tile_u = self.tile_u;
+        b.tile_v = self.tile_v;
+        b.map = self.map;
     }
 
     /// The image index of scan position `(u, v)`.
@@ -119,53 +130,57 @@ impl<'a> ResponsePeaks<'a> {
         u * self.step_u + v * self.step_v
     }
 
-    /// Whether image index `i` is an unused peak of the polarity above its
-    /// tile's threshold: one bit.
-    #[inline(always)]
-    fn is_peak(&self, i: usize, positive: bool) -> bool {
-        let bits = if positive { &self.pos } else { &self.neg };
-        bits.get(i / 64).is_some_and(|b| b >> (i % 64) & 1 != 0)
-    }
-
     /// The candidate of the peak at `(u, v)`, image index `i`.
     #[inline]
     fn cand(&self, u: usize, v: usize, i: usize) -> Cand {
-        let keys = self.k.keys;
-        let (lo, k0, hi) = (keys[i - self.step_u], keys[i], keys[i + self.step_u]);
-        let (x, y) = if self.step_u == 1 { (u, v) } else { (v, u) };
-        let t = self.tile_y[y] as usize + self.tile_x[x] as usize;
-        let d = subpixel(f32::from(lo), f32::from(k0), f32::from(hi));
+        let mag = |j: usize| f32::from(key(self.sums[j]));
+        let k0 = mag(i);
+        let d = subpixel(mag(i - self.step_u), k0, mag(i + self.step_u));
         Cand {
             // (In `f32`, as edge points are: a track on the points alone
             // then sees the same positions.)
             u: f64::from(u as f32 + d),
             v,
-            response: f32::from(self.k.sums[i]) * self.k.scale,
-            z: f32::from(k0) * self.inv_sigma[t],
+            response: f32::from(self.sums[i]) * self.scale,
+            z: k0 * self.inv_sigma[(self.tile_u[u] + self.tile_v[v]) as usize],
             id: i,
         }
     }
 
-    /// The whole positions `u` whose peak may lie within `r` of `c`
-    /// (peaks are not at a scan line's ends).
-    #[inline]
-    fn span(&self, c: f64, r: f64) -> std::ops::RangeInclusive<usize> {
-        // `⌈c − r − ½⌉ ..= ⌊c + r + ½⌋` by truncation of positive values
-        // (a libm call each on baseline x86-64 otherwise).
-        let (lo, hi) = (c - r - 0.5, c + r + 0.5);
-        let top = self.len_u as f64 - 2.0;
-        if !(hi >= 1.0 && lo <= top) {
-            #[allow(clippy::reversed_empty_ranges)]
-            return 1..=0;
+    /// The candidate of a start at image index `i` (an edge point's pixel).
+    pub fn start(&self, i: usize) -> Option<Cand> {
+        if i >= self.sums.len() || self.sums[i] == NONE {
+            return None;
         }
-        let lo = if lo <= 1.0 {
-            1
+        let (u, v) = self.scan_pos(i);
+        (u >= 1 && u + 1 < self.len_u && v < self.nlines).then(|| self.cand(u, v, i))
+    }
+
+    /// The scan position of image index `i`.
+    #[inline]
+    fn scan_pos(&self, i: usize) -> (usize, usize) {
+        if self.step_u == 1 {
+            (i % self.step_v, i / self.step_v)
         } else {
-            let t = lo as usize;
-            t + usize::from((t as f64) < lo)
-        };
-        let hi = if hi >= top { top as usize } else { hi as usize };
-        lo..=hi
+            (i / self.step_u, i % self.step_u)
+        }
+    }
+
+    /// The whole positions `u` whose peak may lie within `r` of `c`
+    /// (peaks are not at a scan line's ends), as `lo..hi`, at most 64.
+    #[inline]
+    fn span(&self, c: f64, r: f64) -> (usize, usize) {
+        // `⌈c − r − ½⌉ ..= ⌊c + r + ½⌋`, clamped to `1..len_u − 1`; in
+        // `i64` (saturating casts of values far inside its range).
+        let top = self.len_u as i64 - 1;
+        let (lo, hi) = (c - r - 0.5, c + r + 0.5);
+        if !(hi >= 1.0 && lo < top as f64) {
+            return (1, 1);
+        }
+        let l = lo as i64;
+        let l = (l + i64::from((l as f64) < lo)).max(1);
+        let h = (hi as i64 + 1).min(top).min(l + 64);
+        (l as usize, h.max(l) as usize)
     }
 }
 
@@ -178,15 +193,16 @@ impl Peaks for ResponsePeaks<'_> {
         if v >= self.nlines {
             return None;
         }
+        let (lo, hi) = self.span(pred, sw);
+        let mut bits = self.map.window(positive, v, lo, hi);
         let mut best: Option<(f64, Cand)> = None;
-        for u in self.span(pred, sw) {
-            let i = self.index(u, v);
-            if self.is_peak(i, positive) {
-                let c = self.cand(u, v, i);
-                let d = (c.u - pred).abs();
-                if d <= sw && best.is_none_or(|(bd, _)| d < bd) {
-                    best = Some((d, c));
-                }
+        while bits != 0 {
+            let u = lo + bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let c = self.cand(u, v, self.index(u, v));
+            let d = (c.u - pred).abs();
+            if d <= sw && best.is_none_or(|(bd, _)| d < bd) {
+                best = Some((d, c));
             }
         }
         best.map(|(_, c)| c)
@@ -196,34 +212,36 @@ impl Peaks for ResponsePeaks<'_> {
         if v >= self.nlines {
             return None;
         }
+        let (lo, hi) = self.span(u, reach);
+        let mut bits = self.map.window(positive, v, lo, hi);
         let mut best: Option<(f32, f64, Cand)> = None;
-        for x in self.span(u, reach) {
-            let i = self.index(x, v);
-            if self.is_peak(i, positive) {
-                let c = self.cand(x, v, i);
-                let d = (c.u - u).abs();
-                let m = c.response.abs();
-                if d <= reach && best.is_none_or(|(bm, bd, _)| m > bm || (m == bm && d < bd)) {
-                    best = Some((m, d, c));
-                }
+        while bits != 0 {
+            let x = lo + bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let c = self.cand(x, v, self.index(x, v));
+            let d = (c.u - u).abs();
+            let m = c.response.abs();
+            if d <= reach && best.is_none_or(|(bm, bd, _)| m > bm || (m == bm && d < bd)) {
+                best = Some((m, d, c));
             }
         }
         best.map(|(_, _, c)| c)
     }
 
     fn take(&mut self, c: &Cand) {
-        let i = c.id;
-        for bits in [&mut self.pos, &mut self.neg] {
-            if let Some(b) = bits.get_mut(i / 64) {
-                *b &= !(1 << (i % 64));
-            }
-        }
+        let (u, v) = self.scan_pos(c.id);
+        self.map.clear(u, v);
     }
 
-    fn is_taken(&self, c: &Cand) -> bool {
-        let i = c.id;
-        let set = |bits: &[u64]| bits.get(i / 64).is_some_and(|b| b >> (i % 64) & 1 != 0);
-        !(set(&self.pos) || set(&self.neg))
+    fn is_taken(&self, i: usize) -> bool {
+        // Taken: a peak of the map that a track cleared (a start below
+        // the map's threshold is never taken by a track).
+        let (u, v) = self.scan_pos(i);
+        self.orig.is_set(u, v) && !self.map.is_set(u, v)
+    }
+
+    fn seed(&self, i: usize) -> Option<Cand> {
+        self.start(i)
     }
 }
 
@@ -397,7 +415,11 @@ impl Peaks for PointPeaks<'_> {
         self.used[c.id] = true;
     }
 
-    fn is_taken(&self, c: &Cand) -> bool {
-        self.used[c.id]
+    fn is_taken(&self, id: usize) -> bool {
+        self.used.get(id).copied().unwrap_or(true)
+    }
+
+    fn seed(&self, id: usize) -> Option<Cand> {
+        (id < self.pts.len()).then(|| self.point(id))
     }
 }

@@ -1,3 +1,4 @@
+use super::super::edges::{PeakScratch, Starts};
 use super::*;
 use crate::llv::EdgePoint;
 use source::{PointBufs, ResponseBufs};
@@ -73,8 +74,14 @@ fn gaps_short_lines_and_scan_parallel_lines() {
 fn scene_parts(
     dir: ScanDir,
     noise: f64,
-) -> (crate::llv::edges::Response, NoiseMap, PeakMap, EdgePoints) {
-    use crate::llv::edges::{ResponseScratch, detect_into, exact_response_into};
+) -> (
+    crate::llv::edges::Response,
+    NoiseMap,
+    PeakMap,
+    EdgePoints,
+    Starts,
+) {
+    use crate::llv::edges::{ResponseScratch, detect_into, response_into};
     use crate::llv::synth;
     let (scene, cam, lights) = synth::test_scenes(1, 160, 160, 5).remove(0);
     let o = synth::RenderOptions {
@@ -84,12 +91,13 @@ fn scene_parts(
     };
     let img = synth::render(&scene, &cam, &lights, &o);
     let mut r = crate::llv::edges::Response::default();
-    exact_response_into(&img, dir, 4, &mut r, &mut ResponseScratch::default()).unwrap();
+    response_into(&img, dir, 4, &mut r, &mut ResponseScratch::default()).unwrap();
     let p = crate::llv::Params::default();
-    let (mut nm, mut map, mut seeds) = (
+    let (mut nm, mut map, mut seeds, mut starts) = (
         NoiseMap::default(),
         PeakMap::default(),
         EdgePoints::default(),
+        Starts::new(),
     );
     let mut ps = PeakScratch::default();
     detect_into(
@@ -99,9 +107,10 @@ fn scene_parts(
         &mut nm,
         &mut map,
         &mut seeds,
+        &mut starts,
         &mut ps,
     );
-    (r, nm, map, seeds)
+    (r, nm, map, seeds, starts)
 }
 
 /// The plain reference of the pipeline's extractor: every peak of the
@@ -111,22 +120,26 @@ fn scene_parts(
 /// tracks look.
 #[test]
 fn reading_peaks_where_tracks_look_equals_listing_them_all() {
-    use crate::llv::edges::KeyBuf;
     let p = LineParams::default();
     let mut kept = 0;
     for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
         for noise in [2.0, 8.0] {
-            let (r, nm, map, seeds) = scene_parts(dir, noise);
+            let (r, nm, map, seeds, starts) = scene_parts(dir, noise);
             let mut fast = Vec::new();
             let mut s = LineScratch::default();
-            track_into(&r, &nm, &map, &seeds, 2.0, 4, &p, &mut fast, &mut s);
+            track_into(
+                &r, &nm, &map, &seeds, &starts, 2.0, 4, &p, &mut fast, &mut s,
+            );
+            // The same from the points alone (no starts given): each
+            // point's pixel found again.
+            let mut again = Vec::new();
+            track_into(&r, &nm, &map, &seeds, &[], 2.0, 4, &p, &mut again, &mut s);
+            assert_eq!(fast, again, "{dir:?} σ {noise}");
             // Every peak of the map as a point, with the values the
             // response source gives it.
-            let mut kb = KeyBuf::default();
-            let k = r.keys(&mut kb);
             let mut bufs = ResponseBufs::default();
-            let src = ResponsePeaks::new(k, &nm, &map, &mut bufs);
-            let (w, h) = (k.width, k.height);
+            let src = ResponsePeaks::new(&r, &nm, &map, &mut bufs);
+            let (w, h) = (r.width, r.height);
             let mut all = EdgePoints {
                 dir: Some(dir),
                 width: w,
@@ -184,7 +197,7 @@ fn reading_peaks_where_tracks_look_equals_listing_them_all() {
                 f.z = zs[j].1;
             }
             let mut src = pb.peaks();
-            // The starts: the edge points, as point indices.
+            // The starts: the edge points, as point indices, in scan order.
             let mut starts = Vec::new();
             for e in &seeds.points {
                 let (u, v) = if vertical { (e.y, e.x) } else { (e.x, e.y) };
@@ -195,6 +208,7 @@ fn reading_peaks_where_tracks_look_equals_listing_them_all() {
             }
             starts.sort_by(|a, b| a.v.cmp(&b.v).then(a.u.total_cmp(&b.u)));
             starts.dedup_by(|a, b| a.id == b.id);
+            let starts: Vec<u32> = starts.iter().map(|c| c.id as u32).collect();
             let nfa = nfa::Nfa::new(w, h, 4, p.search_width, p.track_sigmas);
             let mut plain = Vec::new();
             let mut t = Tracks::default();

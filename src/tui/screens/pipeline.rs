@@ -115,14 +115,12 @@ fn combined(o: &crate::llv::pipeline::StageOutputs) -> Option<GreyImage> {
     if h.width == 0 || h.width != v.width || h.height != v.height {
         return None;
     }
-    let mag: Vec<f32> = h
-        .data
-        .iter()
-        .zip(&v.data)
-        .map(|(a, b)| {
+    let mag: Vec<f32> = (0..h.width * h.height)
+        .map(|i| {
+            let (a, b) = (h.value(i), v.value(i));
             let (a, b) = (
-                if a.is_finite() { *a } else { 0.0 },
-                if b.is_finite() { *b } else { 0.0 },
+                if a.is_finite() { a } else { 0.0 },
+                if b.is_finite() { b } else { 0.0 },
             );
             (a * a + b * b).sqrt()
         })
