@@ -256,8 +256,15 @@ impl<P: Link> VsgClient<P> {
     /// rest must follow without a gap.
     fn read_line(&mut self) -> Result<Vec<u8>, ReadFail> {
         let deadline = Instant::now() + self.cfg.timeout;
+        // `rx[..seen]` holds no line end: after a read only the new bytes
+        // are looked at.
+        let mut seen = 0;
         loop {
-            if let Some(i) = self.rx.iter().position(|&b| b == b'\n') {
+            let found = self
+                .rx
+                .get(seen..)
+                .and_then(|b| b.iter().position(|&b| b == b'\n'));
+            if let Some(i) = found.map(|i| seen + i) {
                 let mut line: Vec<u8> = self.rx.drain(..=i).collect();
                 line.pop();
                 if line.last() == Some(&b'\r') {
@@ -273,6 +280,7 @@ impl<P: Link> VsgClient<P> {
                     self.rx.len()
                 )));
             }
+            seen = self.rx.len();
             let wait = if self.rx.is_empty() {
                 deadline.saturating_duration_since(Instant::now())
             } else {

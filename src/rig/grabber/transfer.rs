@@ -26,6 +26,7 @@
 //! inter-byte wait of a failure, each weighed by how likely a block of that
 //! size comes through whole.
 
+use std::cell::Cell;
 use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
@@ -79,6 +80,9 @@ pub(super) struct Sizer {
     /// decayed over [`WINDOW`] bytes asked for.
     whole: [f64; 33],
     failed: [f64; 33],
+    /// [`Sizer::rate`] since the last [`Sizer::record`] (it is asked for
+    /// every READ).
+    rate: Cell<Option<f64>>,
 }
 
 /// The size class of a block: ⌈log2(len)⌉.
@@ -92,10 +96,12 @@ impl Sizer {
             full: full.max(1),
             whole: [0.0; 33],
             failed: [0.0; 33],
+            rate: Cell::new(None),
         }
     }
 
     pub fn record(&mut self, len: u32, ok: bool) {
+        self.rate.set(None);
         let d = (-f64::from(len) / WINDOW).exp();
         for (w, f) in self.whole.iter_mut().zip(self.failed.iter_mut()) {
             *w *= d;
@@ -116,18 +122,35 @@ impl Sizer {
     /// given the blocks of each size that came whole and that failed (a
     /// search over p from 10⁻⁸ to 0.5, 4 steps a decade).
     pub fn rate(&self) -> f64 {
+        if let Some(r) = self.rate.get() {
+            return r;
+        }
+        let r = self.estimate();
+        self.rate.set(Some(r));
+        r
+    }
+
+    fn estimate(&self) -> f64 {
         if self.failed.iter().all(|&f| f <= 1e-9) {
             return 0.0;
         }
+        // Only the sizes that were asked for add to the likelihood (an
+        // untouched size adds exactly 0).
+        let seen: Vec<(f64, f64, f64)> = (0..33)
+            .filter_map(|k| {
+                let b = f64::from(1u32 << k.min(31));
+                let (w, f) = (*self.whole.get(k)?, *self.failed.get(k)?);
+                (w != 0.0 || f != 0.0).then_some((b, w, f))
+            })
+            .collect();
         let loglik = |p: f64| {
             let mut l = 0.0;
-            for k in 0..33 {
-                let b = f64::from(1u32 << k.min(31));
-                let (w, f) = (
-                    self.whole.get(k).copied().unwrap_or(0.0),
-                    self.failed.get(k).copied().unwrap_or(0.0),
-                );
-                l += -p * b * w + f * (1.0 - (-p * b).exp()).max(1e-300).ln();
+            for &(b, w, f) in &seen {
+                let mut term = -p * b * w;
+                if f != 0.0 {
+                    term += f * (1.0 - (-p * b).exp()).max(1e-300).ln();
+                }
+                l += term;
             }
             l
         };
@@ -231,33 +254,48 @@ impl<P: Link> VsgClient<P> {
         pending: &VecDeque<(u32, u32)>,
         since: Instant,
     ) -> Result<Event, RigError> {
+        // `rx[..seen]` holds no line end. A reply line ends at one and never
+        // spans one (its text is printable), so what comes up to the last
+        // line end when no reply is found is junk for good: it is dropped,
+        // and after a read only the new bytes are looked at for a line end.
+        // (Looking through all of `rx` again after each read made a stream
+        // of junk cost the square of its length.)
+        let mut seen = 0;
         loop {
-            if let Some((_, end, reply)) = find_reply(&self.rx) {
-                self.rx.drain(..end);
-                match reply {
-                    Reply::Data { off, len, crc } => {
-                        let Some(index) = pending.iter().position(|&p| p == (off, len)) else {
-                            // A late answer: its payload is skipped as junk.
-                            continue;
-                        };
-                        return Ok(Event::Header { index, crc });
+            let line_end = self.rx.get(seen..).is_some_and(|b| b.contains(&b'\n'));
+            if line_end {
+                if let Some((_, end, reply)) = find_reply(&self.rx) {
+                    self.rx.drain(..end);
+                    seen = 0;
+                    match reply {
+                        Reply::Data { off, len, crc } => {
+                            let Some(index) = pending.iter().position(|&p| p == (off, len)) else {
+                                // A late answer: its payload is skipped as junk.
+                                continue;
+                            };
+                            return Ok(Event::Header { index, crc });
+                        }
+                        Reply::Err {
+                            code: ErrCode::Checksum,
+                            ..
+                        } => return Ok(Event::DeviceChecksum),
+                        r @ Reply::Err { .. } => {
+                            let (off, len) = pending.front().copied().unwrap_or_default();
+                            return self.device_err(&Command::Read { off, len }, r);
+                        }
+                        // A late OK to an earlier command.
+                        Reply::Ok(_) => continue,
                     }
-                    Reply::Err {
-                        code: ErrCode::Checksum,
-                        ..
-                    } => return Ok(Event::DeviceChecksum),
-                    r @ Reply::Err { .. } => {
-                        let (off, len) = pending.front().copied().unwrap_or_default();
-                        return self.device_err(&Command::Read { off, len }, r);
-                    }
-                    // A late OK to an earlier command.
-                    Reply::Ok(_) => continue,
+                }
+                if let Some(last) = self.rx.iter().rposition(|&b| b == b'\n') {
+                    self.rx.drain(..=last);
                 }
             }
             if self.rx.len() > MAX_SCAN {
                 let cut = self.rx.len() - 256;
                 self.rx.drain(..cut);
             }
+            seen = self.rx.len();
             // Once anything came after the requests went out, silence
             // means loss; before, the reply timeout applies.
             let heard = self.last_rx.is_some_and(|t| t >= since);
