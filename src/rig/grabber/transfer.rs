@@ -30,7 +30,7 @@ use std::cell::Cell;
 use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
-use super::{ReadFail, VsgClient};
+use super::{FrameGrabber, ReadFail, VsgClient};
 use crate::llv::GreyImage;
 use crate::rig::protocol::{Command, ErrCode, FrameInfo, Reply, crc32, find_reply};
 use crate::rig::{Link, RigError};
@@ -330,6 +330,68 @@ impl<P: Link> VsgClient<P> {
         // but its first byte is looked through again.
         self.rx.drain(..1);
         Ok(Payload::Bad)
+    }
+
+    /// The frozen frame, got back when the grabber loses it on the way.
+    ///
+    /// A grabber that is reset (a power dip, its watchdog) forgets its
+    /// frame and its camera, and answers the READs still to come `NOFRAME`.
+    /// The operator asked for a frame of one camera, under the lights the
+    /// cell set: the transfer freezes again by itself ([`Self::recover_frame`])
+    /// when that is what it gets back, and only then:
+    /// - this client froze the frame itself, from a camera it had selected
+    ///   (not a LOADed image, which FREEZE cannot make again, nor a frame
+    ///   someone else froze, whose camera is unknown);
+    /// - STATUS says the grabber holds no frame: it lost it. A frame with
+    ///   another CRC there was frozen by someone else (a second console, the
+    ///   front panel) and is not replaced. The same CRC there means the
+    ///   NOFRAME answered a READ of an earlier transfer: the frame is read
+    ///   again as it is;
+    /// - that camera is selected again before FREEZE (a reset grabber is
+    ///   back on camera 1), and the new frame must have the old one's size.
+    ///
+    /// The lights are not the grabber's: a reset leaves the relay board as
+    /// the cell switched it, so the new frame is taken under the same
+    /// lighting. The new frame is a new exposure (its CRC is the new
+    /// FREEZE's, in [`FrameGrabber::frame`]), just as a retake by hand would
+    /// be. At most [`super::FRAME_RECOVERIES`] times per transfer; then, or
+    /// when a condition fails, the operator is told to freeze again.
+    pub(super) fn read_frame_recovering(
+        &mut self,
+        mut frame: FrameInfo,
+        progress: &mut dyn FnMut(usize, usize) -> bool,
+    ) -> Result<GreyImage, RigError> {
+        let mut recovered = 0;
+        loop {
+            match self.read_frame(frame, progress) {
+                Err(e @ RigError::NoFrame { .. }) if recovered < super::FRAME_RECOVERIES => {
+                    recovered += 1;
+                    match self.recover_frame(frame)? {
+                        Some(f) => frame = f,
+                        None => return Err(e),
+                    }
+                }
+                r => return r,
+            }
+        }
+    }
+
+    /// After `NOFRAME` in a transfer of `lost`: the frame to read now, or
+    /// `None` when the conditions of [`Self::read_frame_recovering`] fail.
+    fn recover_frame(&mut self, lost: FrameInfo) -> Result<Option<FrameInfo>, RigError> {
+        let Some(camera) = self.frozen_from.filter(|_| self.frame == Some(lost)) else {
+            return Ok(None);
+        };
+        match self.status()?.frame {
+            Some(crc) if crc == lost.crc => Ok(Some(lost)),
+            Some(_) => Ok(None),
+            None => {
+                self.select_camera(camera)?;
+                let f = self.freeze()?;
+                self.stats.refreezes += 1;
+                Ok(((f.width, f.height) == (lost.width, lost.height)).then_some(f))
+            }
+        }
     }
 
     /// The whole frozen frame, block by block, [`DEPTH`] READs at a time.
