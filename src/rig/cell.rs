@@ -229,9 +229,10 @@ impl Cell {
         names
     }
 
-    /// Selects `camera`, switches to `letter`, freezes and transfers.
-    /// A grabber that lost its frame on the way (a reset) is asked once
-    /// more; the frame returned has passed every CRC check.
+    /// Selects `camera`, switches to `letter`, freezes and transfers. A
+    /// grabber that loses its frame on the way (a reset) is asked for it
+    /// again by its driver (`VsgClient`'s transfer says when); the frame
+    /// returned has passed every CRC check, against the FREEZE that made it.
     pub fn capture(
         &mut self,
         camera: u32,
@@ -240,25 +241,17 @@ impl Cell {
     ) -> Result<Capture, RigError> {
         let start = Instant::now();
         self.switch_lighting(letter)?;
-        let mut again = true;
-        loop {
-            self.grabber.select_camera(camera)?;
-            let frame = self.grabber.freeze()?;
-            match self.grabber.transfer(progress) {
-                Ok(image) => {
-                    return Ok(Capture {
-                        image,
-                        frame,
-                        camera,
-                        lighting: letter,
-                        lights_on: self.lights_on(),
-                        elapsed: start.elapsed(),
-                    });
-                }
-                Err(RigError::NoFrame { .. }) if again => again = false,
-                Err(e) => return Err(e),
-            }
-        }
+        self.grabber.select_camera(camera)?;
+        let frozen = self.grabber.freeze()?;
+        let image = self.grabber.transfer(progress)?;
+        Ok(Capture {
+            image,
+            frame: self.grabber.frame().unwrap_or(frozen),
+            camera,
+            lighting: letter,
+            lights_on: self.lights_on(),
+            elapsed: start.elapsed(),
+        })
     }
 
     /// After the grabber vanished or stopped answering: plug the simulated
@@ -333,6 +326,9 @@ impl FrameGrabber for Unplugged {
     }
     fn status(&mut self) -> Result<crate::rig::GrabberStatus, RigError> {
         Err(self.err())
+    }
+    fn frame(&self) -> Option<FrameInfo> {
+        None
     }
     fn port_name(&self) -> &str {
         &self.port

@@ -39,6 +39,11 @@ pub trait FrameGrabber: Send {
         progress: &mut dyn FnMut(usize, usize) -> bool,
     ) -> Result<GreyImage, RigError>;
     fn status(&mut self) -> Result<GrabberStatus, RigError>;
+    /// The frame in the grabber's memory as the driver knows it: what the
+    /// last FREEZE (or LOAD) reported, or the FREEZE a transfer made itself
+    /// after a reset ([`VsgClient`]'s `transfer`). A transferred image has
+    /// this frame's size and CRC.
+    fn frame(&self) -> Option<FrameInfo>;
     /// The device path, for messages.
     fn port_name(&self) -> &str;
     /// Reopens the port after the device came back.
@@ -63,6 +68,8 @@ pub struct WireStats {
     pub resyncs: u64,
     /// Times a block's answer stopped and the inter-byte timeout was waited.
     pub stalls: u64,
+    /// Frames frozen again by a transfer after the grabber lost its frame.
+    pub refreezes: u64,
 }
 
 impl WireStats {
@@ -111,6 +118,10 @@ const GARBLED_TRIES: u32 = 12;
 const MAX_STALE: u32 = 8;
 /// The largest frame a reply may announce (guards allocations).
 const MAX_FRAME: usize = 1 << 28;
+/// Times one transfer gets its frame back after the grabber answered
+/// NOFRAME ([`VsgClient::recover_frame`]): a grabber that loses the frame
+/// more often than this within one transfer is failing.
+const FRAME_RECOVERIES: u32 = 2;
 
 /// Why reading a reply failed, before it becomes a [`RigError`].
 enum ReadFail {
@@ -141,6 +152,14 @@ pub struct VsgClient<P: Link> {
     untracked: bool,
     info: Option<GrabberInfo>,
     frame: Option<FrameInfo>,
+    /// The camera this client last selected (CAMERA or LIVE answered OK);
+    /// `None` while the grabber's own choice is unknown (after connecting
+    /// or INIT).
+    camera: Option<u32>,
+    /// The camera `frame` was digitised from by this client's own FREEZE;
+    /// `None` for a frame it did not freeze itself (a LOAD, or one frozen
+    /// by someone else) or froze with the camera unknown.
+    frozen_from: Option<u32>,
     /// Received, not yet consumed bytes.
     rx: Vec<u8>,
     buf: Vec<u8>,
@@ -177,6 +196,8 @@ impl<P: Link> VsgClient<P> {
             untracked: false,
             info: None,
             frame: None,
+            camera: None,
+            frozen_from: None,
             rx: Vec::new(),
             buf: vec![0; 65536],
             stats: WireStats::default(),
@@ -186,6 +207,7 @@ impl<P: Link> VsgClient<P> {
 
     /// Discards whatever the line holds (garbage on connect), then HELLO.
     pub fn connect(&mut self) -> Result<GrabberInfo, RigError> {
+        self.camera = None;
         self.resync()?;
         self.hello()
     }
@@ -193,11 +215,6 @@ impl<P: Link> VsgClient<P> {
     /// The grabber as HELLO described it.
     pub fn info(&self) -> Option<&GrabberInfo> {
         self.info.as_ref()
-    }
-
-    /// The frame the last FREEZE reported.
-    pub fn frame(&self) -> Option<FrameInfo> {
-        self.frame
     }
 
     /// The stream (tests inspect what was sent).
@@ -256,8 +273,15 @@ impl<P: Link> VsgClient<P> {
     /// rest must follow without a gap.
     fn read_line(&mut self) -> Result<Vec<u8>, ReadFail> {
         let deadline = Instant::now() + self.cfg.timeout;
+        // `rx[..seen]` holds no line end: after a read only the new bytes
+        // are looked at.
+        let mut seen = 0;
         loop {
-            if let Some(i) = self.rx.iter().position(|&b| b == b'\n') {
+            let found = self
+                .rx
+                .get(seen..)
+                .and_then(|b| b.iter().position(|&b| b == b'\n'));
+            if let Some(i) = found.map(|i| seen + i) {
                 let mut line: Vec<u8> = self.rx.drain(..=i).collect();
                 line.pop();
                 if line.last() == Some(&b'\r') {
@@ -273,6 +297,7 @@ impl<P: Link> VsgClient<P> {
                     self.rx.len()
                 )));
             }
+            seen = self.rx.len();
             let wait = if self.rx.is_empty() {
                 deadline.saturating_duration_since(Instant::now())
             } else {
@@ -414,6 +439,21 @@ impl<P: Link> VsgClient<P> {
                         code: ErrCode::Checksum,
                         text,
                     }) => break ReadFail::Garbage(format!("device saw a bad checksum {text}")),
+                    // Only a READ is answered NOFRAME (hardware.md §1): this
+                    // answers one given up on earlier (a transfer stopped by
+                    // the first of several, its re-sync outwaited by the
+                    // rest on a busy machine).
+                    Ok(Reply::Err {
+                        code: ErrCode::NoFrame,
+                        ..
+                    }) if !matches!(cmd, Command::Read { .. }) => {
+                        stale += 1;
+                        if stale > MAX_STALE {
+                            break ReadFail::Garbage(format!(
+                                "{stale} replies that do not fit `{cmd}`"
+                            ));
+                        }
+                    }
                     Ok(r @ Reply::Err { .. }) => return self.device_err(&cmd, r),
                     Ok(r) if accept(&r) => return Ok(r),
                     // A late OK to an earlier command: keep listening.
@@ -505,15 +545,21 @@ impl<P: Link> FrameGrabber for VsgClient<P> {
 
     fn init(&mut self) -> Result<(), RigError> {
         self.frame = None;
+        self.frozen_from = None;
+        self.camera = None;
         self.ok_plain(Command::Init)
     }
 
     fn live(&mut self, cam: u32) -> Result<(), RigError> {
-        self.ok_plain(Command::Live(cam))
+        self.camera = None;
+        self.ok_plain(Command::Live(cam))?;
+        self.camera = Some(cam);
+        Ok(())
     }
 
     fn freeze(&mut self) -> Result<FrameInfo, RigError> {
         self.frame = None;
+        self.frozen_from = None;
         let r = self.exchange(
             Command::Freeze,
             |r| matches!(r, Reply::Ok(s) if FrameInfo::parse(s).is_some()),
@@ -524,14 +570,19 @@ impl<P: Link> FrameGrabber for VsgClient<P> {
         }
         .ok_or_else(|| self.garbled("FREEZE", &r))?;
         self.frame = Some(f);
+        self.frozen_from = self.camera;
         Ok(f)
     }
 
     fn select_camera(&mut self, cam: u32) -> Result<(), RigError> {
-        self.ok_plain(Command::Camera(cam))
+        self.camera = None;
+        self.ok_plain(Command::Camera(cam))?;
+        self.camera = Some(cam);
+        Ok(())
     }
 
     fn load(&mut self, img: &GreyImage) -> Result<(), RigError> {
+        self.frozen_from = None;
         let (w, h) = img.size();
         let data = img.data();
         let crc = crc32(data);
@@ -611,7 +662,7 @@ impl<P: Link> FrameGrabber for VsgClient<P> {
                 }
             }
         };
-        self.read_frame(frame, progress)
+        self.read_frame_recovering(frame, progress)
     }
 
     fn status(&mut self) -> Result<GrabberStatus, RigError> {
@@ -624,6 +675,10 @@ impl<P: Link> FrameGrabber for VsgClient<P> {
             _ => None,
         }
         .ok_or_else(|| self.garbled("STATUS", &r))
+    }
+
+    fn frame(&self) -> Option<FrameInfo> {
+        self.frame
     }
 
     fn port_name(&self) -> &str {
@@ -642,6 +697,7 @@ impl<P: Link> FrameGrabber for VsgClient<P> {
         self.port = Some(reopen()?);
         self.rx.clear();
         self.frame = None;
+        self.frozen_from = None;
         self.connect().map(|_| ())
     }
 

@@ -107,7 +107,9 @@ impl<L: Link> Link for Tap<L> {
 /// released, like a silent device.
 pub struct Replay {
     answers: std::collections::VecDeque<Vec<u8>>,
-    readable: std::collections::VecDeque<u8>,
+    /// Released bytes; those before `read` have been read.
+    readable: Vec<u8>,
+    read: usize,
     lines: Lines,
     chunk: usize,
 }
@@ -117,10 +119,11 @@ impl Replay {
     /// whose commands end with `eol`.
     pub fn new(recording: &[u8], eol: u8, chunk: usize) -> Replay {
         let mut answers = split(recording).into_iter();
-        let readable = answers.next().unwrap_or_default().into();
+        let readable = answers.next().unwrap_or_default();
         Replay {
             answers: answers.collect(),
             readable,
+            read: 0,
             lines: Lines { eol, open: false },
             chunk: chunk.max(1),
         }
@@ -141,13 +144,15 @@ fn split(recording: &[u8]) -> Vec<Vec<u8>> {
 
 impl Read for Replay {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        if self.readable.is_empty() {
+        let left = self.readable.get(self.read..).unwrap_or_default();
+        if left.is_empty() {
             return Err(ErrorKind::TimedOut.into());
         }
-        let n = self.readable.len().min(self.chunk).min(buf.len());
-        for (dst, src) in buf.iter_mut().zip(self.readable.drain(..n)) {
-            *dst = src;
+        let n = left.len().min(self.chunk).min(buf.len());
+        if let (Some(dst), Some(src)) = (buf.get_mut(..n), left.get(..n)) {
+            dst.copy_from_slice(src);
         }
+        self.read += n;
         Ok(n)
     }
 }
@@ -156,6 +161,8 @@ impl Write for Replay {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
         for _ in 0..self.lines.feed(buf) {
             if let Some(a) = self.answers.pop_front() {
+                self.readable.drain(..self.read);
+                self.read = 0;
                 self.readable.extend(a);
             }
         }

@@ -210,6 +210,30 @@ fn a_reset_mid_transfer_is_recovered_by_freezing_again() {
     assert_good("reset", &r, &want);
 }
 
+/// The driver itself, without the cell's help: a reset strikes after the
+/// first block, the grabber forgets its frame and falls back to camera 1;
+/// the transfer freezes again from camera 2, so the frame is camera 2's.
+#[test]
+fn the_driver_freezes_again_from_the_same_camera_after_a_reset() {
+    let want = reference();
+    let got = within(Duration::from_secs(60), || {
+        let faults = Faults::parse("reset").expect("fault spec");
+        let mut cell = Cell::open_with_faults(&profile(), faults).expect("open");
+        cell.switch_lighting('a').expect("lights");
+        let g = &mut cell.grabber;
+        g.select_camera(2).expect("camera");
+        let first = g.freeze().expect("freeze");
+        let r = g.transfer(&mut |_, _| true);
+        (r, first, g.frame(), g.wire_stats())
+    });
+    let (r, first, frame, stats) = got;
+    let img = r.unwrap_or_else(|e| panic!("reset: {e}"));
+    assert!(img == want, "the frame differs from camera 2's");
+    assert_eq!(stats.refreezes, 1);
+    // Noise is off: the new exposure is the same picture.
+    assert_eq!(frame, Some(first));
+}
+
 #[test]
 fn a_hopeless_line_ends_in_a_clear_error_not_a_hang() {
     let (r, took) = try_faulty("corrupt=0.01,seed=9");

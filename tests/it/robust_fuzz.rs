@@ -26,7 +26,7 @@ use vss::rig::protocol::{
     numato_reply,
 };
 use vss::rig::replay::{Replay, SEPARATOR, Tap, recording};
-use vss::rig::sim::{SimCell, SimOptions, cell_profile};
+use vss::rig::sim::{Faults, SimCell, SimOptions, cell_profile};
 use vss::session::manifest::Manifest;
 
 /// The image kinds of the `image` target, picked by a seed's first byte.
@@ -93,13 +93,16 @@ fn taken(target: &str, seed: &[u8]) -> Result<(), String> {
         "profile" => Profile::from_toml(text()?, p).map(drop).map_err(|x| e(&x)),
         "vsg_line" => decode_line(line_of(seed)).map(drop).map_err(|x| e(&x)),
         "vsg_client" => {
-            let (&chunk, bytes) = seed.split_first().ok_or("empty")?;
-            let feed = Replay::new(bytes, b'\n', usize::from(chunk % 64) + 1);
+            let (&head, bytes) = seed.split_first().ok_or("empty")?;
+            let feed = Replay::new(bytes, b'\n', usize::from(head % 64) + 1);
             let mut c = VsgClient::new(feed, "/dev/seed", client_config());
             c.connect().map_err(|x| e(&x))?;
-            let f = c.freeze().map_err(|x| e(&x))?;
+            if head & 0x40 != 0 {
+                c.select_camera(2).map_err(|x| e(&x))?;
+            }
+            c.freeze().map_err(|x| e(&x))?;
             let img = c.transfer(&mut |_, _| true).map_err(|x| e(&x))?;
-            if crc32(img.data()) == f.crc {
+            if c.frame().is_some_and(|f| f.crc == crc32(img.data())) {
                 Ok(())
             } else {
                 Err("frame CRC".into())
@@ -292,7 +295,7 @@ fn write_fuzz_seeds() {
     let (tap, heard) = Tap::new(port, b'\n');
     let mut cfg = client_config();
     cfg.timeout = Duration::from_millis(500);
-    let mut c = VsgClient::new(tap, sim.grabber_path(), cfg);
+    let mut c = VsgClient::new(tap, sim.grabber_path(), cfg.clone());
     c.connect().expect("connect");
     let f = c.freeze().expect("freeze");
     let img = c.transfer(&mut |_, _| true).expect("transfer");
@@ -308,6 +311,28 @@ fn write_fuzz_seeds() {
         bytes.extend_from_slice(&recording(&answers));
         taken("vsg_client", &bytes).expect("the recording plays back");
         seed("vsg_client", &format!("frame-{}", chunk + 1), &bytes);
+    }
+    // Camera 2 selected (bit 6 of the first byte), and the grabber reset
+    // after the first block: the client freezes again by itself.
+    let mut o = SimOptions::new(32, 24);
+    o.faults = Faults::parse("reset").expect("faults");
+    let reset = SimCell::start(o).expect("sim");
+    let port =
+        open_serial(reset.grabber_path(), 921_600, Duration::from_millis(200)).expect("open");
+    let (tap, heard) = Tap::new(port, b'\n');
+    let mut c = VsgClient::new(tap, reset.grabber_path(), cfg.clone());
+    c.connect().expect("connect");
+    c.select_camera(2).expect("camera");
+    c.freeze().expect("freeze");
+    c.transfer(&mut |_, _| true)
+        .expect("transfer after a reset");
+    assert_eq!(c.wire_stats().refreezes, 1);
+    let answers = heard.lock().expect("heard").clone();
+    for chunk in [63u8, 6, 0] {
+        let mut bytes = vec![0x40 | chunk];
+        bytes.extend_from_slice(&recording(&answers));
+        taken("vsg_client", &bytes).expect("the recording plays back");
+        seed("vsg_client", &format!("reset-{}", chunk + 1), &bytes);
     }
     let mut rest = &stream[..];
     let mut n = 0;

@@ -268,3 +268,123 @@ fn a_noisy_line_shrinks_the_block_and_the_budget_ends_it() {
     // No re-sync (an empty line) between the READs: the next one goes at once.
     assert!(!sent.trim_end().contains("\r\n\r\n"), "{sent}");
 }
+
+/// Two frames of the 4 × 2 test grabber: before and after a reset.
+const BEFORE: [u8; 8] = [1, 2, 3, 4, 5, 6, 7, 8];
+const AFTER: [u8; 8] = [11, 12, 13, 14, 15, 16, 17, 18];
+
+fn frame_line(pixels: &[u8]) -> Vec<u8> {
+    line(&format!("OK FRAME 4 2 {:08X}", crc32(pixels)))
+}
+
+fn noframe() -> Vec<u8> {
+    line("ERR NOFRAME no frame frozen")
+}
+
+/// HELLO, CAMERA 2, FREEZE, and a transfer whose second block the grabber
+/// answers NOFRAME (it was reset after the first).
+fn reset_after_one_block() -> Vec<Vec<u8>> {
+    vec![
+        line(HELLO),
+        line("OK"),
+        frame_line(&BEFORE),
+        data(0, &BEFORE[..4]),
+        noframe(),
+    ]
+}
+
+#[test]
+fn a_reset_mid_transfer_is_frozen_again_from_the_camera_selected() {
+    let mut answers = reset_after_one_block();
+    // The re-sync was outwaited: a second NOFRAME (to a READ given up on)
+    // comes before STATUS's answer, which says the frame is gone.
+    let mut status = noframe();
+    status.extend(line("OK camera=1 live=0 frame=none"));
+    answers.extend([
+        status,
+        line("OK"),
+        frame_line(&AFTER),
+        data(0, &AFTER[..4]),
+        data(4, &AFTER[4..]),
+    ]);
+    let mut c = client(answers);
+    assert!(c.hello().is_ok() && c.select_camera(2).is_ok() && c.freeze().is_ok());
+    let img = c.transfer(&mut |_, _| true);
+    assert_eq!(img.ok().map(|i| i.data().to_vec()), Some(AFTER.to_vec()));
+    assert_eq!(c.frame().map(|f| f.crc), Some(crc32(&AFTER)));
+    assert_eq!(c.wire_stats().refreezes, 1);
+    let sent = sent(&mut c);
+    // Camera 2 again (a reset grabber is back on camera 1), then FREEZE.
+    let after = sent.split("STATUS").nth(1).unwrap_or_default();
+    assert!(
+        after.contains("CAMERA 2*") && after.contains("FREEZE*"),
+        "{sent}"
+    );
+}
+
+#[test]
+fn a_late_noframe_with_the_frame_still_there_reads_it_again() {
+    let mut answers = reset_after_one_block();
+    answers.extend([
+        line(&format!("OK camera=2 live=0 frame={:08X}", crc32(&BEFORE))),
+        data(0, &BEFORE[..4]),
+        data(4, &BEFORE[4..]),
+    ]);
+    let mut c = client(answers);
+    assert!(c.hello().is_ok() && c.select_camera(2).is_ok() && c.freeze().is_ok());
+    let img = c.transfer(&mut |_, _| true);
+    assert_eq!(img.ok().map(|i| i.data().to_vec()), Some(BEFORE.to_vec()));
+    assert_eq!(c.wire_stats().refreezes, 0);
+    assert_eq!(sent(&mut c).matches("FREEZE").count(), 1);
+}
+
+#[test]
+fn a_frame_is_frozen_again_only_when_it_is_the_one_asked_for() {
+    // Frozen without a camera selected: which camera it showed is unknown.
+    let mut answers = reset_after_one_block();
+    answers.remove(1);
+    let mut c = client(answers);
+    assert!(c.hello().is_ok() && c.freeze().is_ok());
+    let e = c.transfer(&mut |_, _| true);
+    assert!(matches!(e, Err(RigError::NoFrame { .. })), "{e:?}");
+    let s = sent(&mut c);
+    assert!(
+        !s.contains("STATUS") && s.matches("FREEZE").count() == 1,
+        "{s}"
+    );
+
+    // Someone else froze another frame meanwhile: it is not replaced.
+    let mut answers = reset_after_one_block();
+    answers.push(line(&format!(
+        "OK camera=3 live=0 frame={:08X}",
+        crc32(&AFTER)
+    )));
+    let mut c = client(answers);
+    assert!(c.hello().is_ok() && c.select_camera(2).is_ok() && c.freeze().is_ok());
+    let e = c.transfer(&mut |_, _| true);
+    assert!(matches!(e, Err(RigError::NoFrame { .. })), "{e:?}");
+    assert_eq!(sent(&mut c).matches("FREEZE").count(), 1);
+
+    // A grabber that keeps losing the frame: frozen again a bounded
+    // number of times, then the operator is told.
+    let mut answers = reset_after_one_block();
+    for _ in 0..FRAME_RECOVERIES {
+        answers.extend([
+            line("OK camera=1 live=0 frame=none"),
+            line("OK"),
+            frame_line(&BEFORE),
+            data(0, &BEFORE[..4]),
+            noframe(),
+        ]);
+    }
+    answers.push(line("OK camera=1 live=0 frame=none"));
+    let mut c = client(answers);
+    assert!(c.hello().is_ok() && c.select_camera(2).is_ok() && c.freeze().is_ok());
+    let e = c.transfer(&mut |_, _| true);
+    assert!(matches!(e, Err(RigError::NoFrame { .. })), "{e:?}");
+    assert_eq!(c.wire_stats().refreezes, u64::from(FRAME_RECOVERIES));
+    assert_eq!(
+        sent(&mut c).matches("FREEZE").count(),
+        1 + FRAME_RECOVERIES as usize
+    );
+}

@@ -26,10 +26,11 @@
 //! inter-byte wait of a failure, each weighed by how likely a block of that
 //! size comes through whole.
 
+use std::cell::Cell;
 use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
-use super::{ReadFail, VsgClient};
+use super::{FrameGrabber, ReadFail, VsgClient};
 use crate::llv::GreyImage;
 use crate::rig::protocol::{Command, ErrCode, FrameInfo, Reply, crc32, find_reply};
 use crate::rig::{Link, RigError};
@@ -79,6 +80,9 @@ pub(super) struct Sizer {
     /// decayed over [`WINDOW`] bytes asked for.
     whole: [f64; 33],
     failed: [f64; 33],
+    /// [`Sizer::rate`] since the last [`Sizer::record`] (it is asked for
+    /// every READ).
+    rate: Cell<Option<f64>>,
 }
 
 /// The size class of a block: ⌈log2(len)⌉.
@@ -92,10 +96,12 @@ impl Sizer {
             full: full.max(1),
             whole: [0.0; 33],
             failed: [0.0; 33],
+            rate: Cell::new(None),
         }
     }
 
     pub fn record(&mut self, len: u32, ok: bool) {
+        self.rate.set(None);
         let d = (-f64::from(len) / WINDOW).exp();
         for (w, f) in self.whole.iter_mut().zip(self.failed.iter_mut()) {
             *w *= d;
@@ -116,18 +122,35 @@ impl Sizer {
     /// given the blocks of each size that came whole and that failed (a
     /// search over p from 10⁻⁸ to 0.5, 4 steps a decade).
     pub fn rate(&self) -> f64 {
+        if let Some(r) = self.rate.get() {
+            return r;
+        }
+        let r = self.estimate();
+        self.rate.set(Some(r));
+        r
+    }
+
+    fn estimate(&self) -> f64 {
         if self.failed.iter().all(|&f| f <= 1e-9) {
             return 0.0;
         }
+        // Only the sizes that were asked for add to the likelihood (an
+        // untouched size adds exactly 0).
+        let seen: Vec<(f64, f64, f64)> = (0..33)
+            .filter_map(|k| {
+                let b = f64::from(1u32 << k.min(31));
+                let (w, f) = (*self.whole.get(k)?, *self.failed.get(k)?);
+                (w != 0.0 || f != 0.0).then_some((b, w, f))
+            })
+            .collect();
         let loglik = |p: f64| {
             let mut l = 0.0;
-            for k in 0..33 {
-                let b = f64::from(1u32 << k.min(31));
-                let (w, f) = (
-                    self.whole.get(k).copied().unwrap_or(0.0),
-                    self.failed.get(k).copied().unwrap_or(0.0),
-                );
-                l += -p * b * w + f * (1.0 - (-p * b).exp()).max(1e-300).ln();
+            for &(b, w, f) in &seen {
+                let mut term = -p * b * w;
+                if f != 0.0 {
+                    term += f * (1.0 - (-p * b).exp()).max(1e-300).ln();
+                }
+                l += term;
             }
             l
         };
@@ -231,33 +254,48 @@ impl<P: Link> VsgClient<P> {
         pending: &VecDeque<(u32, u32)>,
         since: Instant,
     ) -> Result<Event, RigError> {
+        // `rx[..seen]` holds no line end. A reply line ends at one and never
+        // spans one (its text is printable), so what comes up to the last
+        // line end when no reply is found is junk for good: it is dropped,
+        // and after a read only the new bytes are looked at for a line end.
+        // (Looking through all of `rx` again after each read made a stream
+        // of junk cost the square of its length.)
+        let mut seen = 0;
         loop {
-            if let Some((_, end, reply)) = find_reply(&self.rx) {
-                self.rx.drain(..end);
-                match reply {
-                    Reply::Data { off, len, crc } => {
-                        let Some(index) = pending.iter().position(|&p| p == (off, len)) else {
-                            // A late answer: its payload is skipped as junk.
-                            continue;
-                        };
-                        return Ok(Event::Header { index, crc });
+            let line_end = self.rx.get(seen..).is_some_and(|b| b.contains(&b'\n'));
+            if line_end {
+                if let Some((_, end, reply)) = find_reply(&self.rx) {
+                    self.rx.drain(..end);
+                    seen = 0;
+                    match reply {
+                        Reply::Data { off, len, crc } => {
+                            let Some(index) = pending.iter().position(|&p| p == (off, len)) else {
+                                // A late answer: its payload is skipped as junk.
+                                continue;
+                            };
+                            return Ok(Event::Header { index, crc });
+                        }
+                        Reply::Err {
+                            code: ErrCode::Checksum,
+                            ..
+                        } => return Ok(Event::DeviceChecksum),
+                        r @ Reply::Err { .. } => {
+                            let (off, len) = pending.front().copied().unwrap_or_default();
+                            return self.device_err(&Command::Read { off, len }, r);
+                        }
+                        // A late OK to an earlier command.
+                        Reply::Ok(_) => continue,
                     }
-                    Reply::Err {
-                        code: ErrCode::Checksum,
-                        ..
-                    } => return Ok(Event::DeviceChecksum),
-                    r @ Reply::Err { .. } => {
-                        let (off, len) = pending.front().copied().unwrap_or_default();
-                        return self.device_err(&Command::Read { off, len }, r);
-                    }
-                    // A late OK to an earlier command.
-                    Reply::Ok(_) => continue,
+                }
+                if let Some(last) = self.rx.iter().rposition(|&b| b == b'\n') {
+                    self.rx.drain(..=last);
                 }
             }
             if self.rx.len() > MAX_SCAN {
                 let cut = self.rx.len() - 256;
                 self.rx.drain(..cut);
             }
+            seen = self.rx.len();
             // Once anything came after the requests went out, silence
             // means loss; before, the reply timeout applies.
             let heard = self.last_rx.is_some_and(|t| t >= since);
@@ -292,6 +330,68 @@ impl<P: Link> VsgClient<P> {
         // but its first byte is looked through again.
         self.rx.drain(..1);
         Ok(Payload::Bad)
+    }
+
+    /// The frozen frame, got back when the grabber loses it on the way.
+    ///
+    /// A grabber that is reset (a power dip, its watchdog) forgets its
+    /// frame and its camera, and answers the READs still to come `NOFRAME`.
+    /// The operator asked for a frame of one camera, under the lights the
+    /// cell set: the transfer freezes again by itself ([`Self::recover_frame`])
+    /// when that is what it gets back, and only then:
+    /// - this client froze the frame itself, from a camera it had selected
+    ///   (not a LOADed image, which FREEZE cannot make again, nor a frame
+    ///   someone else froze, whose camera is unknown);
+    /// - STATUS says the grabber holds no frame: it lost it. A frame with
+    ///   another CRC there was frozen by someone else (a second console, the
+    ///   front panel) and is not replaced. The same CRC there means the
+    ///   NOFRAME answered a READ of an earlier transfer: the frame is read
+    ///   again as it is;
+    /// - that camera is selected again before FREEZE (a reset grabber is
+    ///   back on camera 1), and the new frame must have the old one's size.
+    ///
+    /// The lights are not the grabber's: a reset leaves the relay board as
+    /// the cell switched it, so the new frame is taken under the same
+    /// lighting. The new frame is a new exposure (its CRC is the new
+    /// FREEZE's, in [`FrameGrabber::frame`]), just as a retake by hand would
+    /// be. At most [`super::FRAME_RECOVERIES`] times per transfer; then, or
+    /// when a condition fails, the operator is told to freeze again.
+    pub(super) fn read_frame_recovering(
+        &mut self,
+        mut frame: FrameInfo,
+        progress: &mut dyn FnMut(usize, usize) -> bool,
+    ) -> Result<GreyImage, RigError> {
+        let mut recovered = 0;
+        loop {
+            match self.read_frame(frame, progress) {
+                Err(e @ RigError::NoFrame { .. }) if recovered < super::FRAME_RECOVERIES => {
+                    recovered += 1;
+                    match self.recover_frame(frame)? {
+                        Some(f) => frame = f,
+                        None => return Err(e),
+                    }
+                }
+                r => return r,
+            }
+        }
+    }
+
+    /// After `NOFRAME` in a transfer of `lost`: the frame to read now, or
+    /// `None` when the conditions of [`Self::read_frame_recovering`] fail.
+    fn recover_frame(&mut self, lost: FrameInfo) -> Result<Option<FrameInfo>, RigError> {
+        let Some(camera) = self.frozen_from.filter(|_| self.frame == Some(lost)) else {
+            return Ok(None);
+        };
+        match self.status()?.frame {
+            Some(crc) if crc == lost.crc => Ok(Some(lost)),
+            Some(_) => Ok(None),
+            None => {
+                self.select_camera(camera)?;
+                let f = self.freeze()?;
+                self.stats.refreezes += 1;
+                Ok(((f.width, f.height) == (lost.width, lost.height)).then_some(f))
+            }
+        }
     }
 
     /// The whole frozen frame, block by block, [`DEPTH`] READs at a time.
