@@ -8,7 +8,11 @@
 //! ```
 //!
 //! Instructions per run = (total at N = 15 − total at N = 5) / 10, which
-//! takes out the scene's rendering and the warm-up. Stages: `pipeline`
+//! takes out the scene's rendering and the warm-up. With `TIME=1` in the
+//! environment each run is timed and the fastest and median are printed
+//! (`TIME=1 llv_count pipeline 500`). Under valgrind the AVX2 paths are
+//! not taken (its CPU lacks features they need): count instructions for
+//! the plain paths, time the machine's own. Stages: `pipeline`
 //! (edges, lines, CONNECT; no lens), `pipeline2` (the same with a thread for
 //! each scan direction: time it, its instruction count means little),
 //! `edges` (response, noise scale and edge points, both directions),
@@ -114,7 +118,12 @@ fn main() {
     };
     let mut five = Workspace::new();
     let mut check = 0usize;
+    // With TIME set, each run is timed and the fastest and median
+    // microseconds are printed (a stage's own time, without the setup).
+    let timed = std::env::var_os("TIME").is_some();
+    let mut times = Vec::with_capacity(n);
     for _ in 0..n {
+        let t0 = std::time::Instant::now();
         match stage.as_str() {
             "pipeline" | "pipeline2" => {
                 ws.run(&Input::single(&img), &p).expect("the scene runs");
@@ -171,6 +180,29 @@ fn main() {
                 }
                 check += lh.len() + lv.len();
             }
+            "linesh" | "linesv" => {
+                let (r, nm, m, e, st, out) = if stage == "linesh" {
+                    (
+                        &warm.response_h,
+                        &warm.noise_h,
+                        &wmh,
+                        &warm.edges_h,
+                        &wsh,
+                        &mut lh,
+                    )
+                } else {
+                    (
+                        &warm.response_v,
+                        &warm.noise_v,
+                        &wmv,
+                        &warm.edges_v,
+                        &wsv,
+                        &mut lv,
+                    )
+                };
+                track_into(r, nm, m, e, st, p.edges.floor, a, &p.lines, out, &mut ls);
+                check += out.len();
+            }
             "connect" => {
                 connect_into(&warm.lines_raw, &p.connect, &mut joined, &mut cs);
                 check += joined.len();
@@ -179,6 +211,9 @@ fn main() {
                 let out = five.run(&five_input, &p).expect("the view runs");
                 check += out.lines.len();
                 let t = out.timings;
+                if timed {
+                    continue;
+                }
                 eprintln!(
                     "five: edge points {} + {}, lines {} raw, {} after CONNECT; edges {} us, lines {} us",
                     out.edges_h.points.len(),
@@ -194,6 +229,15 @@ fn main() {
                 std::process::exit(2);
             }
         }
+        times.push(t0.elapsed().as_secs_f64() * 1e6);
+    }
+    if timed && !times.is_empty() {
+        times.sort_by(f64::total_cmp);
+        println!(
+            "{stage}: fastest {:.1} us, median {:.1} us over {n} runs",
+            times[0],
+            times[times.len() / 2]
+        );
     }
     println!("{stage} x{n}: {check}");
 }

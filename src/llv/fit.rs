@@ -200,6 +200,31 @@ impl LineFit {
         (n > 1e-24 * (1.0 + lmax * lmax) && n.is_finite()).then_some(v)
     }
 
+    /// The mean and [`LineFit::major_axis`] together, with one division
+    /// and one square root (the line extractor's prediction after every
+    /// point it takes).
+    #[inline]
+    pub fn mean_and_axis(&self) -> Option<(Point, (f64, f64))> {
+        if self.count < 2 || self.w <= 0.0 {
+            return None;
+        }
+        let inv = 1.0 / self.w;
+        let (mx, my) = (self.sx * inv, self.sy * inv);
+        let s11 = self.sxx - self.sx * mx;
+        let s22 = self.syy - self.sy * my;
+        let s12 = self.sxy - self.sx * my;
+        let half = 0.5 * (s11 - s22);
+        let lmax = 0.5 * (s11 + s22) + (half * half + s12 * s12).sqrt();
+        let v1 = (s12, lmax - s11);
+        let v2 = (lmax - s22, s12);
+        let n1 = v1.0 * v1.0 + v1.1 * v1.1;
+        let n2 = v2.0 * v2.0 + v2.1 * v2.1;
+        let v = if n1 >= n2 { v1 } else { v2 };
+        let n = n1.max(n2);
+        let mean = Point::new(self.origin.x + mx, self.origin.y + my);
+        (n > 1e-24 * (1.0 + lmax * lmax) && n.is_finite()).then_some((mean, v))
+    }
+
     /// Projects `p` onto the fitted line (the point itself without a line).
     pub fn project(&self, p: Point) -> Point {
         self.line().map_or(p, |l| l.project(p))

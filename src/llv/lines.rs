@@ -96,10 +96,8 @@ impl TrackPoint {
 pub struct LineScratch {
     response: ResponseBufs,
     points: PointBufs,
-    seeds: Vec<u32>,
-    /// Starts found again from their points (sort keys), and the
-    /// counting sort's column counts.
-    sorted: Vec<u32>,
+    seeds: Vec<u64>,
+    /// The counting sort's column counts.
     order: Vec<u32>,
     tracks: Tracks,
     /// The peak map, when the one given does not fit the parameters.
@@ -122,7 +120,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
     s.points.file(e);
     let mut src = s.points.peaks();
     s.seeds.clear();
-    s.seeds.extend(0..src.len() as u32);
+    s.seeds.extend(0..src.len() as u64);
     follow(
         &mut src,
         &s.seeds,
@@ -148,7 +146,7 @@ pub fn track_into(
     noise: &NoiseMap,
     map: &PeakMap,
     seeds: &EdgePoints,
-    starts: &[u32],
+    starts: &[[u16; 2]],
     floor: f64,
     half_width: usize,
     p: &LineParams,
@@ -169,32 +167,35 @@ pub fn track_into(
         &own
     };
     let mut src = ResponsePeaks::new(resp, noise, map, &mut s.response);
+    // Seeds are scan positions, packed `v << 32 | u`, in scan order.
     s.seeds.clear();
     if starts.len() == seeds.points.len() {
-        // In scan order: the starts are in image order, which is the
-        // horizontal scan's; a vertical scan's are put in column order by
-        // a counting sort on the column (stable, so rows stay ascending).
+        // The starts are in image order, which is the horizontal scan's; a
+        // vertical scan's are put in column order by a counting sort on
+        // the column (stable, so rows stay ascending).
         if vertical {
             s.order.clear();
             s.order.resize(w + 1, 0);
-            for &i in starts {
-                s.order[i as usize % w + 1] += 1;
+            for &[x, _] in starts {
+                s.order[usize::from(x) + 1] += 1;
             }
             for x in 0..w {
                 s.order[x + 1] += s.order[x];
             }
-            s.seeds.clear();
             s.seeds.resize(starts.len(), 0);
-            for &i in starts {
-                let x = i as usize % w;
-                s.seeds[s.order[x] as usize] = i;
-                s.order[x] += 1;
+            for &[x, y] in starts {
+                let k = &mut s.order[usize::from(x)];
+                s.seeds[*k as usize] = pack(usize::from(y), usize::from(x));
+                *k += 1;
             }
         } else {
-            s.seeds.extend_from_slice(starts);
+            s.seeds.extend(
+                starts
+                    .iter()
+                    .map(|&[x, y]| pack(usize::from(x), usize::from(y))),
+            );
         }
     } else {
-        s.sorted.clear();
         for e in &seeds.points {
             let (u, v) = if vertical { (e.y, e.x) } else { (e.x, e.y) };
             let r = (v + 0.5).floor();
@@ -203,24 +204,10 @@ pub fn track_into(
             }
             // The seed's pixel: the peak at or next to its position.
             if let Some(c) = src.strongest(r as usize, f64::from(u), 0.5, e.response > 0.0) {
-                s.sorted.push(if vertical {
-                    (c.v * h + c.id / w) as u32
-                } else {
-                    c.id as u32
-                });
+                s.seeds.push(pack(c.pix as usize, c.v));
             }
         }
-        // In scan order (a vertical scan's by column, then row), as
-        // image indices.
-        s.sorted.sort_unstable();
-        s.seeds.extend(s.sorted.iter().map(|&k| {
-            if vertical {
-                let (x, y) = (k as usize / h, k as usize % h);
-                (y * w + x) as u32
-            } else {
-                k
-            }
-        }));
+        s.seeds.sort_unstable();
     }
     s.seeds.dedup();
     let nfa = nfa::Nfa::new(w, h, half_width, p.search_width, p.track_sigmas);
@@ -252,7 +239,7 @@ struct Tracks {
 #[allow(clippy::too_many_arguments)]
 fn follow<P: Peaks>(
     src: &mut P,
-    seeds: &[u32],
+    seeds: &[u64],
     p: &LineParams,
     nfa: Option<&nfa::Nfa>,
     trim: usize,
@@ -270,10 +257,10 @@ fn follow<P: Peaks>(
     let steep = (1.0 / min_angle.clamp(1e-3, std::f64::consts::FRAC_PI_2).tan()).min(MAX_SLOPE);
     let gap = p.max_gap.max(1) as usize;
     for &id in seeds {
-        if src.is_taken(id as usize) {
+        if src.is_taken(id) {
             continue;
         }
-        let Some(seed) = src.seed(id as usize) else {
+        let Some(seed) = src.seed(id) else {
             continue;
         };
         let seed = &seed;
@@ -329,6 +316,12 @@ fn follow<P: Peaks>(
     }
 }
 
+/// A scan position `(u, v)` as one seed: `v << 32 | u` (scan order is
+/// numeric order).
+fn pack(u: usize, v: usize) -> u64 {
+    (v as u64) << 32 | u as u64
+}
+
 /// Scan line `v + d`, if it is one.
 fn line_at(v: usize, d: i64, lines: usize) -> Option<usize> {
     let r = v as i64 + d;
@@ -341,7 +334,7 @@ fn line_at(v: usize, d: i64, lines: usize) -> Option<usize> {
 fn walk<P: Peaks>(
     src: &mut P,
     fit: &mut LineFit,
-    mut last: TrackPoint,
+    last: TrackPoint,
     dir: i64,
     first_slope: f64,
     positive: bool,
@@ -350,11 +343,11 @@ fn walk<P: Peaks>(
     list: &mut Vec<TrackPoint>,
 ) {
     let lines = src.lines();
+    let (mut last_u, mut last_v) = (last.u, last.v as usize);
     loop {
-        let axis = fit.major_axis();
-        let mean = fit.mean();
-        let slope = match axis {
-            Some((du, dv)) if fit.len() >= 2 => {
+        let fitted = fit.mean_and_axis();
+        let slope = match fitted {
+            Some((_, (du, dv))) => {
                 if dv.abs() * MAX_SLOPE > du.abs() {
                     du / dv
                 } else {
@@ -363,14 +356,29 @@ fn walk<P: Peaks>(
             }
             _ => first_slope,
         };
+        // A point off the line of an established track is not taken: a
+        // stray peak of noise is skipped like a missing point, and where
+        // the edge turns (a shallow corner, a branching shadow) the track
+        // ends after `max_gap` lines of such points. (Its distance from the
+        // line, `|cross| / |axis|`, compared squared.)
+        let stray = fitted
+            .filter(|_| fit.len() >= STRAY_AFTER)
+            .map(|(m, (du, dv))| {
+                (
+                    m,
+                    du,
+                    dv,
+                    STRAY_DISTANCE * STRAY_DISTANCE * (du * du + dv * dv),
+                )
+            });
         let mut found = None;
         for i in 1..=gap {
-            let Some(v) = line_at(last.v as usize, dir * i as i64, lines) else {
+            let Some(v) = line_at(last_v, dir * i as i64, lines) else {
                 break;
             };
-            let pred = match mean {
-                Some(m) if fit.len() >= 2 => m.x + (v as f64 - m.y) * slope,
-                _ => last.u + (v as f64 - last.v) * slope,
+            let pred = match fitted {
+                Some((m, _)) => m.x + (v as f64 - m.y) * slope,
+                _ => last_u + (v as f64 - last_v as f64) * slope,
             };
             if !pred.is_finite() {
                 break;
@@ -378,16 +386,10 @@ fn walk<P: Peaks>(
             let Some(c) = src.nearest(v, pred, sw, positive) else {
                 continue;
             };
-            // A point off the line of an established track is not taken: a
-            // stray peak of noise is skipped like a missing point, and where
-            // the edge turns (a shallow corner, a branching shadow) the
-            // track ends after `max_gap` lines of such points.
-            if fit.len() >= STRAY_AFTER {
-                if let (Some((du, dv)), Some(m)) = (axis, mean) {
-                    let cross = (c.u - m.x) * dv - (c.v as f64 - m.y) * du;
-                    if cross.abs() > STRAY_DISTANCE * (du * du + dv * dv).sqrt() {
-                        continue;
-                    }
+            if let Some((m, du, dv, lim)) = stray {
+                let cross = (c.u - m.x) * dv - (c.v as f64 - m.y) * du;
+                if cross * cross > lim {
+                    continue;
                 }
             }
             found = Some(c);
@@ -396,8 +398,10 @@ fn walk<P: Peaks>(
         let Some(c) = found else { break };
         src.take(&c);
         fit.add(Point::new(c.u, c.v as f64));
-        last = TrackPoint::of(&c);
-        list.push(last);
+        // (Only the position is kept: a copy of the whole point read back
+        // at once stalled on the stores that made it.)
+        (last_u, last_v) = (c.u, c.v);
+        list.push(TrackPoint::of(&c));
     }
 }
 

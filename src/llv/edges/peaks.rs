@@ -24,7 +24,7 @@
 //! fallback elsewhere), the compares' sign bits taken at once; at 3.5 σ
 //! candidates are rare, so the rest is plain code.
 
-use super::{NONE, NoiseMap, Response, key};
+use super::{NoiseMap, Response, key};
 use crate::llv::params::EdgeParams;
 use crate::llv::{EdgePoint, EdgePoints, ScanDir};
 
@@ -32,16 +32,16 @@ use crate::llv::{EdgePoint, EdgePoints, ScanDir};
 #[derive(Clone, Debug, Default)]
 pub struct PeakScratch {
     /// Candidates: pixel index and key, in image order.
-    cand: Vec<(u32, i16)>,
+    cand: Vec<Peak>,
     /// Per tile, the largest key that does not pass: for an edge point,
     /// for a peak a track may take.
     thr: Vec<i32>,
     track_thr: Vec<i32>,
     /// Per column of a row of tiles, the same two.
     cols: Vec<i16>,
-    /// Per column, its tile; a row's candidate bits.
+    /// Per column, its tile; the rows of the pass.
     tiles: Vec<u32>,
-    starts_row: Vec<u64>,
+    rows: ScanRows,
     /// Per region: candidate count, then the smallest key kept.
     count: Vec<u32>,
     lim: Vec<i16>,
@@ -51,9 +51,18 @@ pub struct PeakScratch {
     noise: super::NoiseScratch,
 }
 
-/// The pixel index of every edge point of a [`detect_into`] call, in the
-/// points' order: where the line extractor starts its tracks.
-pub type Starts = Vec<u32>;
+/// The pixel `[x, y]` of every edge point of a [`detect_into`] call, in
+/// the points' order: where the line extractor starts its tracks.
+pub type Starts = Vec<[u16; 2]>;
+
+/// A peak found by the pass: its pixel and key (images are at most 8192
+/// pixels a side, `image::MAX_PIXELS`, so coordinates fit `u16`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Peak {
+    pub x: u16,
+    pub y: u16,
+    pub key: i16,
+}
 
 /// The peaks a line extractor may follow: one bit per pixel and polarity
 /// for every peak along the scan above the tracking threshold (the floor
@@ -336,11 +345,10 @@ pub fn points_into(
     }
     let rl = p.region_lines.max(1) as usize;
     let m = p.per_region.max(1) as usize;
-    let region = |i: u32| -> usize {
-        let i = i as usize;
+    let region = |c: &Peak| -> usize {
         match resp.dir {
-            ScanDir::Horizontal => i / w / rl,
-            ScanDir::Vertical => i % w / rl,
+            ScanDir::Horizontal => usize::from(c.y) / rl,
+            ScanDir::Vertical => usize::from(c.x) / rl,
         }
     };
     let nreg = match resp.dir {
@@ -353,14 +361,14 @@ pub fn points_into(
         ScanDir::Vertical => w,
     };
     let sums = resp.sums();
-    for &(i, k) in &cand {
-        if k < s.lim[region(i)] {
+    for c in &cand {
+        if c.key < s.lim[region(c)] {
             continue;
         }
-        let i = i as usize;
+        let i = usize::from(c.y) * w + usize::from(c.x);
         let mag = |j: usize| f32::from(key(sums[j]));
         let d = subpixel(mag(i - step), mag(i), mag(i + step));
-        let (x, y) = ((i % w) as f32, (i / w) as f32);
+        let (x, y) = (f32::from(c.x), f32::from(c.y));
         let (x, y) = match resp.dir {
             ScanDir::Horizontal => (x + d, y),
             ScanDir::Vertical => (x, y + d),
@@ -370,7 +378,7 @@ pub fn points_into(
             y,
             response: f32::from(sums[i]) * resp.scale(),
         });
-        starts.push(i as u32);
+        starts.push([c.x, c.y]);
     }
     s.cand = cand;
 }
@@ -380,7 +388,7 @@ pub fn points_into(
 /// threshold `thr` (per tile of `noise`, as keys), in image order, with its
 /// key.
 #[cfg(test)]
-fn candidates(resp: &Response, noise: &NoiseMap, thr: &[i32], cand: &mut Vec<(u32, i16)>) {
+fn candidates(resp: &Response, noise: &NoiseMap, thr: &[i32], cand: &mut Vec<Peak>) {
     let mut s = PeakScratch::default();
     scan(
         resp,
@@ -397,13 +405,20 @@ fn candidates(resp: &Response, noise: &NoiseMap, thr: &[i32], cand: &mut Vec<(u3
 /// `start`, per tile, when given) into `cand`, and every peak above
 /// `track` into `map` when it was reset for `resp` (else it is left
 /// alone). `s` gives the row buffers.
+///
+/// Each row's magnitudes are computed once, into a row padded to whole
+/// blocks of 32 positions with a sentinel (`i16::MAX`, which stops a peak
+/// like [`NONE`](super::NONE)) at each end, so that the test runs on aligned blocks with
+/// no edge cases: position `x` reads `keys[x]`, `keys[x + 1]`,
+/// `keys[x + 2]` of the row (horizontal scan) or of the rows above, at and
+/// below (vertical scan, three rows kept in turn).
 fn scan(
     resp: &Response,
     noise: &NoiseMap,
     start: Option<&[i32]>,
     track: &[i32],
     s: &mut PeakScratch,
-    cand: &mut Vec<(u32, i16)>,
+    cand: &mut Vec<Peak>,
     map: &mut PeakMap,
 ) {
     let (w, h) = (resp.width, resp.height);
@@ -413,6 +428,8 @@ fn scan(
     }
     let mapped = map.holds(resp);
     let wpr = w.div_ceil(64);
+    // Positions padded to whole blocks (and words: two blocks a word).
+    let wp = wpr * 64;
     let simd = simd();
     let as_key = |t: Option<&i32>| {
         t.copied()
@@ -420,151 +437,170 @@ fn scan(
             .clamp(-1, i32::from(i16::MAX)) as i16
     };
     noise.columns_into(w, &mut s.tiles);
-    s.starts_row.clear();
-    s.starts_row.resize(wpr, 0);
-    let (mut none_pos, mut none_neg) = (Vec::new(), Vec::new());
+    let rb = &mut s.rows;
+    for k in &mut rb.keys {
+        k.clear();
+        k.resize(wp + 2, i16::MAX);
+    }
+    rb.sign.clear();
+    rb.sign.resize(wp, 0);
+    rb.bits.clear();
+    rb.bits.resize(3 * wpr, 0);
     let mut tile_row = usize::MAX;
-    let rows = match resp.dir {
-        ScanDir::Horizontal => 0..h,
-        ScanDir::Vertical => 1..h - 1,
-    };
+    let vertical = resp.dir == ScanDir::Vertical;
+    let rows = if vertical { 1..h - 1 } else { 0..h };
+    if vertical {
+        // The rows above and at the first: keys[0], keys[1].
+        key_row(&sums[..w], &mut rb.keys[0][1..=w]);
+        key_row(&sums[w..2 * w], &mut rb.keys[1][1..=w]);
+    }
     for y in rows {
-        // The thresholds of every column of this row's tiles: `cols[..w]`
-        // the edge points', `cols[w..]` the tracks'.
+        // The thresholds of every column of this row's tiles: `cols[..wp]`
+        // the edge points', `cols[wp..]` the tracks' (never passed beyond
+        // the row).
         let t0 = noise.row_of(y);
         if t0 != tile_row {
             tile_row = t0;
             s.cols.clear();
-            let tiles = &s.tiles;
-            s.cols.extend(tiles.iter().map(|&tx| match start {
-                Some(st) => as_key(st.get(t0 + tx as usize)),
-                None => i16::MAX,
-            }));
-            s.cols.extend(tiles.iter().map(|&tx| {
-                if mapped {
-                    as_key(track.get(t0 + tx as usize))
-                } else {
-                    i16::MAX
+            s.cols.resize(2 * wp, i16::MAX);
+            for (x, &tx) in s.tiles.iter().enumerate() {
+                let t = t0 + tx as usize;
+                if let Some(st) = start {
+                    s.cols[x] = as_key(st.get(t));
                 }
-            }));
+                if mapped {
+                    s.cols[wp + x] = as_key(track.get(t));
+                }
+            }
         }
-        let (cs, ct) = s.cols.split_at(w);
         let at = y * w;
-        s.starts_row.fill(0);
-        let (pos, neg) = if mapped {
-            (
-                &mut map.pos[y * wpr..(y + 1) * wpr],
-                &mut map.neg[y * wpr..(y + 1) * wpr],
-            )
+        let row = &sums[at..at + w];
+        // The signs: the row itself where the padded length stays inside
+        // the response (what follows the row is never a peak: thresholds
+        // are `i16::MAX` there), else a padded copy.
+        let sign: &[i16] = match sums.get(at..at + wp) {
+            Some(s) => s,
+            None => {
+                rb.sign[..w].copy_from_slice(row);
+                &rb.sign
+            }
+        };
+        let [k0, k1, k2] = &mut rb.keys;
+        let keys: [&[i16]; 3] = if vertical {
+            // keys[2] takes the row below; then the three turn.
+            key_row(&sums[at + w..at + 2 * w], &mut k2[1..=w]);
+            [&k0[1..], &k1[1..], &k2[1..]]
         } else {
-            none_pos.clear();
-            none_pos.resize(wpr, 0);
-            none_neg.clear();
-            none_neg.resize(wpr, 0);
-            (&mut none_pos[..], &mut none_neg[..])
+            key_row(row, &mut k0[1..=w]);
+            [&k0[..], &k0[1..], &k0[2..]]
         };
-        let out = RowMasks {
-            start: &mut s.starts_row,
-            pos,
-            neg,
-        };
-        match resp.dir {
-            ScanDir::Horizontal => {
-                // Positions 1..w − 1 (the ends have no neighbour).
-                let row = &sums[at..at + w];
-                let (lo, mid, hi) = (&row[..w - 2], &row[1..w - 1], &row[2..]);
-                row_masks(simd, [lo, mid, hi], &cs[1..w - 1], &ct[1..w - 1], 1, out);
-            }
-            ScanDir::Vertical => {
-                let (up, row, dn) = (
-                    &sums[at - w..at],
-                    &sums[at..at + w],
-                    &sums[at + w..at + 2 * w],
-                );
-                row_masks(simd, [up, row, dn], cs, ct, 0, out);
-            }
+        rb.bits.fill(0);
+        let (cs, ct) = s.cols.split_at(wp);
+        row_masks(simd, keys, sign, cs, ct, &mut rb.bits);
+        let (st, rest) = rb.bits.split_at(wpr);
+        let (pos, neg) = rest.split_at(wpr);
+        if mapped {
+            map.pos[y * wpr..(y + 1) * wpr].copy_from_slice(pos);
+            map.neg[y * wpr..(y + 1) * wpr].copy_from_slice(neg);
         }
-        for (k, &word) in s.starts_row.iter().enumerate() {
+        for (k, &word) in st.iter().enumerate() {
             let mut m = word;
             while m != 0 {
                 let x = k * 64 + m.trailing_zeros() as usize;
                 m &= m - 1;
-                cand.push(((at + x) as u32, key(sums[at + x])));
+                cand.push(Peak {
+                    x: x as u16,
+                    y: y as u16,
+                    key: key(sums[at + x]),
+                });
             }
+        }
+        if vertical {
+            rb.keys.rotate_left(1);
         }
     }
 }
 
-/// The bits of one row of the peak test, by position: edge points'
-/// candidates, and the peaks a track may take by polarity.
-struct RowMasks<'a> {
-    start: &'a mut [u64],
-    pos: &'a mut [u64],
-    neg: &'a mut [u64],
+/// The scan's row buffers (see [`scan`]).
+#[derive(Clone, Debug, Default)]
+struct ScanRows {
+    /// Padded key rows: position `x` at index `x + 1`.
+    keys: [Vec<i16>; 3],
+    /// The row's sums, padded with zeros.
+    sign: Vec<i16>,
+    /// The row's candidate, positive and negative bits, a word per 64
+    /// positions each.
+    bits: Vec<u64>,
 }
 
-impl RowMasks<'_> {
-    /// ORs the bits of positions `u..u + 32` into the row.
-    #[inline(always)]
-    fn put(&mut self, u: usize, [st, pos, neg]: [u32; 3]) {
-        for (bits, m) in [
-            (&mut *self.start, st),
-            (&mut *self.pos, pos),
-            (&mut *self.neg, neg),
-        ] {
-            let (at, off) = (u / 64, u % 64);
-            let m = u64::from(m);
-            if let Some(b) = bits.get_mut(at) {
-                *b |= m << off;
-            }
-            // (Bits past the word are positions of the same row.)
-            if off > 32 && m >> (64 - off) != 0 {
-                if let Some(b) = bits.get_mut(at + 1) {
-                    *b |= m >> (64 - off);
-                }
-            }
-        }
+/// `|s|` of every sum of `row` into `out` (as long), saturating: [`NONE`](super::NONE)
+/// gives `i16::MAX`. Plain code the compiler vectorises (AVX2 at run time).
+#[multiversion::multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt", "x86_64+sse4.1"))]
+fn key_row(row: &[i16], out: &mut [i16]) {
+    for (k, &s) in out.iter_mut().zip(row) {
+        *k = s.max(0i16.saturating_sub(s));
     }
 }
 
-/// The peak test of one row, for positions `u0 + j`, `j` in
-/// `0..mid.len()` (all slices as long): with `k = |mid[j]|` (magnitudes
-/// saturate, so [`NONE`] as a neighbour stops a peak), position `j` is a
-/// peak along the scan when `k > |lo[j]|`, `k ≥ |hi[j]|` and `mid[j] ≠
-/// NONE`; an edge point's candidate when also `k > thr[j]`, a peak a track
-/// may take when `k > trk[j]`, by the sign of `mid[j]`. Thirty-two pixels
-/// an iteration in AVX2 where the processor has it (`pulp`, chosen at run
-/// time), else [`row_masks_plain`], the reference the tests compare with.
+/// The largest key a real sum has ([`SUM_MAX`]); `i16::MAX` is [`NONE`](super::NONE)'s.
+const REAL: i16 = super::SUM_MAX as i16;
+
+/// The peak test of one padded row, for positions `x` in `0..sign.len()`
+/// (a multiple of 64): with `k = mid[x]`, position `x` is a peak along the
+/// scan when `k > lo[x]`, `k ≥ hi[x]` and `k` is a real magnitude (not
+/// [`NONE`](super::NONE)'s); an edge point's candidate when also `k > thr[x]`, a peak a
+/// track may take when `k > trk[x]`, positive or negative by `sign[x]`.
+/// `bits` gets the three masks, each `sign.len() / 64` words. Thirty-two
+/// positions an iteration with AVX2 where the processor has it (`pulp`,
+/// chosen at run time), else [`row_masks_plain`], the reference the tests
+/// compare with.
 fn row_masks(
     simd: Simd,
     [lo, mid, hi]: [&[i16]; 3],
+    sign: &[i16],
     thr: &[i16],
     trk: &[i16],
-    u0: usize,
-    mut out: RowMasks,
+    bits: &mut [u64],
 ) {
-    let n = mid
-        .len()
-        .min(lo.len())
-        .min(hi.len())
-        .min(thr.len())
-        .min(trk.len());
-    let mut done = 0;
+    let n = sign.len();
+    let words = n / 64;
+    let ok = n % 64 == 0
+        && [lo.len(), mid.len(), hi.len(), thr.len(), trk.len()]
+            .iter()
+            .all(|&l| l >= n)
+        && bits.len() >= 3 * words;
+    if !ok {
+        debug_assert!(false, "row buffers not padded");
+        return;
+    }
     #[cfg(target_arch = "x86_64")]
     if let Some(simd) = simd {
-        done = simd.vectorize(
+        simd.vectorize(
             #[inline(always)]
-            || avx2_masks(simd, [lo, mid, hi], thr, trk, n, u0, &mut out),
+            || avx2_masks(simd, [lo, mid, hi], sign, thr, trk, bits),
         );
+        return;
     }
-    for j in (done..n).step_by(32) {
-        let end = (j + 32).min(n);
+    let _ = simd;
+    for b in 0..n / 32 {
+        let r = b * 32..b * 32 + 32;
         let m = row_masks_plain(
-            [&lo[j..end], &mid[j..end], &hi[j..end]],
-            &thr[j..end],
-            &trk[j..end],
+            [&lo[r.clone()], &mid[r.clone()], &hi[r.clone()]],
+            &sign[r.clone()],
+            &thr[r.clone()],
+            &trk[r],
         );
-        out.put(u0 + j, m);
+        put32(bits, words, b, m);
+    }
+}
+
+/// Stores the three 32-bit masks of block `b` (positions `32 b ..`) into
+/// `bits` (three runs of `words` words).
+#[inline(always)]
+fn put32(bits: &mut [u64], words: usize, b: usize, m: [u32; 3]) {
+    let (word, shift) = (b / 2, 32 * (b % 2));
+    for (k, m) in m.into_iter().enumerate() {
+        bits[k * words + word] |= u64::from(m) << shift;
     }
 }
 
@@ -586,83 +622,87 @@ fn simd() -> Simd {
     }
 }
 
-/// [`row_masks`] with AVX2, for rows of 32 pixels or more; returns how
-/// many pixels it did (all of them, or none). (Helpers are `inline(always)` functions, not
+/// [`row_masks`] with AVX2. (Helpers are `inline(always)` functions, not
 /// closures, so that they compile inside the AVX2 context.)
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn avx2_masks(
     simd: pulp::x86::V3,
     [lo, mid, hi]: [&[i16]; 3],
+    sign: &[i16],
     thr: &[i16],
     trk: &[i16],
-    n: usize,
-    u0: usize,
-    out: &mut RowMasks,
-) -> usize {
+    bits: &mut [u64],
+) {
     let a = simd.avx2;
-    if n < 32 {
-        return 0;
-    }
-    // Blocks of 32 from 0, and one more ending at `n` (overlapping the
-    // last: its bits are ORed in again, the same).
-    let last = n - 32;
-    let mut i = 0;
-    loop {
-        let [s0, p0, n0] = avx2_half(a, [lo, mid, hi], thr, trk, i);
-        let [s1, p1, n1] = avx2_half(a, [lo, mid, hi], thr, trk, i + 16);
-        let bits = [
-            avx2_bits(a, s0, s1),
-            avx2_bits(a, p0, p1),
-            avx2_bits(a, n0, n1),
-        ];
-        out.put(u0 + i, bits);
-        if i == last {
-            return n;
-        }
-        i = (i + 32).min(last);
+    let n = sign.len() / 64 * 64;
+    let words = n / 64;
+    let (lo, mid, hi, thr, trk) = (&lo[..n], &mid[..n], &hi[..n], &thr[..n], &trk[..n]);
+    let (st_bits, rest) = bits.split_at_mut(words);
+    let (pos_bits, neg_bits) = rest.split_at_mut(words);
+    // Two blocks of 32 a word: each word of each mask is stored once.
+    let it = lo
+        .chunks_exact(64)
+        .zip(mid.chunks_exact(64))
+        .zip(hi.chunks_exact(64))
+        .zip(sign[..n].chunks_exact(64))
+        .zip(thr.chunks_exact(64).zip(trk.chunks_exact(64)))
+        .zip(
+            st_bits
+                .iter_mut()
+                .zip(pos_bits.iter_mut().zip(neg_bits.iter_mut())),
+        );
+    for (((((l, m), h), sg), (t, tk)), (sb, (pb, nb))) in it {
+        let half = |o: usize| avx2_half(a, [l, m, h], sg, t, tk, o);
+        let [s0, p0, n0] = half(0);
+        let [s1, p1, n1] = half(16);
+        let [s2, p2, n2] = half(32);
+        let [s3, p3, n3] = half(48);
+        let word = |x0, x1, y0, y1| {
+            u64::from(avx2_bits(a, x0, x1)) | u64::from(avx2_bits(a, y0, y1)) << 32
+        };
+        *sb = word(s0, s1, s2, s3);
+        *pb = word(p0, p1, p2, p3);
+        *nb = word(n0, n1, n2, n3);
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 type Avx2 = pulp::core_arch::x86::Avx2;
+#[cfg(target_arch = "x86_64")]
+type V = core::arch::x86_64::__m256i;
 
-/// Sixteen `i16` from `s[i..]`.
+/// Sixteen `i16` from `s[o..]`.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn avx2_load(s: &[i16], i: usize) -> core::arch::x86_64::__m256i {
-    pulp::cast(*s[i..].first_chunk::<16>().expect("16 lanes"))
-}
-
-/// `|v|`, saturating (so [`NONE`] gives `i16::MAX`).
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-fn avx2_mag(a: Avx2, v: core::arch::x86_64::__m256i) -> core::arch::x86_64::__m256i {
-    let zero = pulp::cast([0i16; 16]);
-    a._mm256_max_epi16(v, a._mm256_subs_epi16(zero, v))
+fn avx2_load(s: &[i16], o: usize) -> V {
+    pulp::cast(*s[o..].first_chunk::<16>().expect("16 lanes"))
 }
 
 /// The candidate, positive-track and negative-track lanes of the sixteen
-/// pixels from `i`.
+/// positions from `o` of a block.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn avx2_half(
     a: Avx2,
     [lo, mid, hi]: [&[i16]; 3],
+    sign: &[i16],
     thr: &[i16],
     trk: &[i16],
-    i: usize,
-) -> [core::arch::x86_64::__m256i; 3] {
-    let zero = pulp::cast([0i16; 16]);
-    let m = avx2_load(mid, i);
-    let k = avx2_mag(a, m);
-    let up = a._mm256_cmpgt_epi16(k, avx2_mag(a, avx2_load(lo, i)));
-    let down = a._mm256_cmpgt_epi16(avx2_mag(a, avx2_load(hi, i)), k);
-    let none = a._mm256_cmpeq_epi16(m, pulp::cast([NONE; 16]));
-    let peak = a._mm256_andnot_si256(a._mm256_or_si256(down, none), up);
-    let st = a._mm256_and_si256(peak, a._mm256_cmpgt_epi16(k, avx2_load(thr, i)));
-    let tr = a._mm256_and_si256(peak, a._mm256_cmpgt_epi16(k, avx2_load(trk, i)));
-    let ng = a._mm256_and_si256(tr, a._mm256_cmpgt_epi16(zero, m));
+    o: usize,
+) -> [V; 3] {
+    let zero: V = pulp::cast([0i16; 16]);
+    let real: V = pulp::cast([REAL + 1; 16]);
+    let k = avx2_load(mid, o);
+    let up = a._mm256_cmpgt_epi16(k, avx2_load(lo, o));
+    let down = a._mm256_cmpgt_epi16(avx2_load(hi, o), k);
+    let peak = a._mm256_and_si256(
+        a._mm256_andnot_si256(down, up),
+        a._mm256_cmpgt_epi16(real, k),
+    );
+    let st = a._mm256_and_si256(peak, a._mm256_cmpgt_epi16(k, avx2_load(thr, o)));
+    let tr = a._mm256_and_si256(peak, a._mm256_cmpgt_epi16(k, avx2_load(trk, o)));
+    let ng = a._mm256_and_si256(tr, a._mm256_cmpgt_epi16(zero, avx2_load(sign, o)));
     [st, a._mm256_andnot_si256(ng, tr), ng]
 }
 
@@ -670,23 +710,23 @@ fn avx2_half(
 /// lanes; the permute puts them back).
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn avx2_bits(a: Avx2, x: core::arch::x86_64::__m256i, y: core::arch::x86_64::__m256i) -> u32 {
+fn avx2_bits(a: Avx2, x: V, y: V) -> u32 {
     let p = a._mm256_permute4x64_epi64::<0b11_01_10_00>(a._mm256_packs_epi16(x, y));
     a._mm256_movemask_epi8(p) as u32
 }
 
-/// The masks of [`row_masks`] for up to 32 pixels, in plain code.
-fn row_masks_plain([lo, mid, hi]: [&[i16]; 3], thr: &[i16], trk: &[i16]) -> [u32; 3] {
+/// The masks of [`row_masks`] for one block of 32 positions, in plain
+/// code.
+fn row_masks_plain([lo, mid, hi]: [&[i16]; 3], sign: &[i16], thr: &[i16], trk: &[i16]) -> [u32; 3] {
     let mut out = [0u32; 3];
     for j in 0..mid.len().min(32) {
-        let m = mid[j];
-        let k = key(m);
-        if k > key(lo[j]) && k >= key(hi[j]) && m != NONE {
+        let k = mid[j];
+        if k > lo[j] && k >= hi[j] && k <= REAL {
             if k > thr[j] {
                 out[0] |= 1 << j;
             }
             if k > trk[j] {
-                out[if m < 0 { 2 } else { 1 }] |= 1 << j;
+                out[if sign[j] < 0 { 2 } else { 1 }] |= 1 << j;
             }
         }
     }
@@ -696,7 +736,7 @@ fn row_masks_plain([lo, mid, hi]: [&[i16]; 3], thr: &[i16], trk: &[i16]) -> [u32
 /// [`candidates`] in plain code, one pixel and tile at a time: the
 /// reference the lane-wise test is compared with.
 #[cfg(test)]
-fn candidates_plain(resp: &Response, noise: &NoiseMap, thr: &[i32], cand: &mut Vec<(u32, i16)>) {
+fn candidates_plain(resp: &Response, noise: &NoiseMap, thr: &[i32], cand: &mut Vec<Peak>) {
     let (w, h) = (resp.width, resp.height);
     let sums = resp.sums();
     let step = match resp.dir {
@@ -718,9 +758,13 @@ fn candidates_plain(resp: &Response, noise: &NoiseMap, thr: &[i32], cand: &mut V
             if i32::from(k0) > th
                 && k0 > key(sums[i - step])
                 && k0 >= key(sums[i + step])
-                && sums[i] != NONE
+                && sums[i] != super::NONE
             {
-                cand.push((i as u32, k0));
+                cand.push(Peak {
+                    x: x as u16,
+                    y: y as u16,
+                    key: k0,
+                });
             }
         }
     }
@@ -729,18 +773,18 @@ fn candidates_plain(resp: &Response, noise: &NoiseMap, thr: &[i32], cand: &mut V
 /// Per region, the smallest key kept: 0 where it has at most `m`
 /// candidates, else its `m`-th largest key.
 fn region_limits(
-    cand: &[(u32, i16)],
+    cand: &[Peak],
     nreg: usize,
     m: usize,
-    region: impl Fn(u32) -> usize,
+    region: impl Fn(&Peak) -> usize,
     s: &mut PeakScratch,
 ) {
     s.count.clear();
     s.count.resize(nreg, 0);
     s.lim.clear();
     s.lim.resize(nreg, 0);
-    for &(i, _) in cand {
-        s.count[region(i)] += 1;
+    for c in cand {
+        s.count[region(c)] += 1;
     }
     if s.count.iter().all(|&c| c as usize <= m) {
         return;
@@ -757,10 +801,10 @@ fn region_limits(
     s.grouped.clear();
     s.grouped.resize(at as usize, 0);
     let mut fill = s.start.clone();
-    for &(i, key) in cand {
-        let r = region(i);
+    for c in cand {
+        let r = region(c);
         if s.count[r] as usize > m {
-            s.grouped[fill[r] as usize] = key;
+            s.grouped[fill[r] as usize] = c.key;
             fill[r] += 1;
         }
     }
@@ -868,9 +912,8 @@ mod tests {
                 &mut PeakScratch::default(),
             );
             assert_eq!(out.points.len(), starts.len());
-            for (p, &i) in out.points.iter().zip(&starts) {
-                let (x, y) = (i as usize % 40, i as usize / 40);
-                assert!((p.x - x as f32).abs() <= 0.5 && (p.y - y as f32).abs() <= 0.5);
+            for (p, &[x, y]) in out.points.iter().zip(&starts) {
+                assert!((p.x - f32::from(x)).abs() <= 0.5 && (p.y - f32::from(y)).abs() <= 0.5);
             }
         }
     }
@@ -973,7 +1016,10 @@ mod tests {
                     }
                 }
                 found.sort_unstable();
-                let want: Vec<u32> = plain.iter().map(|c| c.0).collect();
+                let want: Vec<u32> = plain
+                    .iter()
+                    .map(|c| u32::from(c.y) * w as u32 + u32::from(c.x))
+                    .collect();
                 assert_eq!(found, want, "{w}x{h} {dir:?}");
             }
         }

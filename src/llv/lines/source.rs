@@ -18,6 +18,8 @@ pub struct Cand {
     pub response: f32,
     pub z: f32,
     pub id: usize,
+    /// The whole position along the scan (a response's pixel).
+    pub pix: u32,
 }
 
 /// What the tracker asks of its points.
@@ -31,10 +33,11 @@ pub trait Peaks {
     /// then smaller).
     fn strongest(&self, v: usize, u: f64, reach: f64, positive: bool) -> Option<Cand>;
     fn take(&mut self, c: &Cand);
-    /// Whether the point with this identity is taken.
-    fn is_taken(&self, id: usize) -> bool;
-    /// The point with this identity, to start a track from.
-    fn seed(&self, id: usize) -> Option<Cand>;
+    /// Whether the seed `id` is taken: a point's index, or a scan
+    /// position packed `v << 32 | u` (a response's).
+    fn is_taken(&self, id: u64) -> bool;
+    /// The point of seed `id`, to start a track from.
+    fn seed(&self, id: u64) -> Option<Cand>;
 }
 
 /// Peaks read from a response: local maxima of `|E|` along the scan above
@@ -144,26 +147,17 @@ impl<'a> ResponsePeaks<'a> {
             response: f32::from(self.sums[i]) * self.scale,
             z: k0 * self.inv_sigma[(self.tile_u[u] + self.tile_v[v]) as usize],
             id: i,
+            pix: u as u32,
         }
     }
 
-    /// The candidate of a start at image index `i` (an edge point's pixel).
-    pub fn start(&self, i: usize) -> Option<Cand> {
-        if i >= self.sums.len() || self.sums[i] == NONE {
+    /// The candidate at scan position `(u, v)` (an edge point's pixel).
+    pub fn start(&self, u: usize, v: usize) -> Option<Cand> {
+        if !(u >= 1 && u + 1 < self.len_u && v < self.nlines) {
             return None;
         }
-        let (u, v) = self.scan_pos(i);
-        (u >= 1 && u + 1 < self.len_u && v < self.nlines).then(|| self.cand(u, v, i))
-    }
-
-    /// The scan position of image index `i`.
-    #[inline]
-    fn scan_pos(&self, i: usize) -> (usize, usize) {
-        if self.step_u == 1 {
-            (i % self.step_v, i / self.step_v)
-        } else {
-            (i / self.step_u, i % self.step_u)
-        }
+        let i = self.index(u, v);
+        (self.sums[i] != NONE).then(|| self.cand(u, v, i))
     }
 
     /// The whole positions `u` whose peak may lie within `r` of `c`
@@ -229,19 +223,18 @@ impl Peaks for ResponsePeaks<'_> {
     }
 
     fn take(&mut self, c: &Cand) {
-        let (u, v) = self.scan_pos(c.id);
-        self.map.clear(u, v);
+        self.map.clear(c.pix as usize, c.v);
     }
 
-    fn is_taken(&self, i: usize) -> bool {
+    fn is_taken(&self, id: u64) -> bool {
         // Taken: a peak of the map that a track cleared (a start below
         // the map's threshold is never taken by a track).
-        let (u, v) = self.scan_pos(i);
+        let (u, v) = ((id & 0xFFFF_FFFF) as usize, (id >> 32) as usize);
         self.orig.is_set(u, v) && !self.map.is_set(u, v)
     }
 
-    fn seed(&self, i: usize) -> Option<Cand> {
-        self.start(i)
+    fn seed(&self, id: u64) -> Option<Cand> {
+        self.start((id & 0xFFFF_FFFF) as usize, (id >> 32) as usize)
     }
 }
 
@@ -350,6 +343,7 @@ impl PointPeaks<'_> {
             response: p.response,
             z: p.z,
             id: i,
+            pix: 0,
         }
     }
 
@@ -380,6 +374,7 @@ impl PointPeaks<'_> {
                 response: p.response,
                 z: p.z,
                 id: a + from + j,
+                pix: 0,
             })
     }
 }
@@ -415,11 +410,11 @@ impl Peaks for PointPeaks<'_> {
         self.used[c.id] = true;
     }
 
-    fn is_taken(&self, id: usize) -> bool {
-        self.used.get(id).copied().unwrap_or(true)
+    fn is_taken(&self, id: u64) -> bool {
+        self.used.get(id as usize).copied().unwrap_or(true)
     }
 
-    fn seed(&self, id: usize) -> Option<Cand> {
-        (id < self.pts.len()).then(|| self.point(id))
+    fn seed(&self, id: u64) -> Option<Cand> {
+        (id < self.pts.len() as u64).then(|| self.point(id as usize))
     }
 }

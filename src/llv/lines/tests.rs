@@ -208,7 +208,7 @@ fn reading_peaks_where_tracks_look_equals_listing_them_all() {
             }
             starts.sort_by(|a, b| a.v.cmp(&b.v).then(a.u.total_cmp(&b.u)));
             starts.dedup_by(|a, b| a.id == b.id);
-            let starts: Vec<u32> = starts.iter().map(|c| c.id as u32).collect();
+            let starts: Vec<u64> = starts.iter().map(|c| c.id as u64).collect();
             let nfa = nfa::Nfa::new(w, h, 4, p.search_width, p.track_sigmas);
             let mut plain = Vec::new();
             let mut t = Tracks::default();
