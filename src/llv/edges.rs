@@ -174,8 +174,8 @@ pub fn response(img: &GreyImage, dir: ScanDir, a: usize) -> Result<Response, Llv
 /// Reusable buffers of [`response_into`].
 #[derive(Clone, Debug, Default)]
 pub struct ResponseScratch {
-    /// Invalid-pixel counts (images with a validity mask).
-    counts: Vec<u32>,
+    /// Images with a validity mask.
+    mask: MaskBufs,
     /// One row of `i32` sums (`A` = 6, 7).
     wide: Vec<i32>,
 }
@@ -225,7 +225,7 @@ pub fn response_into(
         }
     }
     if let Some(mask) = img.valid_mask() {
-        mask_invalid(mask, w, h, dir, a, sums, &mut scratch.counts);
+        mask_invalid(mask, w, h, dir, a, sums, &mut scratch.mask);
     }
     Ok(())
 }
@@ -260,7 +260,75 @@ pub(crate) fn checked_input(img: &GreyImage, a: usize) -> Result<(usize, usize, 
 }
 
 /// Sets [`NONE`] wherever the kernel window touches an invalid pixel.
+///
+/// A lens-corrected image's valid pixels form one interval in every row
+/// (the image of the source's rectangle), so the usual case is done with
+/// fills: a horizontal response is none within `a` of each row's interval
+/// ends, a vertical one outside the intersection of the intervals of the
+/// `2a + 1` rows under its window. Rows with holes inside their interval
+/// (a mask from elsewhere) go through [`mask_invalid_plain`].
 pub(crate) fn mask_invalid(
+    mask: &[bool],
+    w: usize,
+    h: usize,
+    dir: ScanDir,
+    a: usize,
+    data: &mut [i16],
+    bufs: &mut MaskBufs,
+) {
+    if mask.len() != w * h || data.len() != w * h {
+        return;
+    }
+    // Per row: the first valid pixel, one past the last, and whether all
+    // between are valid (`lo == hi`: none valid).
+    let spans = &mut bufs.spans;
+    spans.clear();
+    for row in mask.chunks_exact(w) {
+        let lo = row.iter().position(|&v| v).unwrap_or(w);
+        let hi = row.iter().rposition(|&v| v).map_or(lo, |x| x + 1);
+        let whole = row[lo..hi].iter().all(|&v| v);
+        spans.push((lo, hi, whole));
+    }
+    if !spans.iter().all(|s| s.2) {
+        mask_invalid_plain(mask, w, h, dir, a, data, &mut bufs.counts);
+        return;
+    }
+    for (y, drow) in data.chunks_exact_mut(w).enumerate() {
+        // The valid outputs of row y: `lo..hi`.
+        let (lo, hi) = match dir {
+            ScanDir::Horizontal => {
+                let (l, r, _) = spans[y];
+                (
+                    if l == 0 { 0 } else { l + a },
+                    if r == w { w } else { r.saturating_sub(a) },
+                )
+            }
+            ScanDir::Vertical => {
+                let window = &spans[y.saturating_sub(a)..(y + a + 1).min(h)];
+                let l = window.iter().map(|s| s.0).max().unwrap_or(w);
+                let r = window.iter().map(|s| s.1).min().unwrap_or(0);
+                (l, r)
+            }
+        };
+        if lo >= hi {
+            drow.fill(NONE);
+        } else {
+            drow[..lo].fill(NONE);
+            drow[hi..].fill(NONE);
+        }
+    }
+}
+
+/// Buffers of [`mask_invalid`].
+#[derive(Clone, Debug, Default)]
+pub(crate) struct MaskBufs {
+    counts: Vec<u32>,
+    spans: Vec<(usize, usize, bool)>,
+}
+
+/// [`mask_invalid`] for any mask: a count of the invalid pixels under every
+/// window (the reference the interval case is tested against).
+pub(crate) fn mask_invalid_plain(
     mask: &[bool],
     w: usize,
     h: usize,

@@ -70,7 +70,7 @@ pub struct PhotoScratch {
     row: Vec<i32>,
     sum_row: Vec<i32>,
     best_row: Vec<i32>,
-    counts: Vec<u32>,
+    mask: edges::MaskBufs,
 }
 
 /// The response of several lightings of one view, per §2.6 (module doc).
@@ -134,29 +134,6 @@ pub fn combined_response_into(
     let terms = images.len() as u32 * if ambient.is_some() { 2 } else { 1 };
     let shift = row::shift(a, terms);
     out.reshape(w, h, dir, row::scale(a) * (1u32 << shift) as f32);
-    let inside = |x: usize, y: usize| match dir {
-        ScanDir::Horizontal => x >= a && x + a < w,
-        ScanDir::Vertical => y >= a && y + a < h,
-    };
-    // Noise levels from an even subsample of at most MEDIAN_SAMPLES pixels.
-    let stride = (w * h).div_ceil(MEDIAN_SAMPLES).max(1);
-    s.taus.clear();
-    for img in images {
-        s.samples.clear();
-        for k in (0..w * h).step_by(stride) {
-            let (x, y) = (k % w, k / w);
-            if inside(x, y) {
-                let mut v = sum_at(img.data(), w, x, y, dir, a);
-                if let Some(m) = ambient {
-                    v -= sum_at(m.data(), w, x, y, dir, a);
-                }
-                s.samples.push(v.abs());
-            }
-        }
-        let med = median(&mut s.samples);
-        s.taus
-            .push((f64::from(med) * p.noise_factor).round() as i32);
-    }
     for buf in [&mut s.amb_row, &mut s.row, &mut s.sum_row, &mut s.best_row] {
         buf.clear();
         buf.resize(w, 0);
@@ -165,6 +142,33 @@ pub fn combined_response_into(
         ScanDir::Horizontal => (0..h, a..w - a),
         ScanDir::Vertical => (a..h - a, 0..w),
     };
+    // Noise levels from about MEDIAN_SAMPLES samples: every second pixel
+    // of rows spread evenly over the valid band (whole rows through the
+    // row kernel; every second, as neighbours along a horizontal scan are
+    // correlated).
+    let per_row = cols.len().div_ceil(2).max(1);
+    let nrows = MEDIAN_SAMPLES.div_ceil(per_row).clamp(1, rows.len().max(1));
+    s.taus.clear();
+    for img in images {
+        s.samples.clear();
+        for k in 0..nrows {
+            let y = rows.start + (2 * k + 1) * rows.len() / (2 * nrows);
+            if !rows.contains(&y) {
+                continue;
+            }
+            if let Some(m) = ambient {
+                response_row(m.data(), w, y, dir, a, &mut s.amb_row);
+            }
+            response_row(img.data(), w, y, dir, a, &mut s.row);
+            for x in cols.clone().step_by(2) {
+                let amb = if ambient.is_some() { s.amb_row[x] } else { 0 };
+                s.samples.push((s.row[x] - amb).abs());
+            }
+        }
+        let med = median(&mut s.samples);
+        s.taus
+            .push((f64::from(med) * p.noise_factor).round() as i32);
+    }
     let sums = out.sums_mut();
     sums.fill(NONE);
     for y in rows {
@@ -173,54 +177,28 @@ pub fn combined_response_into(
         }
         for (i, img) in images.iter().enumerate() {
             response_row(img.data(), w, y, dir, a, &mut s.row);
-            let tau = s.taus[i];
             let c = cols.clone();
-            let (r, amb, sm, best) = (
+            combine(
+                (i == 0, ambient.is_some()),
                 &s.row[c.clone()],
                 &s.amb_row[c.clone()],
+                s.taus[i],
                 &mut s.sum_row[c.clone()],
                 &mut s.best_row[c],
             );
-            match (i == 0, ambient.is_some()) {
-                (true, true) => combine_row::<true, true>(r, amb, tau, sm, best),
-                (true, false) => combine_row::<true, false>(r, amb, tau, sm, best),
-                (false, true) => combine_row::<false, true>(r, amb, tau, sm, best),
-                (false, false) => combine_row::<false, false>(r, amb, tau, sm, best),
-            }
         }
         let c = cols.clone();
         let orow = &mut sums[y * w..(y + 1) * w][c.clone()];
-        for ((o, &m), &b) in orow
-            .iter_mut()
-            .zip(&s.sum_row[c.clone()])
-            .zip(&s.best_row[c])
-        {
-            let v = row::narrow_one(m, shift);
-            *o = if b < 0 { -v } else { v };
-        }
+        finish_row(orow, &s.sum_row[c.clone()], &s.best_row[c], shift);
     }
     // No combined response where any image's kernel touches an invalid
     // pixel.
     for img in images.iter().chain(ambient) {
         if let Some(mask) = img.valid_mask() {
-            edges::mask_invalid(mask, w, h, dir, a, sums, &mut s.counts);
+            edges::mask_invalid(mask, w, h, dir, a, sums, &mut s.mask);
         }
     }
     Ok(())
-}
-
-/// The exact kernel sum of one image at one pixel inside the valid band.
-fn sum_at(img: &[u8], w: usize, x: usize, y: usize, dir: ScanDir, a: usize) -> i32 {
-    let mut o = 0i32;
-    for s in 1..a {
-        let c = (6 * s * (a - s)) as i32;
-        let (hi, lo) = match dir {
-            ScanDir::Horizontal => (img[y * w + x + s], img[y * w + x - s]),
-            ScanDir::Vertical => (img[(y + s) * w + x], img[(y - s) * w + x]),
-        };
-        o += c * (i32::from(hi) - i32::from(lo));
-    }
-    o
 }
 
 /// One output row `y` of one image's sums into `out` (length `w`; only
@@ -234,6 +212,35 @@ fn response_row(img: &[u8], w: usize, y: usize, dir: ScanDir, a: usize, out: &mu
             }
         }
         ScanDir::Vertical => row::sums_i32(&row::Taps::vertical(img, w, y, a), a, out),
+    }
+}
+
+/// [`combine_row`] with the flags chosen at run time, compiled for AVX2 too
+/// (eight `i32` lanes) and picked at run time.
+#[multiversion::multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt", "x86_64+sse4.1"))]
+fn combine(
+    (first, sub): (bool, bool),
+    r: &[i32],
+    amb: &[i32],
+    tau: i32,
+    sum: &mut [i32],
+    best: &mut [i32],
+) {
+    match (first, sub) {
+        (true, true) => combine_row::<true, true>(r, amb, tau, sum, best),
+        (true, false) => combine_row::<true, false>(r, amb, tau, sum, best),
+        (false, true) => combine_row::<false, true>(r, amb, tau, sum, best),
+        (false, false) => combine_row::<false, false>(r, amb, tau, sum, best),
+    }
+}
+
+/// The combined row: each sum narrowed to the stored unit, with the sign
+/// of its strongest term.
+#[multiversion::multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt", "x86_64+sse4.1"))]
+fn finish_row(out: &mut [i16], sum: &[i32], best: &[i32], shift: u32) {
+    for ((o, &m), &b) in out.iter_mut().zip(sum).zip(best) {
+        let v = row::narrow_one(m, shift);
+        *o = if b < 0 { -v } else { v };
     }
 }
 

@@ -242,3 +242,42 @@ fn invalid_pixels_suppress_responses_around_them() {
     assert!(rv.get(16, 5).is_some() && rv.get(16, 15).is_some());
     assert!(rv.get(17, 10).is_some());
 }
+
+/// The interval fills of a lens-like mask (one valid span a row: an
+/// ellipse cut by the frame) mark exactly what the plain window count
+/// marks, both directions, every half-width; a mask with holes takes the
+/// plain path.
+#[test]
+fn interval_masks_equal_the_window_count() {
+    let (w, h) = (90, 70);
+    let ellipse: Vec<bool> = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f64 - 44.0, (i / w) as f64 - 30.0);
+            (x / 52.0).powi(2) + (y / 38.0).powi(2) <= 1.0
+        })
+        .collect();
+    let mut holed = ellipse.clone();
+    holed[35 * w + 40] = false;
+    for mask in [ellipse, holed] {
+        for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
+            for a in 3..=7 {
+                let (mut fast, mut plain) = (vec![7i16; w * h], vec![7i16; w * h]);
+                mask_invalid(&mask, w, h, dir, a, &mut fast, &mut MaskBufs::default());
+                mask_invalid_plain(&mask, w, h, dir, a, &mut plain, &mut Vec::new());
+                // The response itself leaves the image's border band none.
+                for y in 0..h {
+                    for x in 0..w {
+                        let border = match dir {
+                            ScanDir::Horizontal => x < a || x + a >= w,
+                            ScanDir::Vertical => y < a || y + a >= h,
+                        };
+                        if !border {
+                            let i = y * w + x;
+                            assert_eq!(fast[i], plain[i], "{dir:?} A {a} ({x}, {y})");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
