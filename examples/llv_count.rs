@@ -142,6 +142,8 @@ fn main() {
     // With TIME set, each run is timed and the fastest and median
     // microseconds are printed (a stage's own time, without the setup).
     let timed = std::env::var_os("TIME").is_some();
+    // With PLAIN set, the edge pass's peak test runs in plain code.
+    vss::llv::edges::peaks::plain_only(std::env::var_os("PLAIN").is_some());
     let mut times = Vec::with_capacity(n);
     for _ in 0..n {
         let t0 = std::time::Instant::now();

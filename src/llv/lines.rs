@@ -9,15 +9,17 @@
 //!
 //! The method, and where it leaves §3:
 //! - **Starts** are the edge points (`edges/peaks.rs`: peaks above
-//!   `edges.noise_sigmas` noise sigmas), in lexical order of the scan frame;
-//!   one already taken by a track is skipped.
+//!   `edges.noise_sigmas` noise sigmas), taken at the pixels the edge pass
+//!   found them at, in lexical order of the scan frame; one already taken
+//!   by a track is skipped.
 //! - **Points** a track takes are peaks of the start's polarity above
 //!   `lines.track_sigmas` noise sigmas — fewer sigmas than a start needs, so
-//!   a weak edge is followed once it is found. In the pipeline they are read
-//!   from the response where the track looks ([`source::ResponsePeaks`]):
-//!   weak peaks are never listed, and noise is never followed from a start
-//!   that has no successor. From edge points alone ([`extract`]: edge files)
-//!   every point is a candidate.
+//!   a weak edge is followed once it is found. In the pipeline they are the
+//!   bits of the peak map the edge pass made in the same pass as the starts
+//!   ([`PeakMap`], [`source::ResponsePeaks`]): a search window is a word of
+//!   it, and a point's subpixel position, response and noise sigmas are
+//!   read from the response only for the peaks in the window. From edge
+//!   points alone ([`extract`]: edge files) every point is a candidate.
 //! - **First step**: the strongest peak of the polarity on the next scan line
 //!   within `search_width + cot(min_scan_angle)` (every slope the angle test
 //!   admits), else on the next `max_gap` lines; no successor at all, no

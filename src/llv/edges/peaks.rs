@@ -16,13 +16,24 @@
 //! noise, `M` only limits clutter (texture, a pattern) and noise is never
 //! promoted; with the default 3.5 σ_r a tile of pure noise keeps about 4
 //! points in 10 000 pixels. Edge points are where lines *start*: the line
-//! extractor follows them through weaker peaks, which it tests where it
-//! looks (`lines/source.rs`), so the threshold here can be high, and no
-//! list or map of the weaker peaks is made.
+//! extractor follows them through weaker peaks, so the threshold here can
+//! be high.
 //!
-//! The test runs sixteen pixels at a time (`wide`: SSE2 or NEON, a scalar
-//! fallback elsewhere), the compares' sign bits taken at once; at 3.5 σ
-//! candidates are rare, so the rest is plain code.
+//! One pass finds both: the edge points' candidates and the peak map the
+//! line extractor follows ([`PeakMap`]: every peak above its lower
+//! threshold, a bit per pixel and polarity). Per row, the magnitudes are
+//! computed once into a row padded to whole words; the test runs 32 pixels
+//! at a time with AVX2 where the processor has it (`pulp`, chosen at run
+//! time, safe intrinsics), and the compares' sign bits (movemask) are the
+//! map's words and the candidates' bits as they are; elsewhere the same
+//! test runs in plain code, which is also the reference the tests compare
+//! the lanes with. The candidates above 3.5 σ are rare, so what follows is
+//! plain code.
+//!
+//! Why one pass and bit masks: a call per peak to fill a map (about ten
+//! thousand a direction), a second pass for the edge points, or a test of
+//! pixel after pixel where a track looks each cost more than this pass
+//! does in all; `docs/performance.md` has the measurements.
 
 use super::{NoiseMap, Response, key};
 use crate::llv::params::EdgeParams;
@@ -611,7 +622,22 @@ type Simd = Option<pulp::x86::V3>;
 #[cfg(not(target_arch = "x86_64"))]
 type Simd = Option<()>;
 
+/// Set to run the peak test in plain code even where AVX2 is there: for
+/// measuring what the lanes save (`PLAIN=1 TIME=1 llv_count peaks`).
+static PLAIN_ONLY: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Runs the peak test in plain code from now on (`true`), or with AVX2
+/// where the processor has it (`false`, the default): a switch for
+/// benchmarks, which give the same results either way.
+#[doc(hidden)]
+pub fn plain_only(on: bool) {
+    PLAIN_ONLY.store(on, std::sync::atomic::Ordering::Relaxed);
+}
+
 fn simd() -> Simd {
+    if PLAIN_ONLY.load(std::sync::atomic::Ordering::Relaxed) {
+        return None;
+    }
     #[cfg(target_arch = "x86_64")]
     {
         pulp::x86::V3::try_new()
@@ -716,21 +742,21 @@ fn avx2_bits(a: Avx2, x: V, y: V) -> u32 {
 }
 
 /// The masks of [`row_masks`] for one block of 32 positions, in plain
-/// code.
+/// code (branch-free: no compare's outcome is guessed).
 fn row_masks_plain([lo, mid, hi]: [&[i16]; 3], sign: &[i16], thr: &[i16], trk: &[i16]) -> [u32; 3] {
-    let mut out = [0u32; 3];
-    for j in 0..mid.len().min(32) {
+    let (mut st, mut pos, mut neg) = (0u32, 0u32, 0u32);
+    let n = mid.len().min(32);
+    let (lo, hi, sign, thr, trk) = (&lo[..n], &hi[..n], &sign[..n], &thr[..n], &trk[..n]);
+    for j in 0..n {
         let k = mid[j];
-        if k > lo[j] && k >= hi[j] && k <= REAL {
-            if k > thr[j] {
-                out[0] |= 1 << j;
-            }
-            if k > trk[j] {
-                out[if sign[j] < 0 { 2 } else { 1 }] |= 1 << j;
-            }
-        }
+        let peak = (k > lo[j]) & (k >= hi[j]) & (k <= REAL);
+        let tr = peak & (k > trk[j]);
+        let ng = tr & (sign[j] < 0);
+        st |= u32::from(peak & (k > thr[j])) << j;
+        pos |= u32::from(tr & !ng) << j;
+        neg |= u32::from(ng) << j;
     }
-    out
+    [st, pos, neg]
 }
 
 /// [`candidates`] in plain code, one pixel and tile at a time: the
@@ -939,7 +965,11 @@ mod tests {
             let mask: Vec<bool> = (0..w * h).map(|i| i % 97 != 5).collect();
             img.set_valid_mask(Some(mask)).unwrap();
             for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
-                for a in [4, 7] {
+                for (a, plain) in [(4, false), (7, false), (4, true)] {
+                    // (`plain`: the fallback for processors without AVX2,
+                    // which other tests may meet meanwhile: the results
+                    // are the same either way.)
+                    plain_only(plain);
                     let r = response(&img, dir, a).unwrap();
                     let noise = NoiseMap::estimate(&r);
                     let (nx, ny) = noise.tiles();
@@ -951,12 +981,13 @@ mod tests {
                         .max()
                         .unwrap_or(0);
                     let thr: Vec<i32> = (0..nx * ny).map(|t| top / 20 + 7 * t as i32).collect();
-                    let (mut fast, mut plain) = (Vec::new(), Vec::new());
+                    let (mut fast, mut reference) = (Vec::new(), Vec::new());
                     candidates(&r, &noise, &thr, &mut fast);
-                    candidates_plain(&r, &noise, &thr, &mut plain);
+                    plain_only(false);
+                    candidates_plain(&r, &noise, &thr, &mut reference);
                     // (A = 7 leaves a 16-pixel image almost no response.)
-                    assert!(!plain.is_empty() || (a == 7 && w.min(h) < 20));
-                    assert_eq!(fast, plain, "{w}x{h} {dir:?} A {a}");
+                    assert!(!reference.is_empty() || (a == 7 && w.min(h) < 20));
+                    assert_eq!(fast, reference, "{w}x{h} {dir:?} A {a} plain {plain}");
                 }
             }
         }

@@ -1,5 +1,5 @@
-//! Where the tracker finds its next point: the peaks of a response, read
-//! where it looks ([`ResponsePeaks`], the pipeline), or a set of edge
+//! Where the tracker finds its next point: the peaks of a response, from the
+//! edge pass's peak map ([`ResponsePeaks`], the pipeline), or a set of edge
 //! points alone ([`PointPeaks`], edge files and hand-made point sets).
 //!
 //! Both work in scan coordinates `(u, v)`: `u` along the scan, `v` the scan
