@@ -10,15 +10,19 @@
 //! Instructions per run = (total at N = 15 − total at N = 5) / 10, which
 //! takes out the scene's rendering and the warm-up. With `TIME=1` in the
 //! environment each run is timed and the fastest and median are printed
-//! (`TIME=1 llv_count pipeline 500`). Under valgrind the AVX2 paths are
-//! not taken (its CPU lacks features they need): count instructions for
-//! the plain paths, time the machine's own. Stages: `pipeline`
-//! (edges, lines, CONNECT; no lens), `pipeline2` (the same with a thread for
-//! each scan direction: time it, its instruction count means little),
-//! `edges` (response, noise scale and edge points, both directions),
-//! `response`, `noise`, `peaks`, `lines`, `connect`, `five` (four lightings and the ambient image to
-//! lines); `scene FILE.pgm` writes
-//! the scene.
+//! (`TIME=1 llv_count pipeline 500`); with `PLAIN=1` as well, the edge
+//! pass's peak test runs in plain code instead of AVX2 lanes. Under
+//! valgrind the AVX2 paths are not taken (its CPU lacks features they
+//! need): count instructions for the plain paths, time the machine's own.
+//!
+//! Stages: `pipeline` (edges, lines, CONNECT; no lens), `pipelinelens` (the
+//! same after lens correction from a precomputed map), `pipeline2` (no
+//! lens, a thread for each scan direction: time it, its instruction count
+//! means little), `edges` (response, noise scale and edge points, both
+//! directions), `response`, `noise`, `peaks` (the peak map and the edge
+//! points, as two passes), `lines` (`linesh`, `linesv`: one direction),
+//! `connect`, `lens` (the correction alone), `five` (four lightings and the
+//! ambient image to lines); `scene FILE.pgm` writes the scene.
 
 use vss::llv::connect::{ConnectScratch, connect_into};
 use vss::llv::edges::{
