@@ -1,4 +1,4 @@
-//! Runs one LLV stage N times on the bench scene (512², noise σ 2, seed 42),
+//! Runs one LLV stage N times on the bench scene (512² or `SIZE`², noise σ 2, seed 42),
 //! for instruction counts that do not depend on the machine's other load:
 //!
 //! ```text
@@ -44,7 +44,16 @@ fn main() {
         );
         std::process::exit(2);
     };
-    let img = llv_scene::scene(512, 512, 2.0, 42);
+    // With SIZE set (say `SIZE=2048`), the scene and the lens are that size
+    // instead of 512² (the lens scaled as `benches/llv.rs` scales it).
+    let size: usize = match std::env::var("SIZE") {
+        Ok(v) => v.parse().unwrap_or_else(|_| {
+            eprintln!("SIZE must be a whole number, not {v:?}");
+            std::process::exit(2);
+        }),
+        Err(_) => 512,
+    };
+    let img = llv_scene::scene(size, size, 2.0, 42);
     if stage == "scene" {
         // Writes the bench scene as a binary PGM to `N` (a path here).
         let (w, h) = img.size();
@@ -110,7 +119,7 @@ fn main() {
     // noise and the ambient image at a fifth of the brightness, as
     // `benches/llv.rs` has them.
     let lit: Vec<_> = (0..4)
-        .map(|k| llv_scene::scene(512, 512, 2.0, 42 + k))
+        .map(|k| llv_scene::scene(size, size, 2.0, 42 + k))
         .collect();
     let (w, h) = img.size();
     let amb = vss::llv::GreyImage::new(w, h, img.data().iter().map(|&v| v / 5).collect())
@@ -123,17 +132,18 @@ fn main() {
     let mut five = Workspace::new();
     // The bench's distorting camera (`benches/llv.rs`), for `lens` and
     // `pipelinelens`.
+    let scale = 512.0 / size as f64;
     let lens = vss::llv::lens::LensMap::new(
         &vss::llv::lens::CameraModel {
-            cx: 259.0,
-            cy: 254.0,
-            sx: 0.0086,
-            sy: 0.0083,
+            cx: size as f64 / 2.0 + 3.0,
+            cy: size as f64 / 2.0 - 2.0,
+            sx: 0.0086 * scale,
+            sy: 0.0083 * scale,
             f: 8.5,
             distortion: Some([-1.2e-3, 1.0e-4, -8.0e-5, 5.0e-5, 2.0e-5]),
         },
-        512,
-        512,
+        size,
+        size,
     );
     let mut corrected = vss::llv::GreyImage::default();
     let lens_input = Input {
