@@ -22,7 +22,9 @@ ELSED: the same images, the same run, the same scorer, one thread each.
 Options: --vss BIN (default target/release/vss), --dir DIR (default
 /tmp/vss-compare), --scenes N (12), --size N (512), --runs N (20),
 --family cubes|yard|all (all), --skip-export (reuse DIR's images, re-run
-the peers and the scoring).
+the peers and the scoring), --rounds K (1: time vss and the peers K times
+in turn and keep each image's fastest, for a shared machine whose speed
+drifts while the run goes on).
 
 The older use, timing the three on one image, still works:
 
@@ -128,6 +130,35 @@ def run_peers(root, runs, elsed):
         print(f"{family}/{level}: peers done", file=sys.stderr)
 
 
+def keep_fastest(root, best):
+    """Folds this round's times files into `best` (per file and scene, the
+    smallest fastest and median so far) and writes the files back with them:
+    rounds alternate vss and its peers, so a slow spell of a shared machine
+    lands on each of them in some round and not on the figure kept."""
+    for dirpath, _, files in os.walk(root):
+        for name in files:
+            if not name.endswith(".times"):
+                continue
+            path = os.path.join(dirpath, name)
+            with open(path) as f:
+                lines = f.read().splitlines()
+            head = [l for l in lines if l.startswith("#")]
+            kept = best.setdefault(path, {})
+            for line in lines:
+                if line.startswith("#") or not line.strip():
+                    continue
+                stem, fastest, median, n = line.split()
+                old = kept.get(stem)
+                fastest, median = float(fastest), float(median)
+                if old:
+                    fastest, median = min(fastest, old[0]), min(median, old[1])
+                kept[stem] = (fastest, median, n)
+            with open(path, "w") as f:
+                f.write("\n".join(head) + "\n")
+                for stem, (fastest, median, n) in kept.items():
+                    f.write(f"{stem} {fastest:.4f} {median:.4f} {n}\n")
+
+
 def compare(argv):
     p = argparse.ArgumentParser(prog="opencv_lines.py compare")
     p.add_argument("--vss", default="target/release/vss")
@@ -138,16 +169,23 @@ def compare(argv):
     p.add_argument("--family", default="all")
     p.add_argument("--elsed", default=None, help="the ELSED driver (benches/elsed_bench.cpp)")
     p.add_argument("--skip-export", action="store_true")
+    p.add_argument("--rounds", type=int, default=1,
+                   help="time everything this many times, alternating, and keep each image's fastest")
     a = p.parse_args(argv)
     cv2.setNumThreads(1)
     print(f"OpenCV {cv2.__version__}, one thread; vss {a.vss}", file=sys.stderr)
-    if not a.skip_export:
-        subprocess.run(
-            [a.vss, "selftest", "--export", a.dir, "--family", a.family,
-             "--scenes", str(a.scenes), "--size", str(a.size), "--runs", str(a.runs)],
-            check=True,
-        )
-    run_peers(a.dir, a.runs, a.elsed)
+    best = {}
+    for r in range(max(a.rounds, 1)):
+        if not a.skip_export:
+            subprocess.run(
+                [a.vss, "selftest", "--export", a.dir, "--family", a.family,
+                 "--scenes", str(a.scenes), "--size", str(a.size), "--runs", str(a.runs)],
+                check=True,
+            )
+        run_peers(a.dir, a.runs, a.elsed)
+        keep_fastest(a.dir, best)
+        if a.rounds > 1:
+            print(f"round {r + 1} of {a.rounds} done", file=sys.stderr)
     table = subprocess.run([a.vss, "selftest", "--score", a.dir], check=True,
                            capture_output=True, text=True).stdout
     print(table, end="")
