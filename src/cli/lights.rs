@@ -21,7 +21,11 @@ pub enum Action {
     On,
     /// Switch every relay off.
     Off,
-    /// Switch to a lighting configuration (a letter of the profile's [[lighting]]).
+    // (The help is an attribute, not a doc comment, so that rustdoc does
+    // not read `[[lighting]]` as a link.)
+    #[command(
+        about = "Switch to a lighting configuration (a letter of the profile's [[lighting]])"
+    )]
     Set { config: char },
     /// Show which lights are on.
     Status,

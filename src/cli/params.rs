@@ -47,8 +47,11 @@ pub enum Cmd {
     Import {
         /// The parameter file.
         file: PathBuf,
-        /// Write the changed profile here (default: print the [llv] tables).
-        #[arg(long, value_name = "FILE")]
+        #[arg(
+            long,
+            value_name = "FILE",
+            help = "Write the changed profile here (default: print the [llv] tables)"
+        )]
         out: Option<PathBuf>,
     },
 }

@@ -87,7 +87,7 @@ const MIN_SPREAD: f64 = 0.25;
 /// Whether `merged` is one edge rather than two distinct near-collinear
 /// ones: the length-weighted RMS distance of the parts' endpoints from the
 /// merged line is within the larger of the parts' own residuals plus
-/// [`MIN_SPREAD`]. Two pieces of one edge lie on its line to within their
+/// `MIN_SPREAD`. Two pieces of one edge lie on its line to within their
 /// fits' errors; two parallel edges a pixel apart are half a pixel off the
 /// line between them, whatever their environments and angles allow.
 pub fn one_edge(s1: &Segment, s2: &Segment, merged: &Segment) -> bool {

@@ -49,7 +49,7 @@ pub const MIN_CORNER_ANGLE_DEG: f64 = 15.0;
 /// intersection by more than the gap it would close.
 pub const MIN_LENGTH_RADII: f64 = 2.0;
 
-/// Largest inward move of an endpoint, in radii (see [`keeps_direction`]).
+/// Largest inward move of an endpoint, in radii (see `keeps_direction`).
 pub const MAX_INWARD_RADII: f64 = 0.25;
 
 /// One endpoint: line index and which end (false = `a`, true = `b`).

@@ -36,7 +36,7 @@
 //! image all along a straight edge between two faces.
 //!
 //! Peaks, subpixel positions and the adaptive threshold then run unchanged
-//! through [`edges::peaks`]. A pixel with no response (near the border or
+//! through [`edges::peaks()`]. A pixel with no response (near the border or
 //! an invalid pixel) in any image has no combined response.
 //!
 //! **Whole numbers throughout.** Every image's sums, `τ_i` (rounded to a
@@ -78,7 +78,7 @@ pub struct PhotoScratch {
 /// `images` are the lit images (at least one); `ambient`, if given, is the
 /// ambient-only image of the same view, subtracted from each. All must share
 /// one size ([`LlvError::SizeMismatch`] otherwise). The result goes through
-/// [`edges::peaks`] like a single image's response.
+/// [`edges::peaks()`] like a single image's response.
 pub fn combined_response(
     images: &[GreyImage],
     ambient: Option<&GreyImage>,

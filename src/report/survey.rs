@@ -1,5 +1,5 @@
 //! The survey report of a session, whoever asks for it: `vss report` and
-//! the console's export both call [`write`], so they write the same pages.
+//! the console's export both call [`write()`], so they write the same pages.
 //!
 //! [`image_report`] gathers what the report shows about an image: its grey
 //! images, edge files, raw and connected lines (with attributes), and from

@@ -84,7 +84,7 @@ pub(crate) struct Peak {
 /// for every peak along the scan above the tracking threshold (the floor
 /// and a number of noise sigmas of its tile), in image order, each row
 /// starting on a word. A track reads the peaks of its search window on the
-/// next scan line from it ([`PeakMap::window`]): one word for a horizontal
+/// next scan line from it (`PeakMap::window`): one word for a horizontal
 /// scan, a bit a row for a vertical one.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PeakMap {

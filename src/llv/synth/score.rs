@@ -67,9 +67,9 @@ pub struct Metrics {
     pub supporting: usize,
     /// Detected segments in all.
     pub detected: usize,
-    /// Recall of the true edges of contrast ≥ [`STRONG`].
+    /// Recall of the true edges of contrast ≥ `STRONG` (30 grey levels).
     pub recall_strong: f64,
-    /// Recall of the parts of true edges with a parallel one [`CLOSE`] px away.
+    /// Recall of the parts of true edges with a parallel one `CLOSE` px away.
     pub recall_close: f64,
     /// Off-angle share of the detected length (see the module doc).
     pub off_angle: f64,

@@ -9,7 +9,7 @@
 //! few byte times at the baud rate (at least [`INTER_BYTE_FLOOR`]): a block
 //! that stops short has lost bytes and is asked for again at once — just
 //! that block, not a re-sync and a reply timeout as before (a lossy line
-//! took 78 s a frame at drop = 1e-3). [`DEPTH`] READs are kept on their
+//! took 78 s a frame at drop = 1e-3). `DEPTH` READs are kept on their
 //! way, so the grabber has the next request while it answers one: the line
 //! does not go quiet between blocks, and a block that lost bytes runs into
 //! the next DATA line — its CRC fails, the bytes after its first are looked
@@ -66,7 +66,7 @@ const RELAX_AFTER: u32 = 256;
 /// Junk bytes kept while looking for a reply line.
 const MAX_SCAN: usize = 1 << 20;
 
-/// The inter-byte timeout for a line at `baud`: [`INTER_BYTE_BYTES`] byte
+/// The inter-byte timeout for a line at `baud`: `INTER_BYTE_BYTES` byte
 /// times (10 bits each, 8N1), at least [`INTER_BYTE_FLOOR`].
 pub fn inter_byte_for(baud: u32) -> Duration {
     let byte = 10.0 / f64::from(baud.max(1));
