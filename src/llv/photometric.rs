@@ -39,6 +39,16 @@
 //! through [`edges::peaks()`]. A pixel with no response (near the border or
 //! an invalid pixel) in any image has no combined response.
 //!
+//! **What the noise-measured thresholds see.** The combination already
+//! takes each image's noise level off, so the combined response is 0
+//! wherever no image beats it, and the noise scale of its tiles
+//! (`edges/noise.rs`, a median) is 0: `edges.noise_sigmas`,
+//! `lines.track_sigmas` and the a-contrario test (`lines.log_nfa`) then let
+//! everything above the floor `T` through, and `noise_factor` is the
+//! threshold that acts. A noise model for the combined response, so that
+//! those three mean the same with several lightings as with one, is not
+//! made yet.
+//!
 //! **Whole numbers throughout.** Every image's sums, `τ_i` (rounded to a
 //! whole sum) and the combination are computed in `i32`, row by row (the
 //! rows stay in the first-level cache and the output is written once),
