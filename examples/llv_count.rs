@@ -194,29 +194,6 @@ fn main() {
                     check += e.points.len();
                 }
             }
-            "lines" => {
-                for (r, nm, m, e, st, out) in [
-                    (
-                        &warm.response_h,
-                        &warm.noise_h,
-                        &wmh,
-                        &warm.edges_h,
-                        &wsh,
-                        &mut lh,
-                    ),
-                    (
-                        &warm.response_v,
-                        &warm.noise_v,
-                        &wmv,
-                        &warm.edges_v,
-                        &wsv,
-                        &mut lv,
-                    ),
-                ] {
-                    track_into(r, nm, m, e, st, p.edges.floor, a, &p.lines, out, &mut ls);
-                }
-                check += lh.len() + lv.len();
-            }
             "lens" => {
                 vss::llv::lens::correct_into(&img, &lens, &mut corrected).expect("same size");
                 check += corrected.data()[1000] as usize;
@@ -225,28 +202,34 @@ fn main() {
                 lensed.run(&lens_input, &p).expect("the scene runs");
                 check += lensed.outputs().lines.len();
             }
-            "linesh" | "linesv" => {
-                let (r, nm, m, e, st, out) = if stage == "linesh" {
-                    (
-                        &warm.response_h,
-                        &warm.noise_h,
-                        &wmh,
-                        &warm.edges_h,
-                        &wsh,
-                        &mut lh,
-                    )
-                } else {
-                    (
-                        &warm.response_v,
-                        &warm.noise_v,
-                        &wmv,
-                        &warm.edges_v,
-                        &wsv,
-                        &mut lv,
-                    )
-                };
-                track_into(r, nm, m, e, st, p.edges.floor, a, &p.lines, out, &mut ls);
-                check += out.len();
+            "lines" | "linesh" | "linesv" => {
+                // Both directions, or the one named.
+                for horizontal in [true, false] {
+                    if stage == if horizontal { "linesv" } else { "linesh" } {
+                        continue;
+                    }
+                    let (r, nm, m, e, st, out) = if horizontal {
+                        (
+                            &warm.response_h,
+                            &warm.noise_h,
+                            &wmh,
+                            &warm.edges_h,
+                            &wsh,
+                            &mut lh,
+                        )
+                    } else {
+                        (
+                            &warm.response_v,
+                            &warm.noise_v,
+                            &wmv,
+                            &warm.edges_v,
+                            &wsv,
+                            &mut lv,
+                        )
+                    };
+                    track_into(r, nm, m, e, st, p.edges.floor, a, &p.lines, out, &mut ls);
+                    check += out.len();
+                }
             }
             "connect" => {
                 connect_into(&warm.lines_raw, &p.connect, &mut joined, &mut cs);

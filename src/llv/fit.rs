@@ -186,18 +186,7 @@ impl LineFit {
             return None;
         }
         let (s11, s22, s12) = self.scatter();
-        let half = 0.5 * (s11 - s22);
-        // `sqrt` of the sum rather than `hypot`: the scatter entries are far
-        // from overflow, and `hypot` is a libm call the extractor made after
-        // every point.
-        let lmax = 0.5 * (s11 + s22) + (half * half + s12 * s12).sqrt();
-        let v1 = (s12, lmax - s11);
-        let v2 = (lmax - s22, s12);
-        let n1 = v1.0 * v1.0 + v1.1 * v1.1;
-        let n2 = v2.0 * v2.0 + v2.1 * v2.1;
-        let v = if n1 >= n2 { v1 } else { v2 };
-        let n = n1.max(n2);
-        (n > 1e-24 * (1.0 + lmax * lmax) && n.is_finite()).then_some(v)
+        axis_of(s11, s22, s12)
     }
 
     /// The mean and [`LineFit::major_axis`] together, with one division
@@ -213,16 +202,8 @@ impl LineFit {
         let s11 = self.sxx - self.sx * mx;
         let s22 = self.syy - self.sy * my;
         let s12 = self.sxy - self.sx * my;
-        let half = 0.5 * (s11 - s22);
-        let lmax = 0.5 * (s11 + s22) + (half * half + s12 * s12).sqrt();
-        let v1 = (s12, lmax - s11);
-        let v2 = (lmax - s22, s12);
-        let n1 = v1.0 * v1.0 + v1.1 * v1.1;
-        let n2 = v2.0 * v2.0 + v2.1 * v2.1;
-        let v = if n1 >= n2 { v1 } else { v2 };
-        let n = n1.max(n2);
         let mean = Point::new(self.origin.x + mx, self.origin.y + my);
-        (n > 1e-24 * (1.0 + lmax * lmax) && n.is_finite()).then_some((mean, v))
+        axis_of(s11, s22, s12).map(|v| (mean, v))
     }
 
     /// Projects `p` onto the fitted line (the point itself without a line).
@@ -261,6 +242,24 @@ impl LineFit {
     pub fn rms_residual(&self) -> f64 {
         self.mean_square_residual().sqrt()
     }
+}
+
+/// The major axis of the centred scatter matrix `[[s11, s12], [s12, s22]]`
+/// (unnormalised), or none where the points are too close to one.
+#[inline]
+fn axis_of(s11: f64, s22: f64, s12: f64) -> Option<(f64, f64)> {
+    let half = 0.5 * (s11 - s22);
+    // `sqrt` of the sum rather than `hypot`: the scatter entries are far
+    // from overflow, and `hypot` is a libm call the extractor made after
+    // every point.
+    let lmax = 0.5 * (s11 + s22) + (half * half + s12 * s12).sqrt();
+    let v1 = (s12, lmax - s11);
+    let v2 = (lmax - s22, s12);
+    let n1 = v1.0 * v1.0 + v1.1 * v1.1;
+    let n2 = v2.0 * v2.0 + v2.1 * v2.1;
+    let v = if n1 >= n2 { v1 } else { v2 };
+    let n = n1.max(n2);
+    (n > 1e-24 * (1.0 + lmax * lmax) && n.is_finite()).then_some(v)
 }
 
 #[cfg(test)]
