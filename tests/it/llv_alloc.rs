@@ -139,28 +139,37 @@ fn a_warm_workspace_does_not_allocate() {
         llv_scene::scene(n, n, 5.0, 3),
     ];
     let map = camera(n);
-    let p = Params::default();
-    let input = |k: usize| Input {
-        images: std::slice::from_ref(&images[k]),
-        ambient: None,
-        lens: Some(&map),
-    };
-    let mut ws = Workspace::new();
-    // Warm up on the busiest image so every buffer reaches its size.
-    for k in [2, 0, 1] {
-        ws.run(&input(k), &p).unwrap();
-    }
-    let lines_before = ws.outputs().lines.len();
-    assert!(lines_before > 10, "the scene has lines");
-    let (count, bytes) = allocations(|| {
-        for k in [0, 1, 0, 1] {
+    // The defaults, and one point a scan line: every region then has more
+    // candidates than it keeps, and the limits are selected.
+    let mut crowded = Params::default();
+    crowded.edges.per_region = 1;
+    for p in [Params::default(), crowded] {
+        let input = |k: usize| Input {
+            images: std::slice::from_ref(&images[k]),
+            ambient: None,
+            lens: Some(&map),
+        };
+        let mut ws = Workspace::new();
+        // Warm up on the busiest image so every buffer reaches its size.
+        for k in [2, 0, 1] {
             ws.run(&input(k), &p).unwrap();
         }
-    });
-    assert_eq!(count, 0, "{count} allocations ({bytes} bytes) in warm runs");
-    let corrected = &ws.outputs().corrected;
-    assert!(
-        corrected.len() == 1 && corrected[0].valid_mask().is_some(),
-        "lens correction ran, with invalid corners"
-    );
+        let lines_before = ws.outputs().lines.len();
+        assert!(lines_before > 10, "the scene has lines");
+        let (count, bytes) = allocations(|| {
+            for k in [0, 1, 0, 1] {
+                ws.run(&input(k), &p).unwrap();
+            }
+        });
+        assert_eq!(
+            count, 0,
+            "{count} allocations ({bytes} bytes) in warm runs, M = {}",
+            p.edges.per_region
+        );
+        let corrected = &ws.outputs().corrected;
+        assert!(
+            corrected.len() == 1 && corrected[0].valid_mask().is_some(),
+            "lens correction ran, with invalid corners"
+        );
+    }
 }

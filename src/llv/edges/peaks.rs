@@ -61,8 +61,10 @@ pub struct PeakScratch {
     /// Per region: candidate count, then the smallest key kept.
     count: Vec<u32>,
     lim: Vec<i16>,
-    /// Candidates' keys grouped by region (regions with more than `M`).
+    /// Candidates' keys grouped by region (regions with more than `M`):
+    /// where each region's start, and where its next key goes.
     start: Vec<u32>,
+    fill: Vec<u32>,
     grouped: Vec<i16>,
     noise: super::NoiseScratch,
 }
@@ -616,12 +618,12 @@ fn region_limits(
     }
     s.grouped.clear();
     s.grouped.resize(at as usize, 0);
-    let mut fill = s.start.clone();
+    s.fill.clone_from(&s.start);
     for c in cand {
         let r = region(c);
         if s.count[r] as usize > m {
-            s.grouped[fill[r] as usize] = c.key;
-            fill[r] += 1;
+            s.grouped[s.fill[r] as usize] = c.key;
+            s.fill[r] += 1;
         }
     }
     for r in 0..nreg {
