@@ -99,16 +99,20 @@ impl NoiseMap {
     /// The tile of pixel `(x, y)` (clamped into the image).
     #[inline]
     pub fn tile_of(&self, x: usize, y: usize) -> usize {
-        let tx = (x / self.tw).min(self.nx - 1);
-        let ty = (y / self.th).min(self.ny - 1);
-        ty * self.nx + tx
+        self.row_of(y) + self.column_of(x)
+    }
+
+    /// The tile column of image column `x` (clamped into the map).
+    #[inline]
+    fn column_of(&self, x: usize) -> usize {
+        (x / self.tw.max(1)).min(self.nx.max(1) - 1)
     }
 
     /// The tile column of every image column `0..w` into `out` (the tile
-    /// of `(x, y)` is `row_of(y) + out[x]`; clamped into the map).
+    /// of `(x, y)` is `row_of(y) + out[x]`).
     pub fn columns_into(&self, w: usize, out: &mut Vec<u32>) {
         out.clear();
-        out.extend((0..w).map(|x| ((x / self.tw.max(1)).min(self.nx.max(1) - 1)) as u32));
+        out.extend((0..w).map(|x| self.column_of(x) as u32));
     }
 
     /// The first tile of the row of tiles of image row `y`.
