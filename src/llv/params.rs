@@ -217,12 +217,11 @@ params! {
         /// Edge points must exceed this many times the noise scale of the
         /// response in their tile (its robust standard deviation, estimated
         /// from the image; `edges/noise.rs`). 0 switches the test off.
-        /// Several lightings: their combined response is 0 wherever no
-        /// image beats its `noise_factor` level, so its tiles' noise scale
-        /// is 0 and `noise_factor` and the floor decide instead.
+        /// Several lightings: sigmas of the noise model of their combined
+        /// response (`photometric.rs`), which means the same.
         noise_sigmas: f64 = 3.5,
             "σ", 0.0..=20.0, step 0.25,
-            "edge points must beat this many noise sigmas of their tile (one lighting; several: noise_factor)";
+            "edge points must beat this many noise sigmas of their tile";
         /// Threads for the two scan directions (edges and lines; 1 or 2).
         /// The results are the same.
         threads: u32 = 1,
@@ -262,19 +261,16 @@ params! {
             "lines whose mean |edge response| is below this are noise; 0 is off";
         /// Points a line takes after its start must exceed this many noise
         /// sigmas of their tile (fewer than an edge point needs: a weak
-        /// stretch of an edge is followed once the edge is found). One
-        /// lighting only, as `edges.noise_sigmas`.
+        /// stretch of an edge is followed once the edge is found).
         track_sigmas: f64 = 2.0,
             "σ", 0.0..=20.0, step 0.25,
-            "points a line follows must beat this many noise sigmas (one lighting)";
+            "points a line follows must beat this many noise sigmas";
         /// A-contrario significance: a segment is kept when noise alone
         /// would give fewer than `10^log_nfa` segments as good in the image
-        /// (`lines/nfa.rs`). 0: one false segment per image at most. One
-        /// lighting only: a combined response has no noise scale to test
-        /// against, and every piece passes.
+        /// (`lines/nfa.rs`). 0: one false segment per image at most.
         log_nfa: f64 = 0.0,
             "log10", -20.0..=20.0, step 1.0,
-            "keep segments whose log10 number of false alarms is below this (one lighting)";
+            "keep segments whose log10 number of false alarms is below this";
     }
 
     /// CONNECT, the automatic post-processing (llv.md §4), and the corner closing

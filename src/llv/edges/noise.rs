@@ -57,6 +57,9 @@ pub struct NoiseMap {
     sigma: Vec<f32>,
     /// The median of the tiles' estimates (0 if none had samples).
     global: f32,
+    /// Noise sigmas the response's values have had taken off already
+    /// ([`KnownNoise`](super::KnownNoise)); 0 for one image's response.
+    offset: f32,
 }
 
 /// Reusable buffers of the estimate.
@@ -148,11 +151,28 @@ impl NoiseMap {
         m
     }
 
-    /// [`NoiseMap::estimate`] into reusable buffers.
+    /// Noise sigmas the response's values have had taken off already: a
+    /// value of `c` grey levels stands `offset + c / σ` sigmas above the
+    /// noise (several lightings combined; 0 for one image).
+    #[inline]
+    pub fn offset(&self) -> f32 {
+        self.offset
+    }
+
+    /// [`NoiseMap::estimate`] into reusable buffers. A response whose
+    /// maker knows its noise ([`Response::known_noise`]) gets a uniform
+    /// map of it instead.
     pub fn estimate_into(&mut self, r: &Response, s: &mut NoiseScratch) {
         let (w, h) = (r.width, r.height);
         self.shape(w, h);
         self.global = 0.0;
+        self.offset = 0.0;
+        if let Some(k) = r.known_noise() {
+            self.sigma.fill(k.sigma);
+            self.global = k.sigma;
+            self.offset = k.offset;
+            return;
+        }
         if w == 0 || h == 0 || !r.covers(w, h) {
             return;
         }

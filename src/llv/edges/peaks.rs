@@ -228,12 +228,14 @@ impl PeakMap {
 }
 
 /// Per tile of `noise`, the largest key at or below `floor` grey levels and
-/// `sigmas` noise sigmas (a key passes when it is above this).
+/// `sigmas` noise sigmas (a key passes when it is above this; of a response
+/// whose values have had `noise.offset()` sigmas taken off, only the rest).
 fn tile_floors(r: &Response, noise: &NoiseMap, floor: f64, sigmas: f64, out: &mut Vec<i32>) {
     let (nx, ny) = noise.tiles();
+    let rest = (sigmas as f32 - noise.offset()).max(0.0);
     out.clear();
     for t in 0..nx * ny {
-        let limit = (floor as f32).max(sigmas as f32 * noise.sigma(t));
+        let limit = (floor as f32).max(rest * noise.sigma(t));
         out.push(key_floor(limit, r.scale()));
     }
 }
