@@ -151,3 +151,37 @@ fn every_parameter_with_lens_correction() {
 fn every_parameter_without_lens_correction() {
     every_parameter(false);
 }
+
+/// A value typed after `Enter` replaces the parameter's value: `Enter`, `12`,
+/// `Enter` on `edges.per_region` (16) gives 12. The field offered the old
+/// value with the cursor after it, so the keys made 1612, a value in range
+/// that was taken without a word.
+#[test]
+fn a_typed_value_replaces_the_old_one() {
+    let mut c = Console::start_with(&five_lightings(false), 80, 24, &[], |_| {});
+    c.create_session("cube");
+    c.capture_current(1);
+    c.send("3");
+    c.wait_text("parameters", 10);
+    let at = PARAMS
+        .iter()
+        .position(|sp| sp.key == "edges.per_region")
+        .unwrap();
+    for _ in 0..at {
+        c.press(PIPELINE, Action::Pipeline(PipelineAction::ParamNext));
+    }
+    c.press(PIPELINE, Action::Pipeline(PipelineAction::Type));
+    c.wait_text("typing replaces it", 10);
+    c.send("12\r");
+    c.wait("edges.per_region = 12", 20, |s| {
+        panel_value(s, "edges.per_region").as_deref() == Some("12") && !s.contains("running")
+    });
+    // ← keeps the offered value to edit: `Enter`, ←, `5`, `Enter` gives 152.
+    c.press(PIPELINE, Action::Pipeline(PipelineAction::Type));
+    c.wait_text("typing replaces it", 10);
+    c.send("\x1b[D5\r");
+    c.wait("edges.per_region = 152", 20, |s| {
+        panel_value(s, "edges.per_region").as_deref() == Some("152")
+    });
+    c.send("q");
+}

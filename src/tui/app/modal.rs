@@ -57,6 +57,11 @@ pub struct Prompt {
     pub purpose: PromptPurpose,
     /// Why the last Enter was refused (the text stays for correcting).
     pub error: Option<String>,
+    /// The text offered when the field opened is selected: the first
+    /// character typed replaces it (a value typed after `Enter` is that
+    /// value, not the old one with it appended), a deleting key clears it,
+    /// and a moving key keeps it for editing.
+    pub selected: bool,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -90,12 +95,33 @@ impl Modal {
         Modal::Prompt(Prompt {
             title: title.into(),
             rule: rule.into(),
+            selected: false,
             text,
             cursor,
             max,
             purpose,
             error: None,
         })
+    }
+}
+
+impl Modal {
+    /// A text field offering a value to replace (a parameter's, say): the
+    /// offered text is selected ([`Prompt::selected`]), so what is typed
+    /// replaces it. A text the operator typed and is to correct is offered
+    /// with [`Modal::prompt`] instead, unselected.
+    pub fn value_prompt(
+        title: impl Into<String>,
+        rule: impl Into<String>,
+        text: String,
+        max: usize,
+        purpose: PromptPurpose,
+    ) -> Modal {
+        let mut m = Modal::prompt(title, rule, text, max, purpose);
+        if let Modal::Prompt(p) = &mut m {
+            p.selected = !p.text.is_empty();
+        }
+        m
     }
 }
 
@@ -107,9 +133,17 @@ impl Prompt {
             .map_or(self.text.len(), |(i, _)| i)
     }
 
-    /// Types one character at the cursor (refused past the limit).
+    /// Types one character at the cursor (refused past the limit); over
+    /// the selected offered text, instead of it.
     pub fn insert(&mut self, c: char) -> bool {
-        if self.text.chars().count() >= self.max || c.is_control() {
+        if c.is_control() {
+            return false;
+        }
+        if std::mem::take(&mut self.selected) {
+            self.text.clear();
+            self.cursor = 0;
+        }
+        if self.text.chars().count() >= self.max {
             return false;
         }
         let at = self.byte(self.cursor);
@@ -121,6 +155,21 @@ impl Prompt {
 
     /// A readline key.
     pub fn edit(&mut self, a: ModalAction) {
+        if std::mem::take(&mut self.selected)
+            && matches!(
+                a,
+                ModalAction::DeleteBack
+                    | ModalAction::DeleteForward
+                    | ModalAction::KillLine
+                    | ModalAction::KillWord
+            )
+        {
+            // A deleting key deletes the selection, as in any text field.
+            self.text.clear();
+            self.cursor = 0;
+            self.error = None;
+            return;
+        }
         let n = self.text.chars().count();
         match a {
             ModalAction::Left => self.cursor = self.cursor.saturating_sub(1),
@@ -313,5 +362,39 @@ impl App {
                 Vec::new()
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn offered(text: &str) -> Prompt {
+        match Modal::value_prompt("v =", "", text.to_string(), 24, PromptPurpose::SessionName) {
+            Modal::Prompt(p) => p,
+            Modal::Confirm { .. } => unreachable!(),
+        }
+    }
+
+    #[test]
+    fn an_offered_value_is_replaced_cleared_or_kept_for_editing() {
+        let mut p = offered("16");
+        assert!(p.insert('1') && p.insert('2'));
+        assert_eq!(p.text, "12");
+        let mut p = offered("16");
+        p.edit(ModalAction::DeleteBack);
+        assert_eq!((p.text.as_str(), p.cursor), ("", 0));
+        let mut p = offered("16");
+        p.edit(ModalAction::Home);
+        assert!(p.insert('2'));
+        assert_eq!(p.text, "216");
+        // A text to correct is offered unselected: typing appends.
+        let Modal::Prompt(mut p) =
+            Modal::prompt("name:", "", "q1".into(), 24, PromptPurpose::SessionName)
+        else {
+            unreachable!()
+        };
+        assert!(p.insert('x'));
+        assert_eq!(p.text, "q1x");
     }
 }

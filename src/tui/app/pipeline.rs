@@ -107,7 +107,7 @@ impl PipelineScreen {
                     .map(fmt_value)
                     .unwrap_or_default();
                 let rule = format!("{} {} (now {now})", sp.range_text(), sp.unit);
-                ctx.chrome.modal = Some(Modal::prompt(
+                ctx.chrome.modal = Some(Modal::value_prompt(
                     format!("{} =", sp.key),
                     rule.trim_end().to_string(),
                     now,

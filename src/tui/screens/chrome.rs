@@ -243,14 +243,29 @@ pub fn modal_box(app: &App, m: &Modal, area: Rect, buf: &mut Buffer) {
             let before: String = chars[..p.cursor.min(chars.len())].iter().collect();
             let at: String = chars.get(p.cursor).map_or(" ".into(), |c| c.to_string());
             let after: String = chars.iter().skip(p.cursor + 1).collect();
-            lines.push(Line::from(vec![
-                Span::styled(format!("{} ", p.title), t.title()),
-                Span::raw(before),
-                Span::styled(at, Style::new().add_modifier(Modifier::REVERSED)),
-                Span::raw(after),
-            ]));
+            let reversed = Style::new().add_modifier(Modifier::REVERSED);
+            lines.push(Line::from(if p.selected {
+                // The whole offered text marked, the cursor after it.
+                vec![
+                    Span::styled(format!("{} ", p.title), t.title()),
+                    Span::styled(p.text.clone(), reversed),
+                    Span::raw(" "),
+                ]
+            } else {
+                vec![
+                    Span::styled(format!("{} ", p.title), t.title()),
+                    Span::raw(before),
+                    Span::styled(at, reversed),
+                    Span::raw(after),
+                ]
+            }));
+            let count = format!("{}/{} characters", chars.len(), p.max);
             lines.push(Line::styled(
-                format!("{}/{} characters", chars.len(), p.max),
+                if p.selected {
+                    format!("{count} · typing replaces it, ← → edit it")
+                } else {
+                    count
+                },
                 t.dim(),
             ));
             if let Some(e) = &p.error {
