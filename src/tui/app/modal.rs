@@ -103,25 +103,16 @@ impl Modal {
             error: None,
         })
     }
-}
 
-impl Modal {
-    /// A text field offering a value to replace (a parameter's, say): the
-    /// offered text is selected ([`Prompt::selected`]), so what is typed
-    /// replaces it. A text the operator typed and is to correct is offered
-    /// with [`Modal::prompt`] instead, unselected.
-    pub fn value_prompt(
-        title: impl Into<String>,
-        rule: impl Into<String>,
-        text: String,
-        max: usize,
-        purpose: PromptPurpose,
-    ) -> Modal {
-        let mut m = Modal::prompt(title, rule, text, max, purpose);
-        if let Modal::Prompt(p) = &mut m {
+    /// The text field with its offered text selected ([`Prompt::selected`]),
+    /// so that what is typed replaces it: for a value to replace (a
+    /// parameter's). A text the operator typed and is to correct stays
+    /// unselected.
+    pub fn selected(mut self) -> Modal {
+        if let Modal::Prompt(p) = &mut self {
             p.selected = !p.text.is_empty();
         }
-        m
+        self
     }
 }
 
@@ -370,7 +361,8 @@ mod tests {
     use super::*;
 
     fn offered(text: &str) -> Prompt {
-        match Modal::value_prompt("v =", "", text.to_string(), 24, PromptPurpose::SessionName) {
+        match Modal::prompt("v =", "", text.to_string(), 24, PromptPurpose::SessionName).selected()
+        {
             Modal::Prompt(p) => p,
             Modal::Confirm { .. } => unreachable!(),
         }

@@ -107,13 +107,16 @@ impl PipelineScreen {
                     .map(fmt_value)
                     .unwrap_or_default();
                 let rule = format!("{} {} (now {now})", sp.range_text(), sp.unit);
-                ctx.chrome.modal = Some(Modal::value_prompt(
-                    format!("{} =", sp.key),
-                    rule.trim_end().to_string(),
-                    now,
-                    24,
-                    PromptPurpose::ParamValue(sp.key),
-                ));
+                ctx.chrome.modal = Some(
+                    Modal::prompt(
+                        format!("{} =", sp.key),
+                        rule.trim_end().to_string(),
+                        now,
+                        24,
+                        PromptPurpose::ParamValue(sp.key),
+                    )
+                    .selected(),
+                );
             }
             PipelineAction::Save => return ctx.save_outputs(false).unwrap_or_default(),
             PipelineAction::ViewNext => self.view = StageView::ALL[(self.view.index() + 1) % n],
