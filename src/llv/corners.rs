@@ -14,10 +14,18 @@
 //!    at least [`MIN_CORNER_ANGLE_DEG`]), the corner is the point closest, in
 //!    least squares, to all of their infinite lines — for two lines exactly
 //!    their intersection, for a cube vertex of three edges the best
-//!    compromise. It is accepted when it lies within `radius` of every
-//!    endpoint of the cluster and is a *corner move* for each: outward along
-//!    the line, or inward by at most [`MAX_INWARD_RADII`] × `radius` (a
+//!    compromise. It is accepted when it lies within [`MAX_VERTEX_OFFSET`]
+//!    of every line of the cluster (their lines really meet there), within
+//!    `radius` of every endpoint and is a *corner move* for each: outward
+//!    along the line, or inward by at most [`MAX_INWARD_RADII`] × `radius` (a
 //!    larger inward move is a crossing or T-junction, not a corner).
+//!    Without the first test, two close parallel edges meeting a third (a
+//!    plate seen edge-on against an upright) had their ends moved to a point
+//!    between them, tilting both: on the cubes at noise σ 10 the mean
+//!    endpoint distance from the true lines is 0.094 px with the test and
+//!    0.108 without, the angle error 0.188° against 0.197°, F, recall and
+//!    precision the same at every level (0.5 px: F 0.977 at σ 10; 2 px: as
+//!    without).
 //! 3. Otherwise the cluster falls back to pairs: every pair of endpoints of
 //!    non-parallel lines within `radius`, whose intersection lies within
 //!    `radius` of both and is a corner move for both, ordered by the total
@@ -51,6 +59,10 @@ pub const MIN_LENGTH_RADII: f64 = 2.0;
 
 /// Largest inward move of an endpoint, in radii (see `keeps_direction`).
 pub const MAX_INWARD_RADII: f64 = 0.25;
+
+/// A cluster's least-squares point is its corner only if it lies within
+/// this (px) of every line of the cluster.
+pub const MAX_VERTEX_OFFSET: f64 = 1.0;
 
 /// One endpoint: line index and which end (false = `a`, true = `b`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -306,9 +318,15 @@ fn cluster_corner(
         return None;
     }
     let p = least_squares_point(lines, idx)?;
-    kept.iter()
-        .all(|&k| pts[k].dist(p) <= radius && keeps_direction(lines, ends[k], p, radius))
-        .then_some(p)
+    let on_every_line = idx.iter().all(|&i| {
+        normal_form(&lines[i])
+            .is_some_and(|(a, b, c)| (a * p.x + b * p.y + c).abs() <= MAX_VERTEX_OFFSET)
+    });
+    (on_every_line
+        && kept
+            .iter()
+            .all(|&k| pts[k].dist(p) <= radius && keeps_direction(lines, ends[k], p, radius)))
+    .then_some(p)
 }
 
 /// Step 3: pairwise intersections, cheapest first, each endpoint once.
@@ -463,6 +481,29 @@ mod tests {
         close_corners(&mut v, 5.0);
         assert!(v[0].b == v[1].b && v[1].b == v[2].b, "{v:?}");
         assert!(v[0].b.dist(Point::new(50.0, 50.0)) < 0.5, "{:?}", v[0].b);
+    }
+
+    #[test]
+    fn two_close_parallel_edges_meeting_a_third_keep_their_lines() {
+        // A plate seen edge-on (two horizontal edges 5 px apart) ending at
+        // an upright (a vertical edge at x = 50): one cluster of three
+        // ends, whose least-squares point lies between the two parallel
+        // lines, 2.5 px from each. Moving their ends there would tilt both
+        // lines; each end goes to its own line's intersection with the
+        // upright instead.
+        let mut v = vec![
+            seg(10.0, 40.0, 47.0, 40.0),
+            seg(10.0, 45.0, 47.5, 45.0),
+            seg(50.0, 41.5, 50.0, 90.0),
+        ];
+        close_corners(&mut v, 5.0);
+        for (s, y) in [(&v[0], 40.0), (&v[1], 45.0)] {
+            assert!(
+                (s.a.y - y).abs() < 1e-9 && (s.b.y - y).abs() < 1e-9,
+                "the edge at y = {y} tilted: {s:?}"
+            );
+        }
+        assert!(close(v[0].b, 50.0, 40.0), "{:?}", v[0]);
     }
 
     #[test]
