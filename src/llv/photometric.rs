@@ -70,8 +70,9 @@
 //! ambient image's noise is in every difference and the terms then beat
 //! `τ` together: an operator who lowers the factor with an ambient image
 //! should raise `edges.noise_sigmas` with it. The map is uniform: the
-//! combination's `τ_i` are one per image too, from a median over the whole image (vignetting or a spot
-//! light is not followed across tiles as it is for one image).
+//! combination's `τ_i` are one per image too, from a median over the whole
+//! image (vignetting or a spot light is not followed across tiles as it is
+//! for one image).
 //!
 //! **Whole numbers throughout.** Every image's sums, `τ_i` (rounded to a
 //! whole sum) and the combination are computed in `i32`, row by row (the

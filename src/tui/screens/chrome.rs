@@ -240,25 +240,21 @@ pub fn modal_box(app: &App, m: &Modal, area: Rect, buf: &mut Buffer) {
                 .map(|r| Line::styled(r, t.dim()))
                 .collect();
             let chars: Vec<char> = p.text.chars().collect();
-            let before: String = chars[..p.cursor.min(chars.len())].iter().collect();
-            let at: String = chars.get(p.cursor).map_or(" ".into(), |c| c.to_string());
-            let after: String = chars.iter().skip(p.cursor + 1).collect();
             let reversed = Style::new().add_modifier(Modifier::REVERSED);
-            lines.push(Line::from(if p.selected {
+            let mut field = vec![Span::styled(format!("{} ", p.title), t.title())];
+            if p.selected {
                 // The whole offered text marked, the cursor after it.
-                vec![
-                    Span::styled(format!("{} ", p.title), t.title()),
-                    Span::styled(p.text.clone(), reversed),
-                    Span::raw(" "),
-                ]
+                field.push(Span::styled(p.text.clone(), reversed));
+                field.push(Span::raw(" "));
             } else {
-                vec![
-                    Span::styled(format!("{} ", p.title), t.title()),
-                    Span::raw(before),
-                    Span::styled(at, reversed),
-                    Span::raw(after),
-                ]
-            }));
+                let before: String = chars[..p.cursor.min(chars.len())].iter().collect();
+                let at: String = chars.get(p.cursor).map_or(" ".into(), |c| c.to_string());
+                let after: String = chars.iter().skip(p.cursor + 1).collect();
+                field.push(Span::raw(before));
+                field.push(Span::styled(at, reversed));
+                field.push(Span::raw(after));
+            }
+            lines.push(Line::from(field));
             let count = format!("{}/{} characters", chars.len(), p.max);
             lines.push(Line::styled(
                 if p.selected {
