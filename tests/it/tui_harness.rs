@@ -381,6 +381,21 @@ impl Console {
             self.wait_text(&format!("Image {}: camera", k + 1), 20);
         }
     }
+
+    /// On the Pipeline screen with the first parameter chosen, chooses
+    /// parameter `key` (by the panel's key, as an operator steps down).
+    pub fn choose_param(&mut self, key: &str) {
+        let at = vss::llv::params::PARAMS
+            .iter()
+            .position(|sp| sp.key == key)
+            .unwrap_or_else(|| panic!("no parameter {key}"));
+        for _ in 0..at {
+            self.press(
+                PIPELINE,
+                Action::Pipeline(vss::tui::keymap::PipelineAction::ParamNext),
+            );
+        }
+    }
 }
 
 /// Begin and end of a synchronized update (DEC mode 2026), which the

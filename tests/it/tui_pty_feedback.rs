@@ -121,13 +121,7 @@ fn values_changes_and_grabs_are_confirmed_and_the_log_keeps_the_run() {
     c.send("3");
     let s = c.wait_text("parameters", 10);
     assert!(s.contains("more"), "a longer list says so:\n{s}");
-    let sp = vss::llv::params::PARAMS
-        .iter()
-        .position(|p| p.key == "edges.half_width")
-        .unwrap();
-    for _ in 0..sp {
-        c.press(PIPELINE, Action::Pipeline(PipelineAction::ParamNext));
-    }
+    c.choose_param("edges.half_width");
     c.press(PIPELINE, Action::Pipeline(PipelineAction::Type));
     c.wait_text("edges.half_width = 4", 5);
     // The field holds the value now: clear it, type a bad one.

@@ -163,13 +163,7 @@ fn a_typed_value_replaces_the_old_one() {
     c.capture_current(1);
     c.send("3");
     c.wait_text("parameters", 10);
-    let at = PARAMS
-        .iter()
-        .position(|sp| sp.key == "edges.per_region")
-        .unwrap();
-    for _ in 0..at {
-        c.press(PIPELINE, Action::Pipeline(PipelineAction::ParamNext));
-    }
+    c.choose_param("edges.per_region");
     c.press(PIPELINE, Action::Pipeline(PipelineAction::Type));
     c.wait_text("typing replaces it", 10);
     c.send("12\r");
