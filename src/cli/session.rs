@@ -68,7 +68,8 @@ pub enum FromStage {
     Lens,
     /// Edges and everything after them, on the grey images.
     Edges,
-    /// Line extraction and CONNECT, on the saved .hpo and .vpo.
+    /// Line extraction and CONNECT with the saved edges' parameters, on the
+    /// grey images (on the saved .hpo and .vpo when there are none).
     Lines,
     /// CONNECT alone, on the saved .lex.
     Connect,

@@ -262,7 +262,7 @@ params! {
         /// Points a line takes after its start must exceed this many noise
         /// sigmas of their tile (fewer than an edge point needs: a weak
         /// stretch of an edge is followed once the edge is found).
-        track_sigmas: f64 = 2.0,
+        track_sigmas: f64 = 1.5,
             "σ", 0.0..=20.0, step 0.25,
             "points a line follows must beat this many noise sigmas";
         /// A-contrario significance: a segment is kept when noise alone

@@ -282,12 +282,19 @@ impl Session {
         Ok(input.with_camera(camera))
     }
 
+    /// Whether image `k` has grey frames recorded.
+    pub fn has_frames(&self, k: u32) -> bool {
+        self.manifest.image(k).is_some_and(|r| !r.grey.is_empty())
+    }
+
     /// Runs image `k`'s stages from `from` with `params` through `runner`,
     /// saving nothing. From `lens` or `edges` on its frames
-    /// ([`Session::pipeline_input`]); from `lines` on its saved `.hpo` and
-    /// `.vpo`, from `connect` on its saved `.lex`, keeping the parameters
-    /// the earlier stages were made with. Returns the parameters the
-    /// outputs stand for.
+    /// ([`Session::pipeline_input`]). From `lines` with the lens and edge
+    /// parameters the saved edges were made with: on its frames, as the
+    /// console re-runs the lines (tracks follow the response's peaks below
+    /// the edge threshold, which the edge files do not hold), or on its
+    /// saved `.hpo` and `.vpo` when it has no frames. From `connect` on its
+    /// saved `.lex`. Returns the parameters the outputs stand for.
     pub fn run_stages<'r>(
         &self,
         k: u32,
@@ -312,6 +319,11 @@ impl Session {
         used.connect = params.connect.clone();
         let saved = if from == Stage::Lines {
             used.lines = params.lines.clone();
+            if self.has_frames(k) {
+                let input = self.pipeline_input(k)?;
+                let out = runner.run(&input, Stage::Lens, &used)?;
+                return Ok((out, used));
+            }
             let read =
                 |ext| formats::edgefile::read_edges(&self.path(&self.file_name(k, None, ext)));
             Saved::Edges {

@@ -5,9 +5,11 @@
 //!
 //! What runs, on which input, is [`super::input`]'s: from `lens` or `edges`
 //! the whole pipeline on the image's lit frames less its ambient frame (with
-//! the image's `.cdf` for lens correction); from `lines` on the saved edge
-//! files, from `connect` on the saved `.lex`, the earlier stages' files and
-//! the parameters they were made with staying as they are.
+//! the image's `.cdf` for lens correction); from `lines` with the earlier
+//! stages' parameters, on the frames as the console does (on the saved edge
+//! files when there are no frames); from `connect` on the saved `.lex`. The
+//! earlier stages' files and the parameters they were made with stay as
+//! they are.
 
 use std::fmt;
 

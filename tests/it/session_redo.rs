@@ -320,9 +320,11 @@ fn redo_and_the_console_s_way_write_the_same_ldr() {
         (out.edges_h.points.len(), out.lines.len())
     );
 
-    // From the saved edge files (exact f32), with the same parameters, the
-    // same lines again; from the saved .lex, whose six decimals round the
-    // extracted lines, the same lines to within that rounding.
+    // From lines, with the same parameters, the same lines again: the
+    // frames run again with the saved edges' parameters, as the console
+    // re-runs lines (tracks follow peaks below the edge threshold, which the
+    // edge files do not hold); from the saved .lex, whose six decimals round
+    // the extracted lines, the same lines to within that rounding.
     drop(sess);
     vss(&["session", "redo", s, "--image", "1", "--from", "lines"]);
     assert!(
