@@ -18,7 +18,7 @@
 //! `NFA = N_tests · min_z B(n, k_z, p_z)`, `N_tests = 2 · levels · (w h)²`.
 //!
 //! A level counts only where its points cover most of the span: `k_z ≥
-//! ⅔ n` ([`dense`]). The binomial model takes the lines as independent,
+//! ⅔ n`. The binomial model takes the lines as independent,
 //! but a track is not placed at random: it takes the nearest peak, and
 //! where it crosses a strong edge that edge gives it two or three points
 //! of 8 σ and more. Without the rule, those few points alone made any
