@@ -254,9 +254,10 @@ impl Workspace {
     }
 
     /// Runs the stages after a saved result (`vss llv --from-edges`, `vss
-    /// session redo --from lines|connect`): line extraction and CONNECT from
-    /// edge points, or CONNECT alone from extracted lines. The outputs have no
-    /// images or responses (nor edge points, from lines), so a later
+    /// session redo --from connect`, and `--from lines` for an image without
+    /// frames): line extraction and CONNECT from edge points, or CONNECT
+    /// alone from extracted lines. The outputs have no images or responses
+    /// (nor edge points, from lines), so a later
     /// [`Workspace::rerun`] runs every stage.
     pub fn run_saved(&mut self, saved: Saved, p: &Params) -> &StageOutputs {
         self.valid = false;
