@@ -174,6 +174,41 @@ fn photometric_run_with_lens_correction_is_saved_per_lighting() {
     ));
 }
 
+/// An image whose manifest lists no frames (dropped by hand, say) but
+/// keeps its saved edges: `redo --from lines` runs on the `.hpo` / `.vpo`
+/// alone, as `vss llv --from-edges` does, and gives those lines.
+#[test]
+fn redo_from_lines_without_frames_uses_the_edge_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Session::create(dir.path(), "box", &profile(&['a'])).unwrap();
+    s.save_image(1, 'a', &ImgFile::new(rectangle(200.0)))
+        .unwrap();
+    let p = Params::default();
+    s.redo(1, Stage::Edges, &p).unwrap();
+    assert!(s.has_frames(1));
+    let sdir = s.dir().to_path_buf();
+    drop(s);
+
+    // The manifest without the image's frames.
+    let path = sdir.join("box.toml");
+    let mut doc: toml_edit::DocumentMut = std::fs::read_to_string(&path).unwrap().parse().unwrap();
+    let images = doc["image"].as_array_of_tables_mut().unwrap();
+    images.get_mut(0).unwrap().remove("grey").unwrap();
+    std::fs::write(&path, doc.to_string()).unwrap();
+
+    let mut s = Session::open(&sdir).unwrap();
+    assert!(!s.has_frames(1));
+    let r = s.redo(1, Stage::Lines, &p).unwrap();
+    assert!(r.counts.lines >= 4, "{r}");
+    let h = vss::formats::edgefile::read_edges(&sdir.join("box1.hpo")).unwrap();
+    let v = vss::formats::edgefile::read_edges(&sdir.join("box1.vpo")).unwrap();
+    let by_edges = Runner::new()
+        .run_saved(vss::llv::pipeline::Saved::Edges { h, v }, &p)
+        .lines
+        .clone();
+    assert_eq!(s.load_lines(1).unwrap().len(), by_edges.len());
+}
+
 #[test]
 fn redo_command_uses_the_profile_and_explains_missing_inputs() {
     let dir = tempfile::tempdir().unwrap();
