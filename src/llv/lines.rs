@@ -371,7 +371,7 @@ fn walk<P: Peaks>(
         // the edge turns (a shallow corner, a branching shadow) the track
         // ends after `max_gap` lines of such points. "Off" is beyond both
         // `STRAY_DISTANCE` and 3 RMS residuals of the track (module doc);
-        // the residual is computed only for a point beyond the first.
+        // the residual is computed only for a point beyond the fixed one.
         // (Its distance from the line, `|cross| / |axis|`, compared
         // squared.)
         let stray = fitted

@@ -287,6 +287,19 @@ impl Session {
         self.manifest.image(k).is_some_and(|r| !r.grey.is_empty())
     }
 
+    /// Every stage of image `k` on its frames with `params`, which it
+    /// returns with the outputs.
+    fn run_frames<'r>(
+        &self,
+        k: u32,
+        params: Params,
+        runner: &'r mut Runner,
+    ) -> Result<(&'r StageOutputs, Params), SessionError> {
+        let input = self.pipeline_input(k)?;
+        let out = runner.run(&input, Stage::Lens, &params)?;
+        Ok((out, params))
+    }
+
     /// Runs image `k`'s stages from `from` with `params` through `runner`,
     /// saving nothing. From `lens` or `edges` on its frames
     /// ([`Session::pipeline_input`]). From `lines` with the lens and edge
@@ -304,9 +317,7 @@ impl Session {
     ) -> Result<(&'r StageOutputs, Params), SessionError> {
         super::check_image_number(k)?;
         if from <= Stage::Edges {
-            let input = self.pipeline_input(k)?;
-            let out = runner.run(&input, Stage::Lens, params)?;
-            return Ok((out, params.clone()));
+            return self.run_frames(k, params.clone(), runner);
         }
         let rec = self.manifest.image(k).and_then(|r| r.outputs.as_ref());
         let Some(rec) = rec else {
@@ -320,9 +331,7 @@ impl Session {
         let saved = if from == Stage::Lines {
             used.lines = params.lines.clone();
             if self.has_frames(k) {
-                let input = self.pipeline_input(k)?;
-                let out = runner.run(&input, Stage::Lens, &used)?;
-                return Ok((out, used));
+                return self.run_frames(k, used, runner);
             }
             let read =
                 |ext| formats::edgefile::read_edges(&self.path(&self.file_name(k, None, ext)));

@@ -71,7 +71,6 @@ fn a_line_count_target_is_met_and_the_changes_are_listed() {
 fn clean_drops_noise_lines_and_keeps_the_edges() {
     let mut base = Params::default();
     base.edges.noise_sigmas = 2.5;
-    base.lines.track_sigmas = 1.5;
     base.lines.log_nfa = 10.0;
     let (mut b, mut c) = (synth::Tally::default(), synth::Tally::default());
     let (mut nb, mut nc) = (0, 0);

@@ -54,6 +54,15 @@ fn profile(letters: &[char]) -> Profile {
     p
 }
 
+/// A session `box` in `dir` with one lighting and image 1 captured: the
+/// rectangle at grey level 200.
+fn box_with_one_image(dir: &std::path::Path) -> Session {
+    let mut s = Session::create(dir, "box", &profile(&['a'])).unwrap();
+    s.save_image(1, 'a', &ImgFile::new(rectangle(200.0)))
+        .unwrap();
+    s
+}
+
 fn hash_of(s: &Session, file: &str) -> String {
     let o = s.manifest().image(1).unwrap().outputs.as_ref().unwrap();
     o.files
@@ -67,9 +76,7 @@ fn hash_of(s: &Session, file: &str) -> String {
 #[test]
 fn redo_runs_only_the_stages_asked_for() {
     let dir = tempfile::tempdir().unwrap();
-    let mut s = Session::create(dir.path(), "box", &profile(&['a'])).unwrap();
-    s.save_image(1, 'a', &ImgFile::new(rectangle(200.0)))
-        .unwrap();
+    let mut s = box_with_one_image(dir.path());
     let p = Params::default();
     let r = s.redo(1, Stage::Edges, &p).unwrap();
     assert!(r.counts.edges_h > 50 && r.counts.edges_v > 50, "{r}");
@@ -180,9 +187,7 @@ fn photometric_run_with_lens_correction_is_saved_per_lighting() {
 #[test]
 fn redo_from_lines_without_frames_uses_the_edge_files() {
     let dir = tempfile::tempdir().unwrap();
-    let mut s = Session::create(dir.path(), "box", &profile(&['a'])).unwrap();
-    s.save_image(1, 'a', &ImgFile::new(rectangle(200.0)))
-        .unwrap();
+    let mut s = box_with_one_image(dir.path());
     let p = Params::default();
     s.redo(1, Stage::Edges, &p).unwrap();
     assert!(s.has_frames(1));
@@ -212,11 +217,7 @@ fn redo_from_lines_without_frames_uses_the_edge_files() {
 #[test]
 fn redo_command_uses_the_profile_and_explains_missing_inputs() {
     let dir = tempfile::tempdir().unwrap();
-    let mut s = Session::create(dir.path(), "box", &profile(&['a'])).unwrap();
-    let sdir = s.dir().to_path_buf();
-    s.save_image(1, 'a', &ImgFile::new(rectangle(200.0)))
-        .unwrap();
-    drop(s);
+    let sdir = box_with_one_image(dir.path()).dir().to_path_buf();
     let vss = |args: &[&str]| {
         Command::new(env!("CARGO_BIN_EXE_vss"))
             .args(args)
