@@ -18,6 +18,7 @@ pub mod lines;
 pub mod params;
 pub mod photometric;
 pub mod pipeline;
+pub mod refine;
 pub mod shadow;
 pub mod synth;
 

@@ -317,7 +317,7 @@ fn from_edges(hpo: &Path, vpo: &Path, a: &Args, p: &Params) -> anyhow::Result<()
         v: edgefile::read_edges(vpo)?,
     };
     let mut runner = Runner::new();
-    let out = runner.run_saved(saved, p);
+    let out = runner.run_saved(saved, p, None)?;
     let stem = hpo
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

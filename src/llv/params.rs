@@ -301,6 +301,11 @@ params! {
         corner_radius: f64 = 5.0,
             "px", 0.0..=50.0, step 0.5,
             "corner closing radius; 0 is off";
+        /// Refit each line on the image along its normal after CONNECT
+        /// (`refine.rs`); lines from edge files alone are not refitted.
+        refine: bool = true,
+            "", 0.0..=1.0, step 1.0,
+            "refit each line on the image across it after CONNECT";
     }
 }
 

@@ -22,6 +22,7 @@ use super::lens::{LensMap, correct_into};
 use super::lines::{LineScratch, extract_into, track_into};
 use super::params::{Params, Stage};
 use super::photometric::{PhotoScratch, combined_response_into};
+use super::refine::{RefineScratch, refine_into};
 use super::{EdgePoints, LlvError, ScanDir, Segment};
 
 /// Wall-clock time of each stage of one run, in microseconds (0 for a
@@ -105,6 +106,7 @@ pub struct Workspace {
     connect: ConnectScratch,
     tmp: Vec<Segment>,
     corners: CornerScratch,
+    refine: RefineScratch,
     /// Whether `out` holds the results of a complete run.
     valid: bool,
 }
@@ -248,7 +250,7 @@ impl Workspace {
             lines_raw.extend_from_slice(&self.dir_h.segs);
             lines_raw.extend_from_slice(&self.dir_v.segs);
         }
-        self.connect_lines(p);
+        self.connect_on(input, p);
         self.valid = true;
         Ok(&self.out)
     }
@@ -256,10 +258,19 @@ impl Workspace {
     /// Runs the stages after a saved result (`vss llv --from-edges`, `vss
     /// session redo --from connect`, and `--from lines` for an image without
     /// frames): line extraction and CONNECT from edge points, or CONNECT
-    /// alone from extracted lines. The outputs have no images or responses
-    /// (nor edge points, from lines), so a later
-    /// [`Workspace::rerun`] runs every stage.
-    pub fn run_saved(&mut self, saved: Saved, p: &Params) -> &StageOutputs {
+    /// alone from extracted lines. The lines are refitted on `images`' images
+    /// (lens-corrected as a run of them would be) when they are given, and
+    /// not at all without them. The outputs have no responses (nor edge
+    /// points, from lines), so a later [`Workspace::rerun`] runs every stage.
+    pub fn run_saved(
+        &mut self,
+        saved: Saved,
+        p: &Params,
+        images: Option<&Input>,
+    ) -> Result<&StageOutputs, LlvError> {
+        if let Some(input) = images {
+            check_input(input)?;
+        }
         self.valid = false;
         self.out.corrected.clear();
         self.out.response_h = Response::default();
@@ -280,8 +291,16 @@ impl Workspace {
                 self.out.lines_raw = raw;
             }
         }
-        self.connect_lines(p);
-        &self.out
+        let Some(input) = images else {
+            self.connect_lines(p, &[]);
+            return Ok(&self.out);
+        };
+        let t = Instant::now();
+        self.lens(input, p)?;
+        let lens_us = micros(t);
+        self.connect_on(input, p);
+        self.out.timings.lens_us = lens_us;
+        Ok(&self.out)
     }
 
     /// Line extraction from edge points alone.
@@ -298,7 +317,21 @@ impl Workspace {
         self.out.timings.lines_us = micros(t);
     }
 
-    fn connect_lines(&mut self, p: &Params) {
+    /// [`Workspace::connect_lines`] with the refit on the images the lines
+    /// were found on: the lens-corrected ones, or `input`'s.
+    fn connect_on(&mut self, input: &Input, p: &Params) {
+        let corrected = std::mem::take(&mut self.out.corrected);
+        let images = if corrected.is_empty() {
+            input.images
+        } else {
+            &corrected[..]
+        };
+        self.connect_lines(p, images);
+        self.out.corrected = corrected;
+    }
+
+    /// CONNECT, the refit on `images` (none: no refit) and corner closing.
+    fn connect_lines(&mut self, p: &Params, images: &[GreyImage]) {
         let t = Instant::now();
         connect_into(
             &self.out.lines_raw,
@@ -306,6 +339,9 @@ impl Workspace {
             &mut self.out.lines,
             &mut self.connect,
         );
+        if p.connect.refine {
+            refine_into(images, &mut self.out.lines, &mut self.refine);
+        }
         if p.connect.corner_radius > 0.0 {
             close_corners_with(
                 &mut self.out.lines,
@@ -473,12 +509,14 @@ fn check_input(input: &Input) -> Result<(usize, usize), LlvError> {
 /// --from-edges`): the outputs have no images or responses.
 pub fn lines_from_edges(edges_h: EdgePoints, edges_v: EdgePoints, p: &Params) -> StageOutputs {
     let mut ws = Workspace::new();
-    ws.run_saved(
+    // Without images nothing can fail.
+    let _ = ws.run_saved(
         Saved::Edges {
             h: edges_h,
             v: edges_v,
         },
         p,
+        None,
     );
     ws.take_outputs()
 }

@@ -229,10 +229,21 @@ impl Runner {
         Ok(self.ws.outputs())
     }
 
-    /// Runs the stages after a saved result (see [`Workspace::run_saved`]).
-    pub fn run_saved(&mut self, saved: Saved, p: &Params) -> &StageOutputs {
+    /// Runs the stages after a saved result, the lines refitted on
+    /// `frames`' images when given (see [`Workspace::run_saved`]).
+    pub fn run_saved(
+        &mut self,
+        saved: Saved,
+        p: &Params,
+        frames: Option<&PipelineInput>,
+    ) -> Result<&StageOutputs, LlvError> {
         self.last = None;
-        self.ws.run_saved(saved, p)
+        let Some(input) = frames else {
+            return self.ws.run_saved(saved, p, None);
+        };
+        let map = self.lens_map(input, p)?;
+        self.ws
+            .run_saved(saved, p, Some(&input.input(map.as_deref())))
     }
 
     /// The outputs of the last run.
@@ -307,7 +318,8 @@ impl Session {
     /// console re-runs the lines (tracks follow the response's peaks below
     /// the edge threshold, which the edge files do not hold), or on its
     /// saved `.hpo` and `.vpo` when it has no frames. From `connect` on its
-    /// saved `.lex`. Returns the parameters the outputs stand for.
+    /// saved `.lex`, the lines refitted on its frames when it has some.
+    /// Returns the parameters the outputs stand for.
     pub fn run_stages<'r>(
         &self,
         k: u32,
@@ -346,7 +358,14 @@ impl Session {
             }
             Saved::Lines(lex)
         };
-        Ok((runner.run_saved(saved, &used), used))
+        // The refit after CONNECT reads the frames, as the console's does.
+        let frames = if from == Stage::Connect && self.has_frames(k) {
+            Some(self.pipeline_input(k)?)
+        } else {
+            None
+        };
+        let out = runner.run_saved(saved, &used, frames.as_ref())?;
+        Ok((out, used))
     }
 
     /// Saves what [`Session::run_stages`] gave for a run from `from`: the

@@ -208,7 +208,8 @@ fn redo_from_lines_without_frames_uses_the_edge_files() {
     let h = vss::formats::edgefile::read_edges(&sdir.join("box1.hpo")).unwrap();
     let v = vss::formats::edgefile::read_edges(&sdir.join("box1.vpo")).unwrap();
     let by_edges = Runner::new()
-        .run_saved(vss::llv::pipeline::Saved::Edges { h, v }, &p)
+        .run_saved(vss::llv::pipeline::Saved::Edges { h, v }, &p, None)
+        .unwrap()
         .lines
         .clone();
     assert_eq!(s.load_lines(1).unwrap().len(), by_edges.len());

@@ -19,6 +19,7 @@ use super::straight::Straightness;
 use super::{Camera, PointLight, RenderOptions, Scene};
 use crate::llv::lens::LensMap;
 use crate::llv::pipeline::{self, Input};
+use crate::llv::refine;
 use crate::llv::{
     EdgePoints, GreyImage, LlvError, Params, Point, Segment, connect, corners, lines,
 };
@@ -178,7 +179,12 @@ pub fn evaluate(cfg: &EvalConfig, params: &Params) -> Result<EvalReport, LlvErro
             sub.add_with(&out.lines, &c.truth, &c.dont_care);
             points += out.edges_h.points.len() + out.edges_v.points.len();
             nlines += out.lines.len();
-            let wp = whole_pixel_lines(&out.edges_h, &out.edges_v, params);
+            let wp = whole_pixel_lines(
+                &out.edges_h,
+                &out.edges_v,
+                std::slice::from_ref(&img),
+                params,
+            );
             whole.add_with(&wp, &c.truth, &c.dont_care);
             let ident = |p: Point| p;
             st_sub.add(&c.truth, &out.edges_h, &out.edges_v, &ident);
@@ -221,9 +227,14 @@ pub(crate) fn run_one(
 }
 
 /// Lines from edge points rounded to whole pixels: what the pipeline would
-/// give without the subpixel step (llv.md §2.4): extraction, CONNECT and
-/// corner closing as in `pipeline::run`.
-pub fn whole_pixel_lines(h: &EdgePoints, v: &EdgePoints, params: &Params) -> Vec<Segment> {
+/// give without the subpixel step (llv.md §2.4): extraction, CONNECT, the
+/// refit on `images` and corner closing as in `pipeline::run`.
+pub fn whole_pixel_lines(
+    h: &EdgePoints,
+    v: &EdgePoints,
+    images: &[GreyImage],
+    params: &Params,
+) -> Vec<Segment> {
     let mut raw = lines::extract(&round_points(h), &params.lines);
     raw.extend(lines::extract(&round_points(v), &params.lines));
     // The same stages after the edges as `pipeline::run`.
@@ -232,6 +243,9 @@ pub fn whole_pixel_lines(h: &EdgePoints, v: &EdgePoints, params: &Params) -> Vec
     } else {
         raw
     };
+    if params.connect.refine {
+        refine::refine_into(images, &mut out, &mut refine::RefineScratch::default());
+    }
     if params.connect.corner_radius > 0.0 {
         corners::close_corners(&mut out, params.connect.corner_radius);
     }

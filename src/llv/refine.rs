@@ -1,0 +1,357 @@
+//! Refitting each line on the image across it (the thesis's §7.1):
+//! the step after CONNECT that places a line where the image says its edge
+//! is, rather than where the scan-direction points put it.
+//!
+//! Why: the tracker's points are peaks of a kernel along the scan. For a
+//! line 22.5–45° from its scan the edge's profile along the scan is
+//! stretched by up to 2.6 times, and CONNECT then averages that version
+//! with the other scan's (length-weighted). A kernel across the line sees
+//! the edge's true profile, whatever its direction.
+//!
+//! The method, for a segment:
+//! - It is read on the scan lines of the image axis nearer its normal
+//!   (rows for a line nearer the vertical, columns otherwise), from
+//!   `TRIM` px of line after its start to `TRIM` px before its end. On
+//!   each, the image is sampled at `2R + 1` points one pixel apart across
+//!   the line (`√(1 + slope²)` apart along the scan line, interpolated
+//!   linearly along it), centred on the line. The scan lines are split
+//!   into blocks of about `BLOCK` px of line whose profiles are summed
+//!   (the edge averaged along its length, as the tracker's fit averages
+//!   its points). A block with a sample outside the image, or next to an
+//!   invalid pixel of a lens-corrected one, is left out.
+//! - The profiles are differentiated across the line with Lee's kernel of
+//!   half-width `KERNEL_A` (narrower than the edge stage's default 4, so
+//!   that a second edge 4–8 px away pulls less). The polarity is that of
+//!   the whole segment's summed profile at the line.
+//! - In each block the peak of that polarity nearest the line, within
+//!   `REACH` px, gives a point (parabolic subpixel position); the line
+//!   is fitted to the points and the segment's ends are projected onto it.
+//! - A segment with fewer than `MIN_BLOCKS` blocks (under about 52 px),
+//!   or whose blocks found a peak in fewer than half, keeps its line: a fit
+//!   to a few block points has a worse direction than the tracker's fit to
+//!   one point per scan line.
+//! - With several lightings the image is, per segment, the one with the
+//!   strongest edge at the line (the derivative of profiles summed on
+//!   eight scan lines).
+//!
+//! How it was chosen, on the cube family only (`vss selftest --family
+//! cubes`, endpoints px / angle °), sampling bilinearly along the normal:
+//! - Without it: σ 2 0.031 / 0.063, σ 5 0.055 / 0.101, σ 10 0.095 / 0.150.
+//! - Every segment refitted, 8-px blocks, `A` = 3: 0.028 / 0.060, 0.052 /
+//!   0.099, 0.094 / 0.172 — the direction of short segments got worse.
+//! - Segments of 6 blocks and more only: 0.027 / 0.058, 0.051 / 0.097,
+//!   0.082 / 0.137, and F at σ 10 0.981 → 0.982. (`A` = 4: σ 2 0.032;
+//!   4-px blocks: σ 5 0.058; 4 blocks at least: σ 10 0.088; before
+//!   CONNECT instead of after: σ 2 0.034; a reach of 1.0 px or 1.5, the
+//!   nearest peak or the strongest: the same.)
+//! - Bilinear samples cost 300 µs an image on the bench scene (a third of
+//!   the pipeline). Samples on scan lines, interpolated along them only,
+//!   cost about 1.0 M instructions (11 %) and give 0.030 / 0.062, 0.054 /
+//!   0.101, 0.086 / 0.144: most of the gain.
+//!
+//! Then, on the yard family (not used to choose), endpoints fell at every
+//! level (σ 0/2/5/10/sd: 0.094 / 0.136 / 0.178 / 0.278 / 0.179 → 0.089 /
+//! 0.117 / 0.151 / 0.254 / 0.155 px) and so did the angles (0.182 / 0.239
+//! / 0.300 / 0.434 / 0.282 → 0.181 / 0.229 / 0.275 / 0.426 / 0.266°).
+//!
+//! The refit needs the image: lines made from edge files alone (`vss llv
+//! --from-edges`, and a session image without frames) are not refitted;
+//! it is `connect.refine` in a profile. `residual` stays the tracker's.
+
+use super::fit::LineFit;
+use super::image::GreyImage;
+use super::{Point, Segment};
+
+/// Pixels left out at each end of a segment (where a meeting edge bends
+/// the profile): the kernel half-width of the edge stage's default.
+const TRIM: f64 = 4.0;
+/// Pixels of line summed into one block.
+const BLOCK: usize = 8;
+/// Least number of blocks for a segment to be refitted.
+const MIN_BLOCKS: usize = 6;
+/// Half-width of the derivative kernel across the line.
+const KERNEL_A: usize = 3;
+/// Farthest a block's peak may lie from the line (px).
+const REACH: f64 = 1.0;
+/// Samples to each side of the line: the peak test at `|k - R| ≤ 2` (a
+/// peak within `REACH` and its two neighbours) with the kernel's
+/// `KERNEL_A` on each side.
+const R: usize = 2 + KERNEL_A;
+const SAMPLES: usize = 2 * R + 1;
+/// Pixels of a scan line a profile reads, at most (`|slope| ≤ 1`).
+const SPAN: usize = 2 * R * 3 / 2 + 3;
+
+type Profile = [f64; SAMPLES];
+
+/// Reusable buffers of [`refine_into`].
+#[derive(Clone, Debug, Default)]
+pub struct RefineScratch {
+    profiles: Vec<Profile>,
+    centres: Vec<f64>,
+}
+
+/// Lee's kernel of half-width `KERNEL_A`, negated so that a dark-to-bright
+/// step along the normal gives a positive peak.
+fn kernel() -> [f64; 2 * KERNEL_A + 1] {
+    let a = KERNEL_A as i64;
+    let mut k = [0.0; 2 * KERNEL_A + 1];
+    for (i, t) in (-a..=a).enumerate() {
+        let v = if t <= 0 {
+            6 * t * (t + a)
+        } else {
+            -6 * t * (t - a)
+        };
+        k[i] = v as f64;
+    }
+    k
+}
+
+/// The derivative across the line at sample `k` (`KERNEL_A ≤ k < SAMPLES -
+/// KERNEL_A`).
+fn derivative(p: &Profile, kern: &[f64; 2 * KERNEL_A + 1], k: usize) -> f64 {
+    kern.iter()
+        .zip(&p[k - KERNEL_A..=k + KERNEL_A])
+        .map(|(c, v)| c * v)
+        .sum()
+}
+
+/// A segment in the frame of the image axis nearer its normal: `u` across
+/// the line along that axis (`x` for a line nearer the vertical, `y`
+/// otherwise), `v` the other axis (the scan line, row or column). The line
+/// is `u = u0 + slope · (v − v0)`, `|slope| ≤ 1`.
+struct Frame {
+    steep: bool,
+    u0: f64,
+    v0: f64,
+    slope: f64,
+    /// `√(1 + slope²)`: the step along the axis that is one pixel across
+    /// the line.
+    sec: f64,
+    /// The scan lines the blocks cover: `first..first + count`.
+    first: usize,
+    count: usize,
+}
+
+impl Frame {
+    /// The frame of `s`, its scan lines less `TRIM` px of line at each
+    /// end; `None` for a segment that is not finite or has no such lines.
+    fn of(s: &Segment) -> Option<Frame> {
+        let (dx, dy) = (s.b.x - s.a.x, s.b.y - s.a.y);
+        let steep = dy.abs() >= dx.abs();
+        let (ua, va, ub, vb) = if steep {
+            (s.a.x, s.a.y, s.b.x, s.b.y)
+        } else {
+            (s.a.y, s.a.x, s.b.y, s.b.x)
+        };
+        let len = dx.hypot(dy);
+        if !(len.is_finite() && len > 0.0 && ua.is_finite() && ub.is_finite()) {
+            return None;
+        }
+        let slope = (ub - ua) / (vb - va);
+        // `TRIM` px of line is `TRIM · |dv| / len` scan lines.
+        let trim = TRIM * (vb - va).abs() / len;
+        let (lo, hi) = (va.min(vb) + trim, va.max(vb) - trim);
+        if !(lo.is_finite() && hi.is_finite() && lo <= hi && lo > -1.0) {
+            return None;
+        }
+        let first = lo.max(0.0).ceil();
+        let last = hi.floor();
+        if last < first || last > (u32::MAX as f64) {
+            return None;
+        }
+        Some(Frame {
+            steep,
+            u0: ua,
+            v0: va,
+            slope,
+            sec: slope.hypot(1.0),
+            first: first as usize,
+            count: (last - first) as usize + 1,
+        })
+    }
+
+    /// The line's `u` on scan line `v`.
+    fn u_at(&self, v: f64) -> f64 {
+        self.u0 + self.slope * (v - self.v0)
+    }
+
+    /// The image point at `u` across, scan line `v`.
+    fn point(&self, u: f64, v: f64) -> Point {
+        if self.steep {
+            Point::new(u, v)
+        } else {
+            Point::new(v, u)
+        }
+    }
+
+    /// Adds to `p` the profile across the line on scan line `v`: the image
+    /// at `u_at(v) + (k − R) · sec` for each sample `k`, interpolated along
+    /// the axis, where `sec = √(1 + slope²)` makes the samples one pixel
+    /// apart across the line (they also move `(k − R) · slope / sec` along
+    /// it, which a straight edge does not see). False (with `p` unchanged)
+    /// where a sample is outside the image or next to an invalid pixel.
+    fn add_profile(&self, img: &GreyImage, v: usize, p: &mut Profile) -> bool {
+        let (w, h) = img.size();
+        let (len_u, len_v) = if self.steep { (w, h) } else { (h, w) };
+        let u = self.u_at(v as f64);
+        let reach = R as f64 * self.sec;
+        if v >= len_v || !(u - reach >= 0.0 && u + reach + 1.0 < len_u as f64) {
+            return false;
+        }
+        let lo = (u - reach) as usize;
+        let n = (u + reach) as usize + 2 - lo;
+        // The pixels `lo..lo + n` of the scan line, in a buffer on the
+        // stack (`n ≤ 2 R √2 + 2`).
+        let mut buf = [0.0f64; SPAN];
+        let Some(buf) = buf.get_mut(..n) else {
+            return false;
+        };
+        let d = img.data();
+        let mask = img.valid_mask();
+        if self.steep {
+            let at = v * w + lo;
+            if mask.is_some_and(|m| m[at..at + n].contains(&false)) {
+                return false;
+            }
+            for (b, &g) in buf.iter_mut().zip(&d[at..at + n]) {
+                *b = f64::from(g);
+            }
+        } else {
+            let at = lo * w + v;
+            if mask.is_some_and(|m| (0..n).any(|j| !m[at + j * w])) {
+                return false;
+            }
+            for (j, b) in buf.iter_mut().enumerate() {
+                *b = f64::from(d[at + j * w]);
+            }
+        }
+        // The sample positions in the buffer in 1/2¹⁶ px (their rounding,
+        // under 2⁻¹⁶ px a step, is far below what the fit resolves).
+        const ONE: f64 = 65536.0;
+        let mut x = ((u - reach - lo as f64) * ONE) as u32;
+        let step = (self.sec * ONE) as u32;
+        for out in p.iter_mut() {
+            let i = ((x >> 16) as usize).min(n - 2);
+            let f = f64::from(x & 0xFFFF) * (1.0 / ONE);
+            *out += buf[i] + f * (buf[i + 1] - buf[i]);
+            x += step;
+        }
+        true
+    }
+}
+
+/// Refits each segment of `segs` on `images` (one image, or the lightings
+/// of a view) as the module doc says; segments it cannot refit are left
+/// as they are.
+pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScratch) {
+    if images.is_empty() {
+        return;
+    }
+    let kern = kernel();
+    for seg in segs.iter_mut() {
+        let Some(f) = Frame::of(seg) else {
+            continue;
+        };
+        // Blocks of about `BLOCK` px of line.
+        let len = seg.length();
+        let steps = (len - 2.0 * TRIM).floor();
+        if steps.is_nan() || steps < (MIN_BLOCKS * BLOCK - BLOCK / 2) as f64 {
+            continue;
+        }
+        let blocks = ((steps as usize + BLOCK / 2) / BLOCK).min(f.count);
+        if blocks < MIN_BLOCKS {
+            continue;
+        }
+        let img = if images.len() == 1 {
+            &images[0]
+        } else {
+            strongest(images, &f, &kern)
+        };
+        s.profiles.clear();
+        s.centres.clear();
+        let mut total = [0.0; SAMPLES];
+        for b in 0..blocks {
+            let (lo, hi) = (b * f.count / blocks, (b + 1) * f.count / blocks);
+            let mut p = [0.0; SAMPLES];
+            if !(lo..hi).all(|i| f.add_profile(img, f.first + i, &mut p)) {
+                continue;
+            }
+            for (t, v) in total.iter_mut().zip(&p) {
+                *t += v;
+            }
+            s.profiles.push(p);
+            s.centres.push(f.first as f64 + 0.5 * (lo + hi - 1) as f64);
+        }
+        if s.profiles.len() < MIN_BLOCKS {
+            continue;
+        }
+        let at_line = derivative(&total, &kern, R);
+        if at_line == 0.0 || !at_line.is_finite() {
+            continue;
+        }
+        let pol = at_line.signum();
+        let mut fit = LineFit::new();
+        for (p, &v) in s.profiles.iter().zip(&s.centres) {
+            if let Some(o) = peak_near_line(p, &kern, pol) {
+                fit.add(f.point(f.u_at(v) + o * f.sec, v));
+            }
+        }
+        if fit.len() < 2 || 2 * fit.len() < s.profiles.len() {
+            continue;
+        }
+        if let Some(line) = fit.line() {
+            seg.a = line.project(seg.a);
+            seg.b = line.project(seg.b);
+        }
+    }
+}
+
+/// The offset (px along the normal) of the peak of polarity `pol` nearest
+/// the line within `REACH`, if there is one.
+fn peak_near_line(p: &Profile, kern: &[f64; 2 * KERNEL_A + 1], pol: f64) -> Option<f64> {
+    let d = |k: usize| pol * derivative(p, kern, k);
+    let mut best: Option<f64> = None;
+    for k in R - 1..=R + 1 {
+        let (dm, d0, dp) = (d(k - 1), d(k), d(k + 1));
+        if d0 <= 0.0 || d0 < dm || d0 < dp {
+            continue;
+        }
+        let den = dm - 2.0 * d0 + dp;
+        let off = if den < 0.0 {
+            0.5 * (dm - dp) / den
+        } else {
+            0.0
+        };
+        let o = k as f64 - R as f64 + off.clamp(-0.5, 0.5);
+        if o.abs() <= REACH && best.is_none_or(|b| o.abs() < b.abs()) {
+            best = Some(o);
+        }
+    }
+    best
+}
+
+/// Of several images, the one whose edge at the line is strongest: the
+/// derivative at the line of profiles summed on eight scan lines.
+fn strongest<'a>(
+    images: &'a [GreyImage],
+    f: &Frame,
+    kern: &[f64; 2 * KERNEL_A + 1],
+) -> &'a GreyImage {
+    let mut best = (0.0, &images[0]);
+    for img in images {
+        let mut p = [0.0; SAMPLES];
+        let whole = (0..8).all(|i| f.add_profile(img, f.first + i * f.count / 8, &mut p));
+        let m = if whole {
+            derivative(&p, kern, R).abs()
+        } else {
+            0.0
+        };
+        if m > best.0 {
+            best = (m, img);
+        }
+    }
+    best.1
+}
+
+#[cfg(test)]
+mod tests;
