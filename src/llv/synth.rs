@@ -28,7 +28,7 @@ pub mod yard;
 pub use geom::{Face, Polyhedron, V3, look_at};
 pub use render::{finish, render_exact};
 pub use scenes::{CELL_LIGHT_NAMES, cell_cameras, cell_lights, cell_scene, l_bracket, test_scenes};
-pub use score::{Metrics, Tally, score, score_all};
+pub use score::{Metrics, Shared, Tally, score, score_all, shared_endpoints};
 pub use truth::{
     MARGIN as TRUTH_MARGIN, MIN_PIECE as TRUTH_MIN_PIECE, visible_edges as true_edges,
 };

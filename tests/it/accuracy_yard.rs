@@ -299,12 +299,43 @@ fn another_detectors_segments_are_scored_with_dont_care_edges() {
         .unwrap()
         .lines()
         .collect();
-    let names: Vec<&str> = block[2..]
+    let names: Vec<&str> = block[2..6]
         .iter()
         .map(|l| l.split_whitespace().next().unwrap())
         .collect();
     assert_eq!(names, ["vss", "faint", "none", "perfect"], "{table}");
     assert!(block[3].contains('—'), "{table}");
+    // Endpoints beside vss's on the true edges both found: the truth itself
+    // is 0 px off them, and vss is compared on those edges only.
+    let shared = |det: &str| {
+        let d = &s
+            .iter()
+            .find(|x| x.0 == "yard" && x.1 == "sd" && x.2 == det)
+            .unwrap()
+            .4["shared_with_vss"];
+        (
+            d["first_mean"].as_f64().unwrap(),
+            d["second_mean"].as_f64().unwrap(),
+            d["edges"].as_u64().unwrap(),
+        )
+    };
+    let vss = &s
+        .iter()
+        .find(|x| x.0 == "yard" && x.1 == "sd" && x.2 == "vss")
+        .unwrap()
+        .4;
+    assert!(vss["shared_with_vss"].is_null());
+    let (mine, theirs, edges) = shared("perfect");
+    assert!(
+        edges > 0 && theirs < 1e-9 && mine > 0.0,
+        "{mine} {theirs} {edges}"
+    );
+    assert_eq!(shared("none").2, 0);
+    assert!(
+        block[6].starts_with("  endpoint px on the true edges both support")
+            && block[6].contains(&format!("perfect {mine:.3} / 0.000 ({edges} edges)")),
+        "{table}"
+    );
 }
 
 /// `vss selftest --score DIR`, which must fail, printing nothing but the

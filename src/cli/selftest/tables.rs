@@ -199,6 +199,25 @@ pub fn compare_table(families: &[FamilyScores]) -> String {
                     ms(d.median_ms)
                 );
             }
+            let shared: Vec<String> = l
+                .detectors
+                .iter()
+                .filter_map(|d| {
+                    d.shared_with_vss.map(|sh| {
+                        format!(
+                            "{} {:.3} / {:.3} ({} edges)",
+                            d.detector, sh.first_mean, sh.second_mean, sh.edges
+                        )
+                    })
+                })
+                .collect();
+            if !shared.is_empty() {
+                let _ = writeln!(
+                    s,
+                    "  endpoint px on the true edges both support, vss / peer: {}",
+                    shared.join(", ")
+                );
+            }
             let _ = writeln!(s);
         }
     }

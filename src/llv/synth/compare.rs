@@ -24,7 +24,7 @@ use serde::{Deserialize, Serialize};
 
 use super::eval::yard::{Level, YardConfig, yard_cases, yard_image, yard_lens_image};
 use super::eval::{EvalConfig, cube_cases, cube_image};
-use super::score::{Metrics, Tally, percentile};
+use super::score::{Metrics, Shared, Tally, percentile, shared_endpoints};
 use super::yard::truth as yard_truth;
 use crate::formats::imageio::write_any;
 use crate::formats::img::ImgFile;
@@ -225,6 +225,9 @@ pub struct DetectorScore {
     /// when the detector wrote its times.
     pub fastest_ms: Option<f64>,
     pub median_ms: Option<f64>,
+    /// For a detector other than vss: vss's endpoint distance (`first_*`)
+    /// and this detector's (`second_*`) on the true edges both support.
+    pub shared_with_vss: Option<Shared>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -295,6 +298,7 @@ pub fn score_dir(dir: &Path) -> Result<Vec<FamilyScores>, FormatError> {
                 .map(|i| read_truth(&ldir.join(format!("{}.truth", stem(i)))))
                 .collect::<Result<_, _>>()?;
             let mut dets = Vec::new();
+            let mut tallies = Vec::new();
             for det in detectors(&ldir)? {
                 let mut tally = Tally::default();
                 for (i, (t, dc)) in truths.iter().enumerate() {
@@ -331,7 +335,15 @@ pub fn score_dir(dir: &Path) -> Result<Vec<FamilyScores>, FormatError> {
                     metrics,
                     fastest_ms,
                     median_ms,
+                    shared_with_vss: None,
                 });
+                tallies.push(tally);
+            }
+            // (`detectors` puts vss first when it is there.)
+            if dets.first().is_some_and(|d| d.detector == VSS) {
+                for (d, t) in dets.iter_mut().zip(&tallies).skip(1) {
+                    d.shared_with_vss = Some(shared_endpoints(&tallies[0], t));
+                }
             }
             levels.push(LevelScores {
                 level: tag.clone(),

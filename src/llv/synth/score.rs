@@ -30,6 +30,11 @@
 //!   lies within [`DIST`] px of a true edge at a larger angle (a line tilted
 //!   off its edge), plus the stretch of a segment between two close
 //!   parallel true edges it runs near both of (a line bent across them).
+//!
+//! Between two detectors, [`shared_endpoints`] gives each one's endpoint
+//! distance over only the true edges both support. The plain endpoint
+//! figure of a detector that finds more faint edges includes them, and
+//! faint edges have larger errors; this one compares like with like.
 
 use crate::llv::{Point, Segment};
 
@@ -109,6 +114,55 @@ pub struct Tally {
     pub close_covered: f64,
     pub off_angle_length: f64,
     pub dont_care_length: f64,
+    /// Images added so far.
+    pub images: usize,
+    /// Per supporting segment (in the order of `angle_errors_deg`; its two
+    /// endpoints are `endpoint_dists[2 k]` and `[2 k + 1]`): the image and
+    /// the index of the true edge it supports most.
+    pub supported: Vec<(usize, usize)>,
+}
+
+/// Endpoint distances of two detectors on the true edges both support
+/// ([`shared_endpoints`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Shared {
+    /// Mean endpoint distance (px) of the first detector's and the second
+    /// detector's supporting segments on those edges.
+    pub first_mean: f64,
+    pub second_mean: f64,
+    /// How many segments each has there.
+    pub first_segments: usize,
+    pub second_segments: usize,
+    /// How many true edges both support.
+    pub edges: usize,
+}
+
+/// The endpoint distance of each of two detectors, scored on the same
+/// images, over only the true edges that both support: a detector that
+/// finds more faint edges is not compared on edges the other did not find.
+pub fn shared_endpoints(first: &Tally, second: &Tally) -> Shared {
+    use std::collections::HashSet;
+    let a: HashSet<(usize, usize)> = first.supported.iter().copied().collect();
+    let b: HashSet<(usize, usize)> = second.supported.iter().copied().collect();
+    let mean_on = |t: &Tally| {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for (k, key) in t.supported.iter().enumerate() {
+            if a.contains(key) && b.contains(key) {
+                sum += t.endpoint_dists[2 * k] + t.endpoint_dists[2 * k + 1];
+                n += 1;
+            }
+        }
+        (if n > 0 { sum / (2 * n) as f64 } else { 0.0 }, n)
+    };
+    let (first_mean, first_segments) = mean_on(first);
+    let (second_mean, second_segments) = mean_on(second);
+    Shared {
+        first_mean,
+        second_mean,
+        first_segments,
+        second_segments,
+        edges: a.intersection(&b).count(),
+    }
 }
 
 impl Tally {
@@ -182,8 +236,10 @@ impl Tally {
                 self.endpoint_dists.push(line_distance(t, d.a));
                 self.endpoint_dists.push(line_distance(t, d.b));
                 self.angle_errors_deg.push(angle_diff_deg(d, t));
+                self.supported.push((self.images, ti));
             }
         }
+        self.images += 1;
         for (ti, (t, c)) in truth.iter().zip(covered).enumerate() {
             let tl = t.length();
             if !tl.is_finite() {

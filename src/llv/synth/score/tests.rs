@@ -175,3 +175,31 @@ fn tilted_and_bridging_lines_are_off_angle() {
     let m = tally(&[seg(0.0, 15.0, 100.0, 15.0)], &far, &[]);
     assert_eq!(m.off_angle, 0.0);
 }
+
+#[test]
+fn shared_endpoints_compare_two_detectors_on_the_edges_both_found() {
+    let truth = vec![seg(0.0, 0.0, 100.0, 0.0), seg(0.0, 50.0, 100.0, 50.0)];
+    // The first finds both edges (the second one 1 px off) in image 0, and
+    // only the second edge in image 1; the other finds the first edge in
+    // image 0 (0.3 px off) and the first edge in image 1.
+    let (mut first, mut second) = (Tally::default(), Tally::default());
+    first.add(
+        &[seg(0.0, 0.1, 100.0, 0.1), seg(0.0, 51.0, 100.0, 51.0)],
+        &truth,
+    );
+    first.add(&[seg(0.0, 50.2, 100.0, 50.2)], &truth);
+    second.add(&[seg(0.0, 0.3, 100.0, 0.3)], &truth);
+    second.add(&[seg(0.0, 0.4, 100.0, 0.4)], &truth);
+    assert!((first.metrics().endpoint_mean - 0.1 / 3.0 - 1.2 / 3.0).abs() < 1e-9);
+    let sh = shared_endpoints(&first, &second);
+    assert_eq!(sh.edges, 1, "{sh:?}");
+    assert_eq!((sh.first_segments, sh.second_segments), (1, 1));
+    assert!((sh.first_mean - 0.1).abs() < 1e-9, "{sh:?}");
+    assert!((sh.second_mean - 0.3).abs() < 1e-9, "{sh:?}");
+    // Symmetric, and nothing shared with a detector that found nothing.
+    let back = shared_endpoints(&second, &first);
+    assert!((back.first_mean - 0.3).abs() < 1e-9 && (back.second_mean - 0.1).abs() < 1e-9);
+    let none = shared_endpoints(&first, &Tally::default());
+    assert_eq!((none.edges, none.first_segments), (0, 0));
+    assert_eq!(none.first_mean, 0.0);
+}
