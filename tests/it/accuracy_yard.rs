@@ -276,12 +276,12 @@ fn another_detectors_segments_are_scored_with_dont_care_edges() {
         std::fs::write(yard_sd.join(format!("s{i:02}.none.seg")), "# nothing\n").unwrap();
     }
     let s = scores(dir.path());
-    let f = |det: &str| {
+    let row = |det: &str| {
         s.iter()
             .find(|x| x.0 == "yard" && x.1 == "sd" && x.2 == det)
-            .map(|x| x.3)
             .unwrap_or_else(|| panic!("no score for {det}"))
     };
+    let f = |det: &str| row(det).3;
     assert!((f("perfect") - 1.0).abs() < 1e-6, "{}", f("perfect"));
     // Finding the don't-care edges too costs nothing.
     assert!((f("faint") - 1.0).abs() < 1e-6, "{}", f("faint"));
@@ -308,23 +308,14 @@ fn another_detectors_segments_are_scored_with_dont_care_edges() {
     // Endpoints beside vss's on the true edges both found: the truth itself
     // is 0 px off them, and vss is compared on those edges only.
     let shared = |det: &str| {
-        let d = &s
-            .iter()
-            .find(|x| x.0 == "yard" && x.1 == "sd" && x.2 == det)
-            .unwrap()
-            .4["shared_with_vss"];
+        let d = &row(det).4["shared_with_vss"];
         (
             d["first_mean"].as_f64().unwrap(),
             d["second_mean"].as_f64().unwrap(),
             d["edges"].as_u64().unwrap(),
         )
     };
-    let vss = &s
-        .iter()
-        .find(|x| x.0 == "yard" && x.1 == "sd" && x.2 == "vss")
-        .unwrap()
-        .4;
-    assert!(vss["shared_with_vss"].is_null());
+    assert!(row("vss").4["shared_with_vss"].is_null());
     let (mine, theirs, edges) = shared("perfect");
     assert!(
         edges > 0 && theirs < 1e-9 && mine > 0.0,
