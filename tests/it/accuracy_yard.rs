@@ -92,13 +92,14 @@ fn noise_free() {
 /// Endpoints and angles, every level: corner closing moves an endpoint only
 /// to a point its line passes through, so close parallel edges meeting a
 /// third keep their direction (`llv::corners`); the refit across each line
-/// (`llv::refine`) sets the ceilings at σ 2, 5 and signal-dependent noise.
+/// (`llv::refine`), its points weighted by their edge's strength, sets the
+/// ceilings at σ 2, 5, 10 and signal-dependent noise.
 #[test]
 fn endpoints_and_angles() {
     geometry(Level::Sigma(0.0), 0.080, 0.195);
-    geometry(Level::Sigma(2.0), 0.110, 0.225);
-    geometry(Level::Sigma(5.0), 0.150, 0.268);
-    geometry(Level::Sigma(10.0), 0.240, 0.390);
+    geometry(Level::Sigma(2.0), 0.109, 0.223);
+    geometry(Level::Sigma(5.0), 0.149, 0.260);
+    geometry(Level::Sigma(10.0), 0.226, 0.375);
     geometry(Level::Signal, 0.165, 0.268);
 }
 

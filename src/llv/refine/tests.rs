@@ -161,3 +161,41 @@ fn invalid_pixels_are_not_sampled() {
     );
     assert_eq!(format!("{:?}", segs[0]), format!("{sg:?}"));
 }
+
+#[test]
+fn where_the_edge_fades_its_blocks_count_for_less() {
+    // The upper half of the edge is lit (contrast 100 grey levels), the
+    // lower half lies in a shadow (contrast 5), under noise σ 8: a block
+    // point in the shadow is about twenty times as uncertain as one in the
+    // light. Weighted by their peaks' strength the fit follows the lit
+    // blocks (0.056 px mean endpoint error over these seeds); unweighted,
+    // the shadowed half tilts the line (0.20 px).
+    let (w, h) = (96, 120);
+    let step = edge_image(w, h, A, B, 0.0, 250.0, None);
+    let mut total = 0.0;
+    let seeds = 24;
+    for seed in 0..seeds {
+        let mut rng = crate::llv::synth::rng::SplitMix64::new(seed);
+        let data: Vec<u8> = step
+            .data()
+            .iter()
+            .enumerate()
+            .map(|(i, &s)| {
+                let y = (i / w) as f64;
+                let contrast = if y < 60.0 { 100.0 } else { 5.0 };
+                let g = 60.0 + contrast * f64::from(s) / 250.0 + 8.0 * rng.gauss();
+                g.round().clamp(0.0, 255.0) as u8
+            })
+            .collect();
+        let img = GreyImage::new(w, h, data).unwrap();
+        let mut segs = [seg((A.0 + 0.4, A.1 + 2.0), (B.0 - 0.4, B.1 - 2.0))];
+        refine_into(
+            std::slice::from_ref(&img),
+            &mut segs,
+            &mut RefineScratch::default(),
+        );
+        total += off_line(segs[0].a, A, B) + off_line(segs[0].b, A, B);
+    }
+    let mean = total / (2 * seeds) as f64;
+    assert!(mean < 0.1, "mean endpoint error {mean:.3} px");
+}
