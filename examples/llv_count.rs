@@ -22,7 +22,11 @@
 //! directions), `response`, `noise`, `peaks` (the peak map and the edge
 //! points, as two passes), `lines` (`linesh`, `linesv`: one direction),
 //! `connect`, `lens` (the correction alone), `five` (four lightings and the
-//! ambient image to lines); `scene FILE.pgm` writes the scene.
+//! ambient image to lines); `scene FILE.pgm` writes the scene. With
+//! `IMAGE=photo.pgm` (any image `vss llv` reads) that image replaces the
+//! bench scene for the stages of one image (`TIME=1 IMAGE=photo.pgm
+//! llv_count connect 200`: a photograph has hundreds of lines where a
+//! synthetic scene has tens).
 
 use vss::llv::connect::{ConnectScratch, connect_into};
 use vss::llv::edges::{
@@ -53,7 +57,16 @@ fn main() {
         }),
         Err(_) => 512,
     };
-    let img = llv_scene::scene(size, size, 2.0, 42);
+    let img = match std::env::var_os("IMAGE") {
+        Some(path) => match vss::formats::imageio::read_any(std::path::Path::new(&path)) {
+            Ok(f) => f.image,
+            Err(e) => {
+                eprintln!("IMAGE: {e}");
+                std::process::exit(2);
+            }
+        },
+        None => llv_scene::scene(size, size, 2.0, 42),
+    };
     if stage == "scene" {
         // Writes the bench scene as a binary PGM to `N` (a path here).
         let (w, h) = img.size();
