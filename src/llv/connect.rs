@@ -399,12 +399,12 @@ pub fn connect(lines: &[Segment], p: &ConnectParams) -> Vec<Segment> {
 /// same state and failed. This makes the final "nothing merges" pass cheap.
 ///
 /// The pairs are found through a grid of 32-px cells: a segment is tested
-/// against the later segments whose environments' bounds may meet its own,
-/// in the order of the module doc, and after it absorbs one, against those
-/// of its grown bounds from the first again. That is the same sequence of
-/// merges as testing every later segment (a pair whose bounds do not meet
-/// fails the test before anything else), at about the cost of the pairs
-/// that are near each other: on a 2560 × 1920 photograph of 5,240 lines
+/// against the later segments whose environments share a cell with its
+/// own, in the order of the module doc, and after it absorbs one, against
+/// those of its grown environment from the first again. That is the same
+/// sequence of merges as testing every later segment (environments that
+/// share no cell do not meet, and such a pair fails the test), at about
+/// the cost of the pairs that are near each other: on a 2560 × 1920 photograph of 5,240 lines
 /// the quadratic scan took most of the pipeline's time.
 pub fn connect_into(
     lines: &[Segment],
