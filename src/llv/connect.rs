@@ -115,6 +115,11 @@ pub fn one_edge(s1: &Segment, s2: &Segment, merged: &Segment) -> bool {
     spread.is_nan() || spread <= allowed
 }
 
+/// Whether both ends of `l` are finite: CONNECT leaves out the others.
+fn finite(l: &Segment) -> bool {
+    l.a.x.is_finite() && l.a.y.is_finite() && l.b.x.is_finite() && l.b.y.is_finite()
+}
+
 /// The canonical order of segments: longer first, then by coordinates.
 fn order(s1: &Segment, s2: &Segment) -> std::cmp::Ordering {
     keyed_order(&(s1.length(), *s1), &(s2.length(), *s2))
@@ -418,14 +423,8 @@ pub fn connect_into(
         return;
     }
     s.keyed.clear();
-    s.keyed.extend(
-        lines
-            .iter()
-            .filter(|l| {
-                l.a.x.is_finite() && l.a.y.is_finite() && l.b.x.is_finite() && l.b.y.is_finite()
-            })
-            .map(|l| (l.length(), *l)),
-    );
+    s.keyed
+        .extend(lines.iter().filter(|l| finite(l)).map(|l| (l.length(), *l)));
     s.keyed.sort_unstable_by(keyed_order);
     s.segs.clear();
     s.segs.extend(s.keyed.iter().map(|k| k.1));
@@ -607,13 +606,7 @@ mod tests {
         if !p.enabled {
             return lines.to_vec();
         }
-        let mut segs: Vec<Segment> = lines
-            .iter()
-            .filter(|l| {
-                l.a.x.is_finite() && l.a.y.is_finite() && l.b.x.is_finite() && l.b.y.is_finite()
-            })
-            .copied()
-            .collect();
+        let mut segs: Vec<Segment> = lines.iter().filter(|l| finite(l)).copied().collect();
         segs.sort_unstable_by(order);
         let n = segs.len();
         let mut alive = vec![true; n];
