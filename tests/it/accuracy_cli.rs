@@ -1,6 +1,6 @@
 //! `vss selftest` as a user runs it: the tables of both families, the JSON
 //! for scripts, and a clear refusal of bad arguments. Small scenes keep it
-//! quick; the floors themselves are in `accuracy.rs` and `accuracy_yard.rs`.
+//! quick; the floors themselves are in `tests/accuracy/` (`cargo test --test accuracy`).
 
 use assert_cmd::Command;
 

@@ -1,13 +1,12 @@
 //! The integration tests of `vss`, one binary with a module per area:
 //! linking one executable instead of one per file keeps a build after a
 //! one-line edit short. Run one area with `cargo test --test it NAME::`.
-//! Shared helpers live in `support/`.
+//! Shared helpers live in `support/`. The accuracy floors are a binary of
+//! their own, `tests/accuracy/` (`cargo test --test accuracy`).
 
 mod support;
 
-mod accuracy;
 mod accuracy_cli;
-mod accuracy_yard;
 mod calib;
 mod calib_cli;
 mod calib_console;
