@@ -213,6 +213,14 @@ pub enum StoreEvent {
     },
     /// Where the console's log file is.
     LogFile(PathBuf),
+    /// A captured frame the session could not save (a link where its file
+    /// goes, a full disk): the image cannot be accepted until that
+    /// lighting is captured again.
+    FrameNotSaved {
+        k: u32,
+        letter: char,
+        error: StoreError,
+    },
     Error(StoreError),
 }
 

@@ -2,7 +2,9 @@
 //! 80 × 24: a long error wraps and opens in full and lands in the log
 //! file; a damaged session is listed with why, a truncated image and a
 //! garbled line file are marked and only the image's damaged lighting
-//! retaken; a report that cannot be written says so;
+//! retaken; a lighting the session cannot save (a link planted where its
+//! file goes) is marked, keeps the image from being accepted and is
+//! retaken alone; a report that cannot be written says so;
 //! a session held by a console that still runs is offered to take over;
 //! a terminal too small, a dumb terminal and the Linux console.
 
@@ -144,6 +146,59 @@ fn damaged_sessions_and_files_are_shown_and_only_the_damage_retaken() {
         std::thread::sleep(Duration::from_millis(20));
     };
     assert_eq!(img.image.size(), (128, 128));
+    c.send("q");
+    c.wait_exit(10);
+}
+
+/// A lighting whose file cannot be written (a link planted where it goes)
+/// is marked `!` on the checklist, the image is not accepted while it is
+/// not on disk, nothing is written through the link, and retaking that
+/// lighting alone once the link is gone puts it right.
+#[test]
+fn a_lighting_the_session_cannot_save_is_marked_and_keeps_the_image_from_acceptance() {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("cube");
+    let d = c.session();
+    let outside = c.dir.path().join("outside.txt");
+    std::fs::write(&outside, "not an image\n").unwrap();
+    std::os::unix::fs::symlink(&outside, d.join("cube1a.img")).unwrap();
+    c.capture_current(1);
+    let s = c.wait("lighting a marked", 20, |s| {
+        s.contains("!bc") && s.contains("lighting a NOT saved")
+    });
+    assert!(s.contains("R captures again"), "what to do:\n{s}");
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    let s = c.wait_text("NOT accepted", 10);
+    assert!(flat(&s).contains("symbolic link"), "why:\n{s}");
+    assert!(s.contains("Image 1: "), "still on image 1:\n{s}");
+    assert!(!d.join("cube1.ldr").exists(), "no outputs of image 1");
+    assert_eq!(
+        std::fs::read_to_string(&outside).unwrap(),
+        "not an image\n",
+        "nothing written through the link"
+    );
+    std::fs::remove_file(d.join("cube1a.img")).unwrap();
+    c.press(SURVEY, Action::Survey(SurveyAction::Redo));
+    let s = c.wait_text("retakes only a", 10);
+    assert!(s.contains("lighting a not saved"), "{s}");
+    c.yes();
+    c.wait_text("captures lighting a again", 10);
+    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    c.wait("image 1 reviewed again", 30, |s| {
+        s.contains("before CONNECT") && s.contains("abc") && !s.contains("NOT saved")
+    });
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    c.wait_text("Image 2: camera", 20);
+    let end = std::time::Instant::now() + Duration::from_secs(20);
+    while !(d.join("cube1.ldr").exists()
+        && vss::formats::img::read_img(&d.join("cube1a.img")).is_ok())
+    {
+        assert!(
+            std::time::Instant::now() < end,
+            "image 1's lighting a and outputs never saved"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
     c.send("q");
     c.wait_exit(10);
 }

@@ -8,6 +8,7 @@ use crate::tui::event::{
     Cmd, DeviceEvent, FramePurpose, ImageKey, PipelineResult, StoreCmd, StoreEvent,
 };
 use crate::tui::text::clean;
+use crate::tui::workers::store::StoreError;
 
 impl App {
     pub(super) fn on_pipeline(&mut self, r: PipelineResult) -> Vec<Cmd> {
@@ -220,6 +221,21 @@ impl App {
                 let p = clean(&path.display().to_string());
                 self.chrome.log.set_file(path);
                 self.ctx().info(format!("log file: {p}"));
+                Vec::new()
+            }
+            StoreEvent::FrameNotSaved { k, letter, error } => {
+                // The whole error for the log; the session's reason (which
+                // file, why) for the checklist and the questions.
+                let why = match &error {
+                    StoreError::Session { source, .. } => clean(&source.to_string()),
+                    e => clean(&e.to_string()),
+                };
+                let mut ctx = self.ctx();
+                ctx.error(format!(
+                    "{} — image {k} is not accepted until R captures it again",
+                    clean(&error.to_string())
+                ));
+                ctx.frame_not_saved(k, letter, why);
                 Vec::new()
             }
             StoreEvent::Error(e) => {

@@ -317,6 +317,7 @@ impl Ctx<'_> {
         cur.version = version;
         cur.frames.retain(|f| f.0 != letter);
         cur.damaged.retain(|d| d.0 != letter);
+        cur.unsaved.retain(|d| d.0 != letter);
         cur.frames.push((letter, image.clone()));
         // Frames newer than the outputs: those, and hand edits of them, are
         // an older capture's.
@@ -356,9 +357,25 @@ impl Ctx<'_> {
                 .as_ref()
                 .and_then(|c| c.lines())
                 .map_or(0, <[_]>::len);
-            self.info(format!(
-                "image {k}: {n} lines — a accepts, R captures again, 3 tunes, 4 edits"
-            ));
+            match self.tracker.current.as_ref().map(|c| &c.unsaved) {
+                Some(u) if !u.is_empty() => {
+                    let msg = not_saved_message(u);
+                    self.error(format!("image {k}: {n} lines, but {msg}"));
+                }
+                _ => self.info(format!(
+                    "image {k}: {n} lines — a accepts, R captures again, 3 tunes, 4 edits"
+                )),
+            }
+        }
+    }
+
+    /// The session could not save lighting `letter` of image `k`, captured
+    /// in this run: the checklist marks it and the image is not accepted
+    /// until it is captured again.
+    pub fn frame_not_saved(&mut self, k: u32, letter: char, why: String) {
+        if let Some(c) = self.tracker.current.as_mut().filter(|c| c.k == k) {
+            c.unsaved.retain(|d| d.0 != letter);
+            c.unsaved.push((letter, why));
         }
     }
 
@@ -527,11 +544,25 @@ impl Ctx<'_> {
             self.warn("nothing to capture again now");
             return;
         }
-        let damaged: Vec<(char, String)> = self
+        let mut damaged: Vec<(char, String)> = self
             .session
             .image(k)
             .map(|i| i.damaged.clone())
             .unwrap_or_default();
+        let on_disk = damaged.len();
+        // And the lightings of this run the session could not save.
+        if let Some(c) = self.tracker.current.as_ref().filter(|c| c.k == k) {
+            for (l, why) in &c.unsaved {
+                if !damaged.iter().any(|d| d.0 == *l) {
+                    damaged.push((*l, why.clone()));
+                }
+            }
+        }
+        let state = match (on_disk, damaged.len() - on_disk) {
+            (_, 0) => "damaged",
+            (0, _) => "not saved",
+            _ => "damaged or not saved",
+        };
         let all = Pending::Retake {
             k,
             letters: Vec::new(),
@@ -551,7 +582,7 @@ impl Ctx<'_> {
         let why: Vec<String> = damaged.iter().map(|(l, w)| format!("{l}: {w}")).collect();
         self.chrome.modal = Some(Modal::Confirm {
             question: format!(
-                "Image {k}: lighting {list} damaged ({}). y retakes only {list}, a every \
+                "Image {k}: lighting {list} {state} ({}). y retakes only {list}, a every \
                  lighting, n nothing.",
                 why.join("; ")
             ),
@@ -596,6 +627,11 @@ impl Ctx<'_> {
         let cur = self.tracker.current.as_ref().filter(|c| c.k == k);
         if self.session.work.phase != Phase::Review || cur.is_none() {
             self.warn("nothing to accept: capture and run an image first (Enter)");
+            return Vec::new();
+        }
+        if let Some(c) = cur.filter(|c| !c.unsaved.is_empty()) {
+            let msg = not_saved_message(&c.unsaved);
+            self.error(format!("image {k} NOT accepted: {msg}"));
             return Vec::new();
         }
         // Outputs the session already holds (hand edits are written as they
@@ -673,4 +709,12 @@ impl Ctx<'_> {
         ));
         Vec::new()
     }
+}
+
+/// What an image with lightings the session could not save needs: which,
+/// why (the first one's error) and what to do.
+pub fn not_saved_message(unsaved: &[(char, String)]) -> String {
+    let letters: String = unsaved.iter().map(|d| d.0).collect();
+    let why = unsaved.first().map_or("", |d| d.1.as_str());
+    format!("lighting {letters} NOT saved ({why}); once that is put right, R captures it again")
 }

@@ -43,6 +43,9 @@ pub struct Loaded {
     pub edit_confirmed: bool,
     /// Lightings whose saved grey image is damaged, with why.
     pub damaged: Vec<(char, String)>,
+    /// Lightings captured in this run that the session could not save,
+    /// with why: the image is not accepted until they are captured again.
+    pub unsaved: Vec<(char, String)>,
 }
 
 impl Loaded {
@@ -63,6 +66,7 @@ impl Loaded {
             accepted: false,
             edit_confirmed: false,
             damaged: Vec::new(),
+            unsaved: Vec::new(),
         }
     }
 

@@ -148,7 +148,8 @@ fn row_text(app: &App, k: u32) -> (String, bool) {
         .letters
         .iter()
         .map(|l| {
-            if damaged.contains(l) && cur.is_none_or(|c| c.frame(*l).is_none()) {
+            let unsaved = cur.is_some_and(|c| c.unsaved.iter().any(|d| d.0 == *l));
+            if unsaved || damaged.contains(l) && cur.is_none_or(|c| c.frame(*l).is_none()) {
                 '!'
             } else if captured.contains(l) {
                 *l
@@ -308,23 +309,39 @@ fn step_box(app: &App, area: Rect, buf: &mut Buffer) {
                     .and_then(|c| c.outputs.as_ref())
                     .map_or((0, 0), |o| (o.lines.len(), o.lines_raw.len()));
                 let n = cur.and_then(|c| c.lines()).map_or(n, <[_]>::len);
-                vec![
-                    Line::raw(format!("Image {}: {n} lines ({raw} before CONNECT)", w.k)),
-                    Line::from(vec![
-                        key("a"),
-                        Span::raw(" accepts ("),
-                        key("Enter"),
-                        Span::raw(" asks) · "),
-                        key("R"),
-                        Span::raw(" again"),
-                    ]),
-                    Line::from(vec![
-                        key("3"),
-                        Span::raw(" tune · "),
-                        key("4"),
-                        Span::raw(" edit"),
-                    ]),
-                ]
+                let unsaved: String =
+                    cur.map_or(String::new(), |c| c.unsaved.iter().map(|d| d.0).collect());
+                if unsaved.is_empty() {
+                    vec![
+                        Line::raw(format!("Image {}: {n} lines ({raw} before CONNECT)", w.k)),
+                        Line::from(vec![
+                            key("a"),
+                            Span::raw(" accepts ("),
+                            key("Enter"),
+                            Span::raw(" asks) · "),
+                            key("R"),
+                            Span::raw(" again"),
+                        ]),
+                        Line::from(vec![
+                            key("3"),
+                            Span::raw(" tune · "),
+                            key("4"),
+                            Span::raw(" edit"),
+                        ]),
+                    ]
+                } else {
+                    // Not accepted until every lighting is on disk.
+                    vec![
+                        Line::raw(format!("Image {}: {n} lines ({raw} before CONNECT)", w.k)),
+                        Line::styled(format!("lighting {unsaved} NOT saved"), t.error()),
+                        Line::from(vec![
+                            key("R"),
+                            Span::raw(" captures again · "),
+                            key("!"),
+                            Span::raw(" why"),
+                        ]),
+                    ]
+                }
             }
             Phase::Complete => vec![
                 Line::styled("Survey complete.", t.ok()),

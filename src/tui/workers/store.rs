@@ -13,6 +13,7 @@ use std::time::{Duration, Instant};
 use super::send;
 use crate::formats;
 use crate::formats::img::ImgFile;
+use crate::llv::GreyImage;
 use crate::llv::lens::CameraModel;
 use crate::profile::Profile;
 use crate::report;
@@ -133,6 +134,37 @@ impl Store {
         self.reply(StoreEvent::Cameras(self.camera_models()));
     }
 
+    /// Saves a captured frame as image `k`'s lighting `letter` (recording
+    /// the image's camera, place and `.cdf` first where they are new), and
+    /// gives its file name.
+    fn save_frame(
+        &mut self,
+        k: u32,
+        letter: char,
+        camera: u32,
+        location: u32,
+        image: GreyImage,
+    ) -> Result<String, StoreError> {
+        let cdf = self.cdf_path(camera);
+        let s = self.session_mut()?;
+        let known = s
+            .manifest()
+            .image(k)
+            .map(|r| (r.camera, r.location, r.cdf.is_some()));
+        let what = format!("image {k} lighting {letter} NOT saved");
+        if known.is_none_or(|(c, l, has_cdf)| {
+            c != camera || l != location || (!has_cdf && cdf.is_some())
+        }) {
+            s.set_image_info(k, camera, location, cdf.as_deref())
+                .map_err(session_err(what.clone()))?;
+        }
+        let file = s.file_name(k, Some(letter), "img");
+        let stem = file.trim_end_matches(".img").to_string();
+        s.save_image(k, letter, &ImgFile::new(image).with_comment(stem))
+            .map_err(session_err(what))?;
+        Ok(file)
+    }
+
     fn reply(&self, e: StoreEvent) {
         send(&self.ui, Msg::Store(e));
     }
@@ -195,28 +227,14 @@ impl Store {
                 camera,
                 location,
                 image,
-            } => {
-                let cdf = self.cdf_path(camera);
-                let s = self.session_mut()?;
-                let known = s
-                    .manifest()
-                    .image(k)
-                    .map(|r| (r.camera, r.location, r.cdf.is_some()));
-                let what = format!("image {k} lighting {letter} NOT saved");
-                if known.is_none_or(|(c, l, has_cdf)| {
-                    c != camera || l != location || (!has_cdf && cdf.is_some())
-                }) {
-                    s.set_image_info(k, camera, location, cdf.as_deref())
-                        .map_err(session_err(what.clone()))?;
+            } => match self.save_frame(k, letter, camera, location, image) {
+                Ok(file) => {
+                    self.forget_problems(std::slice::from_ref(&file));
+                    self.reply(StoreEvent::Saved(file));
+                    self.updated();
                 }
-                let file = s.file_name(k, Some(letter), "img");
-                let stem = file.trim_end_matches(".img").to_string();
-                s.save_image(k, letter, &ImgFile::new(image).with_comment(stem))
-                    .map_err(session_err(what))?;
-                self.forget_problems(std::slice::from_ref(&file));
-                self.reply(StoreEvent::Saved(file));
-                self.updated();
-            }
+                Err(error) => self.reply(StoreEvent::FrameNotSaved { k, letter, error }),
+            },
             StoreCmd::SaveOutputs { k, outputs, params } => {
                 let s = self.session_mut()?;
                 s.save_outputs(k, &outputs, &params)
