@@ -268,6 +268,21 @@ impl App {
                         "A capture is under way. Quit anyway? The frames saved so far are kept.",
                         Pending::Quit,
                     );
+                } else if let Some(c) = self
+                    .tracker
+                    .current
+                    .as_ref()
+                    .filter(|c| !c.unsaved.is_empty())
+                {
+                    let letters: String = c.unsaved.iter().map(|d| d.0).collect();
+                    let k = c.k;
+                    self.ctx().ask(
+                        format!(
+                            "Lighting {letters} of image {k} is not saved (! on the checklist): \
+                             quitting loses it. Quit anyway?"
+                        ),
+                        Pending::Quit,
+                    );
                 } else {
                     self.chrome.quit = true;
                 }

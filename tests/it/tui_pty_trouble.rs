@@ -152,8 +152,8 @@ fn damaged_sessions_and_files_are_shown_and_only_the_damage_retaken() {
 
 /// A lighting whose file cannot be written (a link planted where it goes)
 /// is marked `!` on the checklist, the image is not accepted while it is
-/// not on disk, nothing is written through the link, and retaking that
-/// lighting alone once the link is gone puts it right.
+/// not on disk, quitting asks first, nothing is written through the link,
+/// and retaking that lighting alone once the link is gone puts it right.
 #[test]
 fn a_lighting_the_session_cannot_save_is_marked_and_keeps_the_image_from_acceptance() {
     let mut c = Console::start(80, 24, &[]);
@@ -177,6 +177,12 @@ fn a_lighting_the_session_cannot_save_is_marked_and_keeps_the_image_from_accepta
         "not an image\n",
         "nothing written through the link"
     );
+    // Quitting would lose the frame: it asks.
+    c.send("q");
+    let s = c.wait_text("Quit anyway?", 10);
+    assert!(s.contains("Lighting a of image 1 is not saved"), "{s}");
+    c.send("n");
+    c.wait("the question closed", 5, |s| !s.contains("Quit anyway?"));
     std::fs::remove_file(d.join("cube1a.img")).unwrap();
     c.press(SURVEY, Action::Survey(SurveyAction::Redo));
     let s = c.wait_text("retakes only a", 10);
