@@ -713,7 +713,7 @@ impl Ctx<'_> {
 
 /// What an image with lightings the session could not save needs: which,
 /// why (the first one's error) and what to do.
-pub fn not_saved_message(unsaved: &[(char, String)]) -> String {
+fn not_saved_message(unsaved: &[(char, String)]) -> String {
     let letters: String = unsaved.iter().map(|d| d.0).collect();
     let why = unsaved.first().map_or("", |d| d.1.as_str());
     format!("lighting {letters} NOT saved ({why}); once that is put right, R captures it again")
