@@ -221,6 +221,11 @@ pub enum StoreEvent {
         letter: char,
         error: StoreError,
     },
+    /// Image `k`'s outputs could not be saved: it is not accepted.
+    OutputsNotSaved {
+        k: u32,
+        error: StoreError,
+    },
     Error(StoreError),
 }
 

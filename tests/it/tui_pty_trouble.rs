@@ -4,7 +4,8 @@
 //! garbled line file are marked and only the image's damaged lighting
 //! retaken; a lighting the session cannot save (a link planted where its
 //! file goes) is marked, keeps the image from being accepted and is
-//! retaken alone; a report that cannot be written says so;
+//! retaken alone; outputs that cannot be written keep the image under
+//! review; a report that cannot be written says so;
 //! a session held by a console that still runs is offered to take over;
 //! a terminal too small, a dumb terminal and the Linux console.
 
@@ -150,18 +151,38 @@ fn damaged_sessions_and_files_are_shown_and_only_the_damage_retaken() {
     c.wait_exit(10);
 }
 
+/// What the file a planted link points to holds.
+const OUTSIDE: &str = "a file outside the session\n";
+
+/// A console with session `cube` open and a link planted as the session's
+/// file `name`, pointing outside the session; and the file it points to.
+fn console_with_a_link(name: &str) -> (Console, std::path::PathBuf) {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("cube");
+    let outside = c.dir.path().join("outside.txt");
+    std::fs::write(&outside, OUTSIDE).unwrap();
+    std::os::unix::fs::symlink(&outside, c.session().join(name)).unwrap();
+    (c, outside)
+}
+
+/// Waits for `saved` to hold: the store worker writes files after the
+/// screen that announces them.
+fn saved_within_20_s(what: &str, saved: impl Fn() -> bool) {
+    let end = std::time::Instant::now() + Duration::from_secs(20);
+    while !saved() {
+        assert!(std::time::Instant::now() < end, "{what} never saved");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
 /// A lighting whose file cannot be written (a link planted where it goes)
 /// is marked `!` on the checklist, the image is not accepted while it is
 /// not on disk, quitting asks first, nothing is written through the link,
 /// and retaking that lighting alone once the link is gone puts it right.
 #[test]
 fn a_lighting_the_session_cannot_save_is_marked_and_keeps_the_image_from_acceptance() {
-    let mut c = Console::start(80, 24, &[]);
-    c.create_session("cube");
+    let (mut c, outside) = console_with_a_link("cube1a.img");
     let d = c.session();
-    let outside = c.dir.path().join("outside.txt");
-    std::fs::write(&outside, "not an image\n").unwrap();
-    std::os::unix::fs::symlink(&outside, d.join("cube1a.img")).unwrap();
     c.capture_current(1);
     let s = c.wait("lighting a marked", 20, |s| {
         s.contains("!bc") && s.contains("lighting a NOT saved")
@@ -174,7 +195,7 @@ fn a_lighting_the_session_cannot_save_is_marked_and_keeps_the_image_from_accepta
     assert!(!d.join("cube1.ldr").exists(), "no outputs of image 1");
     assert_eq!(
         std::fs::read_to_string(&outside).unwrap(),
-        "not an image\n",
+        OUTSIDE,
         "nothing written through the link"
     );
     // Quitting would lose the frame: it asks.
@@ -195,16 +216,42 @@ fn a_lighting_the_session_cannot_save_is_marked_and_keeps_the_image_from_accepta
     });
     c.press(SURVEY, Action::Survey(SurveyAction::Accept));
     c.wait_text("Image 2: camera", 20);
-    let end = std::time::Instant::now() + Duration::from_secs(20);
-    while !(d.join("cube1.ldr").exists()
-        && vss::formats::img::read_img(&d.join("cube1a.img")).is_ok())
-    {
-        assert!(
-            std::time::Instant::now() < end,
-            "image 1's lighting a and outputs never saved"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    saved_within_20_s("image 1's lighting a and outputs", || {
+        d.join("cube1.ldr").exists() && vss::formats::img::read_img(&d.join("cube1a.img")).is_ok()
+    });
+    c.send("q");
+    c.wait_exit(10);
+}
+
+/// Outputs that cannot be written at `a` (a link planted at the `.ldr`)
+/// leave the image under review and not done, nothing is written through
+/// the link, and `a` once the link is gone accepts it.
+#[test]
+fn outputs_that_cannot_be_saved_keep_the_image_under_review() {
+    let (mut c, outside) = console_with_a_link("cube1.ldr");
+    let d = c.session();
+    c.capture_current(1);
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    let s = c.wait_text("outputs of image 1 NOT saved", 10);
+    assert!(flat(&s).contains("symbolic link"), "why:\n{s}");
+    let s = c.wait("image 1 under review again", 10, |s| {
+        s.contains("Image 1: ") && s.contains("before CONNECT")
+    });
+    assert!(
+        s.lines().any(|r| r.contains(">  1") && r.contains(" -")),
+        "image 1 is the current row, not done:\n{s}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(&outside).unwrap(),
+        OUTSIDE,
+        "nothing written through the link"
+    );
+    std::fs::remove_file(d.join("cube1.ldr")).unwrap();
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    c.wait_text("Image 2: camera", 20);
+    saved_within_20_s("image 1's outputs", || {
+        vss::formats::lines::read_lines(&d.join("cube1.ldr")).is_ok()
+    });
     c.send("q");
     c.wait_exit(10);
 }

@@ -238,6 +238,15 @@ impl App {
                 ctx.frame_not_saved(k, letter, why);
                 Vec::new()
             }
+            StoreEvent::OutputsNotSaved { k, error } => {
+                let mut ctx = self.ctx();
+                ctx.error(format!(
+                    "{} — image {k} is not accepted; a tries again once that is put right",
+                    clean(&error.to_string())
+                ));
+                ctx.outputs_not_saved(k);
+                Vec::new()
+            }
             StoreEvent::Error(e) => {
                 let mut ctx = self.ctx();
                 ctx.error(clean(&e.to_string()));

@@ -369,6 +369,24 @@ impl Ctx<'_> {
         }
     }
 
+    /// The session could not save image `k`'s outputs: the outputs on
+    /// screen are not the session's, and a survey that went on from `k` to
+    /// an image not yet begun comes back to `k` for review.
+    pub fn outputs_not_saved(&mut self, k: u32) {
+        let accepted = self.session.accepted(k);
+        let Some(c) = self.tracker.current.as_mut().filter(|c| c.k == k) else {
+            return;
+        };
+        c.in_session = false;
+        c.accepted = accepted;
+        let w = &self.session.work;
+        if w.k != k && matches!(w.phase, Phase::Setup | Phase::Complete) && c.outputs.is_some() {
+            self.session.work.k = k;
+            self.session.work.phase = Phase::Review;
+            self.follow_plan();
+        }
+    }
+
     /// The session could not save lighting `letter` of image `k`, captured
     /// in this run: the checklist marks it and the image is not accepted
     /// until it is captured again.

@@ -237,8 +237,11 @@ impl Store {
             },
             StoreCmd::SaveOutputs { k, outputs, params } => {
                 let s = self.session_mut()?;
-                s.save_outputs(k, &outputs, &params)
-                    .map_err(session_err(format!("outputs of image {k} NOT saved")))?;
+                if let Err(e) = s.save_outputs(k, &outputs, &params) {
+                    let error = session_err(format!("outputs of image {k} NOT saved"))(e);
+                    self.reply(StoreEvent::OutputsNotSaved { k, error });
+                    return Ok(());
+                }
                 let files: Vec<String> = ["hpo", "vpo", "lex", "ldr"]
                     .iter()
                     .map(|e| s.file_name(k, None, e))
