@@ -9,21 +9,9 @@
 
 use std::sync::OnceLock;
 
-use vss::llv::Params;
+use super::default_params;
 use vss::llv::synth::Metrics;
 use vss::llv::synth::eval::{EvalConfig, EvalReport, NoiseResult, evaluate};
-
-/// The default profile's parameters; the spec defaults while the profile
-/// file does not exist yet.
-fn default_params() -> Params {
-    match vss::profile::resolve("default") {
-        Ok(_) => match vss::profile::Profile::load("default") {
-            Ok(p) => p.llv,
-            Err(e) => panic!("profiles/default.toml does not load: {e}"),
-        },
-        Err(_) => Params::default(),
-    }
-}
 
 fn report() -> &'static EvalReport {
     static REPORT: OnceLock<EvalReport> = OnceLock::new();

@@ -5,3 +5,13 @@
 
 mod cubes;
 mod yard;
+
+/// The default profile's LLV parameters (the built-in profile, or
+/// `profiles/default.toml` where it is there): what both families are
+/// scored with.
+fn default_params() -> vss::llv::Params {
+    match vss::profile::Profile::load("default") {
+        Ok(p) => p.llv,
+        Err(e) => panic!("the default profile does not load: {e}"),
+    }
+}

@@ -10,17 +10,10 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
+use super::default_params;
 use assert_cmd::Command;
-use vss::llv::Params;
 use vss::llv::synth::Metrics;
 use vss::llv::synth::eval::yard::{Level, YardConfig, YardReport, evaluate_yard};
-
-fn default_params() -> Params {
-    match vss::profile::Profile::load("default") {
-        Ok(p) => p.llv,
-        Err(e) => panic!("profiles/default.toml does not load: {e}"),
-    }
-}
 
 fn report() -> &'static YardReport {
     static REPORT: OnceLock<YardReport> = OnceLock::new();
