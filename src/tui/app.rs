@@ -274,8 +274,7 @@ impl App {
                     .as_ref()
                     .filter(|c| !c.unsaved.is_empty())
                 {
-                    let letters: String = c.unsaved.iter().map(|d| d.0).collect();
-                    let k = c.k;
+                    let (letters, k) = (c.unsaved_letters(), c.k);
                     self.ctx().ask(
                         format!(
                             "Lighting {letters} of image {k} is not saved (! on the checklist): \

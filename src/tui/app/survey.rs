@@ -357,9 +357,9 @@ impl Ctx<'_> {
                 .as_ref()
                 .and_then(|c| c.lines())
                 .map_or(0, <[_]>::len);
-            match self.tracker.current.as_ref().map(|c| &c.unsaved) {
-                Some(u) if !u.is_empty() => {
-                    let msg = not_saved_message(u);
+            match self.tracker.current.as_ref() {
+                Some(c) if !c.unsaved.is_empty() => {
+                    let msg = not_saved_message(c);
                     self.error(format!("image {k}: {n} lines, but {msg}"));
                 }
                 _ => self.info(format!(
@@ -648,7 +648,7 @@ impl Ctx<'_> {
             return Vec::new();
         }
         if let Some(c) = cur.filter(|c| !c.unsaved.is_empty()) {
-            let msg = not_saved_message(&c.unsaved);
+            let msg = not_saved_message(c);
             self.error(format!("image {k} NOT accepted: {msg}"));
             return Vec::new();
         }
@@ -731,8 +731,8 @@ impl Ctx<'_> {
 
 /// What an image with lightings the session could not save needs: which,
 /// why (the first one's error) and what to do.
-fn not_saved_message(unsaved: &[(char, String)]) -> String {
-    let letters: String = unsaved.iter().map(|d| d.0).collect();
-    let why = unsaved.first().map_or("", |d| d.1.as_str());
+fn not_saved_message(c: &Loaded) -> String {
+    let letters = c.unsaved_letters();
+    let why = c.unsaved.first().map_or("", |d| d.1.as_str());
     format!("lighting {letters} NOT saved ({why}); once that is put right, R captures it again")
 }

@@ -70,6 +70,11 @@ impl Loaded {
         }
     }
 
+    /// The letters of the lightings the session could not save (`unsaved`).
+    pub fn unsaved_letters(&self) -> String {
+        self.unsaved.iter().map(|d| d.0).collect()
+    }
+
     /// The frame of lighting `letter`.
     pub fn frame(&self, letter: char) -> Option<&GreyImage> {
         self.frames.iter().find(|f| f.0 == letter).map(|f| &f.1)

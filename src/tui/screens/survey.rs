@@ -309,8 +309,7 @@ fn step_box(app: &App, area: Rect, buf: &mut Buffer) {
                     .and_then(|c| c.outputs.as_ref())
                     .map_or((0, 0), |o| (o.lines.len(), o.lines_raw.len()));
                 let n = cur.and_then(|c| c.lines()).map_or(n, <[_]>::len);
-                let unsaved: String =
-                    cur.map_or(String::new(), |c| c.unsaved.iter().map(|d| d.0).collect());
+                let unsaved = cur.map_or(String::new(), |c| c.unsaved_letters());
                 if unsaved.is_empty() {
                     vec![
                         Line::raw(format!("Image {}: {n} lines ({raw} before CONNECT)", w.k)),
