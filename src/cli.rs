@@ -33,10 +33,21 @@ macro_rules! out {
 }
 
 /// `eprintln!` through the one sanitiser: notes and errors name files and
-/// quote what they hold.
+/// quote what they hold. A standard error that cannot be written (closed,
+/// `/dev/full`) loses the message, not the exit status: `eprintln!` would
+/// panic (exit 101).
 macro_rules! errln {
+    () => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr());
+    }};
     ($($arg:tt)*) => {{
-        eprintln!("{}", $crate::text::sanitize_lines(&format!($($arg)*)))
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr(),
+            "{}",
+            $crate::text::sanitize_lines(&format!($($arg)*))
+        );
     }};
 }
 
@@ -64,10 +75,21 @@ pub struct Global {
 
 impl Global {
     /// Loads the profile named on the command line, or `default`.
+    /// A profile found by name in the working folder's `profiles/` is
+    /// named on stderr: a file there changes what vss drives.
     pub fn load_profile(&self) -> anyhow::Result<crate::profile::Profile> {
-        Ok(crate::profile::Profile::load(
-            self.profile.as_deref().unwrap_or("default"),
-        )?)
+        let name = self.profile.as_deref().unwrap_or("default");
+        let p = crate::profile::Profile::load(name)?;
+        if let Some(src) = &p.source
+            && src.is_relative()
+            && !std::path::Path::new(name).is_file()
+        {
+            errln!(
+                "vss: note: profile `{name}` is {} (found in the working folder)",
+                src.display()
+            );
+        }
+        Ok(p)
     }
 }
 
@@ -156,10 +178,29 @@ pub fn main() -> ExitCode {
         // wanted, so stop quietly, as a pipeline expects.
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            errln!("vss: error: {e:#}");
+            errln!("vss: error: {}", error_text(&e));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The error and its causes joined with ": ", as `{:#}` does, but a cause
+/// whose text the message already holds is not repeated (an I/O error
+/// shown in its wrapper's message and kept as its source printed
+/// "(os error 28)" twice).
+pub fn error_text(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let c = cause.to_string();
+        if c.is_empty() || text.contains(&c) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&c);
+    }
+    text
 }
 
 /// A failed write of a command's output to stdout: kept apart from other

@@ -175,6 +175,17 @@ pub(crate) fn input_err(path: &Path, e: &std::io::Error) -> FormatError {
     FormatError::new(path, Location::None, kind, format!("cannot read: {e}"))
 }
 
+/// Stages a file of a set written as one ([`crate::fsutil::StagedWrites`]),
+/// mapping the error.
+pub fn stage(
+    set: &mut crate::fsutil::StagedWrites,
+    path: &Path,
+    bytes: &[u8],
+) -> Result<(), FormatError> {
+    set.stage(path, bytes)
+        .map_err(|e| FormatError::io(path, "write", &e))
+}
+
 /// Writes a file atomically, mapping the error.
 pub(crate) fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), FormatError> {
     crate::fsutil::write_atomic(path, bytes).map_err(|e| FormatError::io(path, "write", &e))

@@ -6,7 +6,7 @@
 //! makes the creation fail instead of being written through) under a random
 //! name in the target's folder, filled, fsynced and renamed over the target,
 //! then the folder is fsynced. An interrupted save never corrupts the
-//! previous good file. The target name itself must be absent or a regular
+//! previous good file, and a replaced file keeps its permission bits. The target name itself must be absent or a regular
 //! file: a symbolic link (or a FIFO, a device, a folder) there is refused
 //! with an error naming the path, so vss never writes through a link, even
 //! one that points back into its own folder. Temporary names embed the pid
@@ -47,8 +47,16 @@ pub fn write_atomic_with(
         .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"))?;
     check_target(path)?;
     sweep_stale_temps(dir);
+    // A replaced file keeps its permissions (a 0600 `.cdf` stays 0600).
+    let old_mode = fs::symlink_metadata(path)
+        .ok()
+        .filter(|m| m.file_type().is_file())
+        .map(|m| m.permissions());
     let (mut file, tmp) = create_temp(dir, name)?;
     let result = (|| {
+        if let Some(mode) = old_mode {
+            file.set_permissions(mode)?;
+        }
         {
             let mut w = io::BufWriter::new(&mut file);
             fill(&mut w)?;
@@ -66,6 +74,86 @@ pub fn write_atomic_with(
         let _ = fs::remove_file(&tmp);
     }
     result
+}
+
+/// Several files replaced as one: each is written to its temporary file
+/// (created exclusively, filled, fsynced) by [`StagedWrites::stage`], and
+/// only [`StagedWrites::commit`], once every file is on disk, renames them
+/// into place. A failure while staging (a full disk) leaves every target as
+/// it was: no mix of old and new outputs. Dropped uncommitted, the
+/// temporary files are removed.
+#[derive(Debug, Default)]
+pub struct StagedWrites {
+    /// (temporary file, target), in the order staged.
+    staged: Vec<(PathBuf, PathBuf)>,
+}
+
+impl StagedWrites {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Writes `bytes` for `path` to a temporary file beside it.
+    pub fn stage(&mut self, path: &Path, bytes: &[u8]) -> io::Result<()> {
+        let dir = parent_dir(path);
+        let name = path
+            .file_name()
+            .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "path has no file name"))?;
+        check_target(path)?;
+        sweep_stale_temps(dir);
+        let mode = fs::symlink_metadata(path)
+            .ok()
+            .filter(|m| m.file_type().is_file())
+            .map(|m| m.permissions());
+        let (mut file, tmp) = create_temp(dir, name)?;
+        let r = (|| {
+            if let Some(mode) = mode {
+                file.set_permissions(mode)?;
+            }
+            file.write_all(bytes)?;
+            file.sync_all()
+        })();
+        if let Err(e) = r {
+            let _ = fs::remove_file(&tmp);
+            return Err(e);
+        }
+        self.staged.push((tmp, path.to_path_buf()));
+        Ok(())
+    }
+
+    /// Renames every staged file into place, in order, then makes the
+    /// renames durable. Returns the targets.
+    pub fn commit(mut self) -> io::Result<Vec<PathBuf>> {
+        let staged = std::mem::take(&mut self.staged);
+        let mut done = Vec::with_capacity(staged.len());
+        let mut iter = staged.into_iter();
+        for (tmp, target) in iter.by_ref() {
+            if let Err(e) = check_target(&target).and_then(|()| fs::rename(&tmp, &target)) {
+                let _ = fs::remove_file(&tmp);
+                for (t, _) in iter {
+                    let _ = fs::remove_file(t);
+                }
+                return Err(e);
+            }
+            done.push(target);
+        }
+        let mut dirs: Vec<&Path> = done.iter().map(|t| parent_dir(t)).collect();
+        dirs.dedup();
+        for d in dirs {
+            if let Ok(d) = File::open(d) {
+                let _ = d.sync_all();
+            }
+        }
+        Ok(done)
+    }
+}
+
+impl Drop for StagedWrites {
+    fn drop(&mut self) {
+        for (tmp, _) in &self.staged {
+            let _ = fs::remove_file(tmp);
+        }
+    }
 }
 
 /// The folder a path lives in (`.` for a bare name).

@@ -363,7 +363,8 @@ impl Profile {
 
 /// The folders a profile name is looked up in, in order: `./profiles`,
 /// then `vss/profiles` in the XDG config folder (`$XDG_CONFIG_HOME`, else
-/// `~/.config`).
+/// `~/.config`). The name `default` is not looked up in `./profiles`
+/// ([`locate`]).
 pub fn search_dirs() -> Vec<PathBuf> {
     let mut dirs = vec![PathBuf::from("profiles")];
     // The XDG base directory rule, which is all a Linux cell PC needs; an
@@ -383,6 +384,22 @@ pub fn search_dirs() -> Vec<PathBuf> {
     dirs
 }
 
+/// The XDG state folder: `$XDG_STATE_HOME`, else `~/.local/state`. A
+/// relative (or empty) value is invalid and ignored, as the XDG base
+/// directory specification says: a relative path would put the state in
+/// whatever folder vss runs in. `None` without an absolute `HOME` either.
+pub fn state_home() -> Option<PathBuf> {
+    std::env::var_os("XDG_STATE_HOME")
+        .map(PathBuf::from)
+        .filter(|p| p.is_absolute())
+        .or_else(|| {
+            std::env::var_os("HOME")
+                .map(PathBuf::from)
+                .filter(|p| p.is_absolute())
+                .map(|h| h.join(".local/state"))
+        })
+}
+
 /// Finds a profile: an existing path as given, else `NAME.toml` in each of
 /// [`search_dirs`], else for `default` the built-in profile.
 pub fn locate(name_or_path: &str) -> Result<Origin, ProfileError> {
@@ -395,7 +412,18 @@ pub fn locate(name_or_path: &str) -> Result<Origin, ProfileError> {
     } else {
         format!("{name_or_path}.toml")
     };
-    let candidates: Vec<PathBuf> = search_dirs().into_iter().map(|d| d.join(&file)).collect();
+    // The default is never taken from the working folder: a
+    // `profiles/default.toml` anyone left there must not silently change
+    // what a bare `vss` drives (and where it writes).
+    let dirs: Vec<PathBuf> = if name_or_path == "default" || name_or_path == "default.toml" {
+        search_dirs()
+            .into_iter()
+            .filter(|d| d.is_absolute())
+            .collect()
+    } else {
+        search_dirs()
+    };
+    let candidates: Vec<PathBuf> = dirs.into_iter().map(|d| d.join(&file)).collect();
     if let Some(c) = candidates.iter().find(|c| c.is_file()) {
         return Ok(Origin::File(c.clone()));
     }
@@ -429,13 +457,16 @@ pub fn resolve(name_or_path: &str) -> Result<PathBuf, ProfileError> {
 pub fn text_of(origin: &Origin) -> Result<(String, PathBuf), ProfileError> {
     match origin {
         Origin::File(path) => {
-            // Bounded, so a huge file is refused unread.
-            let text = crate::fsutil::read_input_text(path, MAX_LEN as u64).map_err(|source| {
-                ProfileError::Io {
-                    path: path.clone(),
-                    source,
-                }
-            })?;
+            // A profile is configuration, which dotfile managers install as
+            // symbolic links: the link is resolved and its target read
+            // (bounded, regular file only, so a huge file or a FIFO is
+            // refused unread).
+            let io = |source| ProfileError::Io {
+                path: path.clone(),
+                source,
+            };
+            let real = std::fs::canonicalize(path).map_err(io)?;
+            let text = crate::fsutil::read_input_text(&real, MAX_LEN as u64).map_err(io)?;
             Ok((text, path.clone()))
         }
         Origin::Builtin => Ok((BUILTIN_TOML.to_string(), PathBuf::from(BUILTIN_NAME))),

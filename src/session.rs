@@ -98,6 +98,13 @@ pub enum SessionError {
         foreign: bool,
     },
     #[error(
+        "session lock {} is now held by {holder}: the session was taken over, so this \
+         console no longer writes it; this change was NOT saved (the session on disk is the \
+         new holder's); open the session again to go on",
+        path.display()
+    )]
+    LockLost { path: PathBuf, holder: String },
+    #[error(
         "{}{}: {message}; the manifest was left as it is: fix it by hand or restore it",
         path.display(),
         if *line > 0 { format!(":{line}") } else { String::new() }
@@ -111,6 +118,12 @@ pub enum SessionError {
     ReadOnly { dir: PathBuf },
     #[error("lighting {letter:?} is not one of this session's lightings ({known})")]
     UnknownLighting { letter: char, known: String },
+    #[error(
+        "{}: the session folder's path is {len} bytes long; with the files' names it would \
+         exceed the system's limit of {PATH_MAX} bytes: make the session in a shorter path",
+        dir.display()
+    )]
+    PathTooLong { dir: PathBuf, len: usize },
     #[error("image number {0} is out of range: image numbers run from 1 to {MAX_IMAGE_NUMBER}")]
     BadImage(u32),
     #[error(
@@ -123,6 +136,25 @@ pub enum SessionError {
         image: u32,
         what: String,
     },
+}
+
+/// The longest path the system takes (`PATH_MAX`, with its final NUL).
+const PATH_MAX: usize = libc::PATH_MAX as usize;
+
+/// Refuses a session folder whose files' paths would exceed `PATH_MAX`
+/// (the longest: a temporary name of `NAME9999z.img`), before anything is
+/// made: such a session was made, then not found.
+fn check_path_len(dir: &Path, name: &SessionName) -> Result<(), SessionError> {
+    let abs = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
+    // "/.NAME9999z.img.tmp.PID.HHHHHHHHRRRRRRRR" and the final NUL.
+    let longest = abs.as_os_str().len() + 2 + name.as_str().len() + 9 + 5 + 10 + 17 + 1;
+    if longest > PATH_MAX {
+        return Err(SessionError::PathTooLong {
+            dir: dir.to_path_buf(),
+            len: abs.as_os_str().len(),
+        });
+    }
+    Ok(())
 }
 
 fn locked_message(path: &Path, holder: &str, stale: bool, foreign: bool) -> String {
@@ -159,6 +191,7 @@ impl Session {
         if manifest_path.exists() {
             return Err(SessionError::Exists { dir });
         }
+        check_path_len(&dir, &name)?;
         fs::create_dir_all(&dir).map_err(|source| SessionError::Io {
             path: dir.clone(),
             source,
@@ -457,7 +490,17 @@ impl Session {
         }
         let file = self.file_name(k, Some(letter), "img");
         let bytes = formats::img::encode_img(img)?;
-        self.write_file(&file, &bytes)?;
+        // Until the manifest records the new image, the old file (if any)
+        // stays reachable under a temporary name, so a failed commit (a
+        // full disk, a take-over) leaves the folder as it was: no file the
+        // manifest does not record, no recorded file replaced.
+        let path = self.path(&file);
+        let kept = self.keep_old(&path)?;
+        if let Err(e) = self.write_file(&file, &bytes) {
+            Self::put_back(&path, kept, false);
+            return Err(e);
+        }
+        let before = self.manifest.clone();
         let rec = GreyRecord {
             letter,
             file: file.clone(),
@@ -474,8 +517,50 @@ impl Session {
         if k > self.manifest.session.planned_images {
             self.manifest.session.planned_images = k;
         }
-        self.commit()?;
-        Ok(self.path(&file))
+        if let Err(e) = self.commit() {
+            self.manifest = before;
+            Self::put_back(&path, kept, true);
+            return Err(e);
+        }
+        Self::put_back(&path, kept, false);
+        Ok(path)
+    }
+
+    /// A hard link to the file at `path` under a temporary name (one the
+    /// next opening removes as a leftover), or `None` when there is none.
+    /// A link takes no space, so it works on a full disk.
+    fn keep_old(&self, path: &Path) -> Result<Option<PathBuf>, SessionError> {
+        if !path.is_file() {
+            return Ok(None);
+        }
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        let keep = self
+            .dir
+            .join(format!(".{name}.tmp.{}.kept", std::process::id()));
+        let _ = fs::remove_file(&keep);
+        fs::hard_link(path, &keep).map_err(|source| SessionError::Io {
+            path: keep.clone(),
+            source,
+        })?;
+        Ok(Some(keep))
+    }
+
+    /// After a save: with `undo`, puts the kept old file back at `path` (or
+    /// removes the new one when there was none); without, drops the kept
+    /// link.
+    fn put_back(path: &Path, kept: Option<PathBuf>, undo: bool) {
+        match (kept, undo) {
+            (Some(k), true) => {
+                let _ = fs::rename(&k, path);
+            }
+            (Some(k), false) => {
+                let _ = fs::remove_file(k);
+            }
+            (None, true) => {
+                let _ = fs::remove_file(path);
+            }
+            (None, false) => {}
+        }
     }
 
     /// Reads back the grey images of `k`, in letter order.
@@ -547,13 +632,15 @@ impl Session {
 
     // ----- internals -----
 
+    /// Opened for writing, and the lock is still this session's (not
+    /// taken over since): checked before every file is written.
     fn writable(&self) -> Result<(), SessionError> {
-        if self.lock.is_none() {
-            return Err(SessionError::ReadOnly {
+        match &self.lock {
+            None => Err(SessionError::ReadOnly {
                 dir: self.dir.clone(),
-            });
+            }),
+            Some(l) => l.check_held(),
         }
-        Ok(())
     }
 
     /// The record of image `k`, made with the default camera and location
@@ -585,7 +672,11 @@ impl Session {
             .ok_or(SessionError::BadImage(k))
     }
 
+    /// Writes one file of the session, if the session is still this
+    /// writer's (checked before each file, so a displaced writer stops at
+    /// its next file).
     fn write_file(&self, file: &str, bytes: &[u8]) -> Result<(), SessionError> {
+        self.writable()?;
         let path = self.path(file);
         write_atomic(&path, bytes).map_err(|source| SessionError::Io { path, source })
     }

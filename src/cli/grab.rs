@@ -139,7 +139,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         );
     }
     let cdf = profile.camera_cdf(a.camera).unwrap_or_else(|e| {
-        eprintln!(
+        errln!(
             "vss: warning: {e}; image {} has no camera description",
             a.image
         );
@@ -176,7 +176,7 @@ fn open_existing(
             if a.take_over || ask_take_over(&e)? {
                 let dir = parent.join(session.as_str());
                 let s = Session::open_take_over(&dir).with_context(context)?;
-                eprintln!("took over the lock of {}", dir.display());
+                errln!("took over the lock of {}", dir.display());
                 Ok(Some(s))
             } else {
                 Err(anyhow::Error::new(e).context(context()))
@@ -226,7 +226,7 @@ fn capture_one(
         !cancel.load(Ordering::SeqCst)
     };
     let result = cell.capture(camera, letter, &mut progress);
-    eprintln!();
+    errln!();
     let cap = result?;
     let img = ImgFile::new(cap.image).with_comment(stem);
     let path = sess.save_image(a.image, letter, &img)?;

@@ -1,5 +1,7 @@
 //! `vss info FILE...`: a few lines on any cell file — grey images (header,
-//! size, comment with control characters removed, grey levels), `.cdf`
+//! size, comment with control characters removed, grey levels: all rows of
+//! an image up to 16 Mi pixels, else rows spread over it, so the largest
+//! `.img` costs one row of memory), `.cdf`
 //! parameters with their status letters, line files (count, bounding box),
 //! edge files, `.par` entries, `.ses` files with their session, and
 //! profiles. A file that cannot be read is reported on stderr and the others
@@ -56,8 +58,8 @@ pub fn describe(path: &Path) -> anyhow::Result<String> {
     let mut s = String::new();
     match ext.as_str() {
         "img" | "imc" => {
-            let h = img::read_header(path)?;
-            let f = img::read_img(path)?;
+            // Header and samples: a 65535² image costs one row of memory.
+            let (h, comment, stats) = img::read_summary(path)?;
             let kind = if ext == "imc" {
                 "lens-corrected grey image"
             } else {
@@ -78,7 +80,17 @@ pub fn describe(path: &Path) -> anyhow::Result<String> {
                 h.pixel_offset(),
                 h.file_len()
             )?;
-            image_lines(&mut s, &f)?;
+            writeln!(s, "  comment: \"{}\"", sanitize(&comment))?;
+            let sampled = if stats.rows_read < stats.rows {
+                format!(" (sampled from {} of {} rows)", stats.rows_read, stats.rows)
+            } else {
+                String::new()
+            };
+            writeln!(
+                s,
+                "  grey levels {} to {}, mean {:.1}{sampled}",
+                stats.lo, stats.hi, stats.mean
+            )?;
         }
         "png" | "pgm" | "pnm" | "tif" | "tiff" | "bmp" => {
             let (f, notes) = imageio::read_any_noted(path)?;

@@ -1,7 +1,8 @@
 //! `vss lights on|off|set CONFIG|status`: quick checks at the cell. Switches
 //! the profile's relay board and reads it back. An LCUS board cannot be
-//! read: `status` then says what vss last set on it (kept in its state
-//! file) and switches nothing.
+//! read: `on`, `off` and `set` send its whole mask (it may have lost power
+//! since vss last switched it), and `status` says what vss last set on it
+//! (kept in its state file) and switches nothing.
 
 use std::process::ExitCode;
 
@@ -39,6 +40,9 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         None
     };
     let mut board = open_lights(&profile, sim.as_ref())?;
+    if let Some(n) = board.note() {
+        errln!("vss: note: {n}");
+    }
     let mask_of = |names: &[String]| -> anyhow::Result<u32> {
         let mut m = 0u32;
         for n in names {

@@ -250,7 +250,9 @@ fn run_group(
         Stage::Lens,
         proposal.as_ref().map_or(p, |r| &r.params),
     )?;
-    let mut written = Vec::new();
+    // Every output is staged first and renamed into place only when all
+    // are on disk: a full disk leaves the previous run's set, not a mix.
+    let mut set = crate::fsutil::StagedWrites::new();
     if camera.is_some() {
         // The corrected images of the lit frames (the inputs themselves when
         // the map is the identity or correction is switched off).
@@ -264,11 +266,12 @@ fn run_group(
                 x0: f.x0,
                 y0: f.y0,
             };
-            imageio::write_any(&target, &imc)?;
-            written.push(target);
+            let bytes = crate::formats::img::encode_img(&imc)?;
+            stage(&mut set, &target, &bytes)?;
         }
     }
-    written.extend(write_outputs(a, &grp.dir, &grp.stem, out, true)?);
+    write_outputs(a, &grp.dir, &grp.stem, out, true, &mut set)?;
+    let written = commit(set)?;
     if let (Some(t), Some(r)) = (&a.auto, &proposal) {
         if !a.json {
             print_auto(&grp.stem, t, r)?;
@@ -287,28 +290,43 @@ fn run_group(
     Ok(())
 }
 
-/// Writes `.hpo`/`.vpo` (when `edges`), `.lex` and `.ldr`.
+/// Stages `.hpo`/`.vpo` (when `edges`), `.lex` and `.ldr` into `set`.
 fn write_outputs(
     a: &Args,
     dir: &Path,
     stem: &str,
     out: &StageOutputs,
     edges: bool,
-) -> anyhow::Result<Vec<PathBuf>> {
-    let mut written = Vec::new();
+    set: &mut crate::fsutil::StagedWrites,
+) -> anyhow::Result<()> {
     if edges {
         for (ext, e) in [("hpo", &out.edges_h), ("vpo", &out.edges_v)] {
             let t = out_path(a, dir, &format!("{stem}.{ext}"));
-            edgefile::write_edges(&t, e)?;
-            written.push(t);
+            stage(set, &t, &edgefile::encode_checked(&t, e)?)?;
         }
     }
     for (ext, l) in [("lex", &out.lines_raw), ("ldr", &out.lines)] {
         let t = out_path(a, dir, &format!("{stem}.{ext}"));
-        linefile::write_lines(&t, l)?;
-        written.push(t);
+        stage(set, &t, linefile::encode_checked(&t, l)?.as_bytes())?;
     }
-    Ok(written)
+    Ok(())
+}
+
+/// Stages one output; an error says that no output was replaced.
+fn stage(set: &mut crate::fsutil::StagedWrites, path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    crate::formats::stage(set, path, bytes).map_err(|e| {
+        anyhow::anyhow!("{e}; no output was replaced: the files on disk are the previous run's")
+    })
+}
+
+/// Renames the staged outputs into place.
+fn commit(set: crate::fsutil::StagedWrites) -> anyhow::Result<Vec<PathBuf>> {
+    set.commit().map_err(|e| {
+        anyhow::anyhow!(
+            "cannot put the outputs in place: {e}; outputs renamed before it are new, the rest \
+             are the previous run's"
+        )
+    })
 }
 
 fn from_edges(hpo: &Path, vpo: &Path, a: &Args, p: &Params) -> anyhow::Result<()> {
@@ -323,7 +341,9 @@ fn from_edges(hpo: &Path, vpo: &Path, a: &Args, p: &Params) -> anyhow::Result<()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "edges".to_string());
     let dir = hpo.parent().map(Path::to_path_buf).unwrap_or_default();
-    let written = write_outputs(a, &dir, &stem, out, false)?;
+    let mut set = crate::fsutil::StagedWrites::new();
+    write_outputs(a, &dir, &stem, out, false, &mut set)?;
+    let written = commit(set)?;
     let size = (out.edges_h.width, out.edges_h.height);
     report(
         a,

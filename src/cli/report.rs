@@ -121,8 +121,24 @@ fn guess_size(ldr: &Path, lines: &[crate::llv::Segment]) -> (usize, usize) {
 
 fn grey_report(a: &Args) -> anyhow::Result<ExitCode> {
     let mut images: Vec<(String, GreyImage)> = Vec::new();
+    // Each picture, and all of them together, within what a report draws:
+    // checked from each header before its pixels are read (a 20000²
+    // image cost 2 GB and a 774 MB PostScript file).
+    let mut total = 0usize;
     for p in &a.img {
-        let f = formats::imageio::read_any(p)?;
+        let (f, _) = formats::imageio::read_any_sized(p, |w, h| {
+            crate::report::check_picture_size(w, h)?;
+            let all = total.saturating_add(w.saturating_mul(h));
+            if all > crate::report::MAX_PICTURE_PIXELS {
+                return Err(anyhow::anyhow!(
+                    "with it the report would draw {all} pixels, more than the {} a report \
+                     draws in all: report fewer or smaller images",
+                    crate::report::MAX_PICTURE_PIXELS
+                ));
+            }
+            Ok(())
+        })?;
+        total += f.image.width() * f.image.height();
         let name = p.file_name().map_or_else(
             || p.display().to_string(),
             |n| n.to_string_lossy().into_owned(),

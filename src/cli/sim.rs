@@ -87,7 +87,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         std::thread::sleep(Duration::from_millis(50));
         match unplugged {
             None if !sim.grabber_plugged() => {
-                eprintln!("vss sim: the grabber was unplugged (fault injection)");
+                errln!("vss sim: the grabber was unplugged (fault injection)");
                 unplugged = Some(Instant::now());
             }
             Some(t) if replug.is_some_and(|d| t.elapsed() >= d) => {
@@ -96,13 +96,13 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                 // stdout must not end the simulator.
                 let mut out = std::io::stdout().lock();
                 let _ = writeln!(out, "grabber: {path}").and_then(|()| out.flush());
-                eprintln!("vss sim: the grabber is back on {path}");
+                errln!("vss sim: the grabber is back on {path}");
                 unplugged = None;
             }
             _ => {}
         }
     }
     sim.stop();
-    eprintln!("vss sim: stopped");
+    errln!("vss sim: stopped");
     Ok(ExitCode::SUCCESS)
 }

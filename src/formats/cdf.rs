@@ -328,17 +328,31 @@ fn check_value(
     if status == Status::NotAvailable {
         return Ok(());
     }
-    let what = match name {
-        "S" => "a scale factor (mm per pixel)",
-        "f" => "the focal length (mm)",
+    // Beyond these no camera is: a 1e-300 mm lens or a centre a billion
+    // pixels off the 65535-pixel image is a damaged or hostile file, and
+    // would make lens correction divide by nearly nothing.
+    let (what, lo, hi) = match name {
+        "S" => ("a scale factor (mm per pixel)", 1e-7, 1e3),
+        "f" => ("the focal length (mm)", 1e-2, 1e5),
+        "C" => ("the image centre (pixels)", -1e5, 1e5),
         _ => return Ok(()),
     };
-    match row.iter().find(|&&v| v <= 0.0) {
-        Some(v) => Err(FormatError::at_line(
+    if name != "C"
+        && let Some(v) = row.iter().find(|&&v| v <= 0.0)
+    {
+        return Err(FormatError::at_line(
             path,
             line,
             K::Range,
             format!("{name}: {what} must be greater than 0, found {v}"),
+        ));
+    }
+    match row.iter().find(|&&v| !(lo..=hi).contains(&v)) {
+        Some(v) => Err(FormatError::at_line(
+            path,
+            line,
+            K::Range,
+            format!("{name}: {what} must be from {lo} to {hi}, found {v}"),
         )),
         None => Ok(()),
     }

@@ -17,7 +17,7 @@
 
 use std::path::Path;
 
-use super::{FormatError, FormatErrorKind as K, read_bytes, shorten, write_bytes};
+use super::{FormatError, FormatErrorKind as K, shorten, write_bytes};
 use crate::llv::{EdgePoint, EdgePoints, ScanDir};
 
 /// The magic word of the header line.
@@ -67,11 +67,25 @@ pub fn encode_edges(e: &EdgePoints) -> Vec<u8> {
     out
 }
 
-/// Decodes an edge file held in memory; `path` names it in errors.
-pub fn parse_edges(bytes: &[u8], path: &Path) -> Result<EdgePoints, FormatError> {
-    let window = bytes.get(..MAX_HEADER.min(bytes.len())).unwrap_or(bytes);
+/// An edge file's header line, checked against the file's size.
+struct Header {
+    dir: Option<ScanDir>,
+    width: usize,
+    height: usize,
+    count: usize,
+    /// Where the points start (after the newline).
+    body: usize,
+}
+
+/// Parses the header line at the start of `window` (the file's first
+/// bytes, at most [`MAX_HEADER`] of them) and checks the point count against
+/// `file_len`, the file's whole size: nothing is allocated for the points
+/// before their bytes are known to be there.
+fn parse_header(window: &[u8], file_len: u64, path: &Path) -> Result<Header, FormatError> {
+    let window = window.get(..MAX_HEADER.min(window.len())).unwrap_or(window);
+    let bytes_len = file_len;
     let Some(nl) = window.iter().position(|&b| b == b'\n') else {
-        let kind = if bytes.len() < MAX_HEADER {
+        let kind = if bytes_len < MAX_HEADER as u64 {
             K::Truncated
         } else {
             K::Syntax
@@ -156,10 +170,10 @@ pub fn parse_edges(bytes: &[u8], path: &Path) -> Result<EdgePoints, FormatError>
             ));
         }
     }
-    let body = bytes.get(nl + 1..).unwrap_or(&[]);
+    let body_len = bytes_len.saturating_sub(nl as u64 + 1);
     let need = (count as u64).saturating_mul(POINT_LEN as u64);
-    if body.len() as u64 != need {
-        let kind = if (body.len() as u64) < need {
+    if body_len != need {
+        let kind = if body_len < need {
             K::Truncated
         } else {
             K::SizeMismatch
@@ -169,13 +183,31 @@ pub fn parse_edges(bytes: &[u8], path: &Path) -> Result<EdgePoints, FormatError>
             (nl + 1) as u64,
             kind,
             format!(
-                "header promises {count} points ({need} bytes after the header), but {} bytes follow",
-                body.len()
+                "header promises {count} points ({need} bytes after the header), but {body_len} bytes follow"
             ),
         ));
     }
-    let mut points = Vec::with_capacity(count);
-    for (k, c) in body.chunks_exact(POINT_LEN).enumerate() {
+    Ok(Header {
+        dir,
+        width,
+        height,
+        count,
+        body: nl + 1,
+    })
+}
+
+/// Appends the points in `chunk` (whole points; the first is point
+/// `first`, 0-based) to `points`; a non-finite value is an error at its
+/// byte (`body` is where the points start).
+fn decode_points(
+    chunk: &[u8],
+    first: usize,
+    body: usize,
+    points: &mut Vec<EdgePoint>,
+    path: &Path,
+) -> Result<(), FormatError> {
+    for (i, c) in chunk.chunks_exact(POINT_LEN).enumerate() {
+        let k = first + i;
         let f = |i: usize| {
             c.get(i * 4..i * 4 + 4)
                 .and_then(|s| <[u8; 4]>::try_from(s).ok())
@@ -189,17 +221,31 @@ pub fn parse_edges(bytes: &[u8], path: &Path) -> Result<EdgePoints, FormatError>
         if !(p.x.is_finite() && p.y.is_finite() && p.response.is_finite()) {
             return Err(FormatError::at_byte(
                 path,
-                (nl + 1 + k * POINT_LEN) as u64,
+                (body + k * POINT_LEN) as u64,
                 K::Range,
                 format!("edge point {} has a non-finite value", k + 1),
             ));
         }
         points.push(p);
     }
+    Ok(())
+}
+
+/// Decodes an edge file held in memory; `path` names it in errors.
+pub fn parse_edges(bytes: &[u8], path: &Path) -> Result<EdgePoints, FormatError> {
+    let h = parse_header(bytes, bytes.len() as u64, path)?;
+    let mut points = Vec::with_capacity(h.count);
+    decode_points(
+        bytes.get(h.body..).unwrap_or(&[]),
+        0,
+        h.body,
+        &mut points,
+        path,
+    )?;
     Ok(EdgePoints {
-        dir,
-        width,
-        height,
+        dir: h.dir,
+        width: h.width,
+        height: h.height,
         points,
     })
 }
@@ -211,23 +257,103 @@ pub fn max_file_len() -> u64 {
     (MAX_HEADER + 2 * POINT_LEN * crate::llv::image::MAX_PIXELS) as u64
 }
 
-/// Reads a `.hpo`/`.vpo` file.
+/// Reads a `.hpo`/`.vpo` file: the header first (checked against the
+/// file's size), then the points in chunks straight into their vector, so
+/// the file costs its points' memory once, not twice.
 pub fn read_edges(path: &Path) -> Result<EdgePoints, FormatError> {
-    parse_edges(&read_bytes(path)?, path)
+    use std::io::Read;
+    let (mut f, len, h, mut rest) = open_header(path)?;
+    let mut points = Vec::with_capacity(h.count);
+    // Bytes already read past the header, then chunks of whole points.
+    let mut buf = std::mem::take(&mut rest);
+    let mut chunk = vec![0u8; 4096 * POINT_LEN];
+    let mut read = h.body as u64 + buf.len() as u64;
+    loop {
+        let whole = buf.len() - buf.len() % POINT_LEN;
+        decode_points(
+            buf.get(..whole).unwrap_or(&[]),
+            points.len(),
+            h.body,
+            &mut points,
+            path,
+        )?;
+        buf.drain(..whole);
+        if read >= len {
+            break;
+        }
+        let n = f
+            .read(&mut chunk)
+            .map_err(|e| FormatError::io(path, "read", &e))?;
+        if n == 0 {
+            break;
+        }
+        read += n as u64;
+        buf.extend_from_slice(chunk.get(..n).unwrap_or(&[]));
+    }
+    if points.len() != h.count {
+        return Err(FormatError::at_byte(
+            path,
+            read,
+            K::Truncated,
+            format!(
+                "the file shrank while it was read: {} of {} points",
+                points.len(),
+                h.count
+            ),
+        ));
+    }
+    Ok(EdgePoints {
+        dir: h.dir,
+        width: h.width,
+        height: h.height,
+        points,
+    })
+}
+
+/// Opens an edge file and parses its header against the file's size;
+/// returns the file (positioned after what was read), its size, the header
+/// and the bytes read past the header line.
+fn open_header(path: &Path) -> Result<(std::fs::File, u64, Header, Vec<u8>), FormatError> {
+    use std::io::Read;
+    let (mut f, len) =
+        crate::fsutil::open_input(path, max_file_len()).map_err(|e| super::input_err(path, &e))?;
+    let mut window = Vec::with_capacity(MAX_HEADER);
+    (&mut f)
+        .take(MAX_HEADER as u64)
+        .read_to_end(&mut window)
+        .map_err(|e| FormatError::io(path, "read", &e))?;
+    let h = parse_header(&window, len, path)?;
+    let rest = window.get(h.body..).unwrap_or(&[]).to_vec();
+    Ok((f, len, h, rest))
 }
 
 /// Reads only the header of an edge file (for `vss info`): direction, size
-/// and count, checked against the file size.
+/// and count, checked against the file size; no point is read.
 pub fn read_edges_header(path: &Path) -> Result<EdgePoints, FormatError> {
-    // The points are small; reading them all is simpler than a partial check.
-    let mut e = read_edges(path)?;
-    e.points = Vec::new();
-    Ok(e)
+    let (_, _, h, _) = open_header(path)?;
+    Ok(EdgePoints {
+        dir: h.dir,
+        width: h.width,
+        height: h.height,
+        points: Vec::new(),
+    })
+}
+
+/// The number of points an edge file's header promises (checked against
+/// the file's size), without reading them.
+pub fn read_edges_count(path: &Path) -> Result<usize, FormatError> {
+    open_header(path).map(|(_, _, h, _)| h.count)
 }
 
 /// Writes a `.hpo`/`.vpo` file atomically; non-finite values and a width or
 /// height over [`MAX_SIDE`] (which [`read_edges`] would refuse) are refused.
 pub fn write_edges(path: &Path, e: &EdgePoints) -> Result<(), FormatError> {
+    write_bytes(path, &encode_checked(path, e)?)
+}
+
+/// The bytes [`write_edges`] writes, after its checks (`path` names the
+/// file in errors).
+pub fn encode_checked(path: &Path, e: &EdgePoints) -> Result<Vec<u8>, FormatError> {
     if e.width > MAX_SIDE || e.height > MAX_SIDE {
         return Err(FormatError::new(
             path,
@@ -251,7 +377,7 @@ pub fn write_edges(path: &Path, e: &EdgePoints) -> Result<(), FormatError> {
             format!("edge point {} has a non-finite value", k + 1),
         ));
     }
-    write_bytes(path, &encode_edges(e))
+    Ok(encode_edges(e))
 }
 
 #[cfg(test)]

@@ -240,6 +240,70 @@ pub fn read_header(path: &Path) -> Result<ImgHeader, FormatError> {
     open_checked(path).map(|(h, _, _)| h)
 }
 
+/// The grey levels of an image's pixels, as `vss info` shows them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GreyStats {
+    pub lo: u8,
+    pub hi: u8,
+    pub mean: f64,
+    /// Rows read, of [`GreyStats::rows`].
+    pub rows_read: usize,
+    pub rows: usize,
+}
+
+/// Images of up to this many pixels are read whole by [`read_summary`];
+/// larger ones are sampled.
+const SUMMARY_ALL_PIXELS: u64 = 16 << 20;
+/// Rows a sampled summary reads, spread evenly from the first to the last.
+const SUMMARY_ROWS: usize = 1024;
+
+/// The header, the comment and the grey levels of an `.img`, read row by
+/// row into one row's buffer: every row of an image of up to 16 Mi
+/// pixels, else 1024 rows spread over it. Memory stays at one row (at
+/// most 64 KiB) whatever the file's size.
+pub fn read_summary(path: &Path) -> Result<(ImgHeader, String, GreyStats), FormatError> {
+    use std::os::unix::fs::FileExt;
+    let (h, _, f) = open_checked(path)?;
+    let read_at = |buf: &mut [u8], at: u64| {
+        f.read_exact_at(buf, at)
+            .map_err(|e| FormatError::io(path, "read", &e))
+    };
+    let mut comment = vec![0u8; usize::from(h.comment_len)];
+    read_at(&mut comment, HEADER_LEN as u64)?;
+    let comment = comment.strip_suffix(&[0]).unwrap_or(&comment);
+    let comment: String = comment.iter().map(|&b| char::from(b)).collect();
+    let (w, rows) = (usize::from(h.width), usize::from(h.height));
+    let all = u64::from(h.width) * u64::from(h.height) <= SUMMARY_ALL_PIXELS;
+    let n = if all { rows } else { SUMMARY_ROWS.min(rows) };
+    let mut row = vec![0u8; w];
+    let (mut lo, mut hi, mut sum) = (u8::MAX, 0u8, 0u64);
+    for i in 0..n {
+        let y = if all || n < 2 {
+            i
+        } else {
+            i * (rows - 1) / (n - 1)
+        };
+        read_at(&mut row, h.pixel_offset() + (y as u64) * (w as u64))?;
+        for &v in &row {
+            lo = lo.min(v);
+            hi = hi.max(v);
+            sum += u64::from(v);
+        }
+    }
+    let mean = sum as f64 / ((n * w).max(1)) as f64;
+    Ok((
+        h,
+        comment,
+        GreyStats {
+            lo,
+            hi,
+            mean,
+            rows_read: n,
+            rows,
+        },
+    ))
+}
+
 /// Encodes an image as `.img` bytes. Fails (kind `Range`/`Encoding`) when the
 /// image is larger than 65535 pixels a side, or the comment is longer than
 /// 199 bytes or holds a character above U+00FF.

@@ -148,6 +148,12 @@ pub fn read_lines(path: &Path) -> Result<Vec<Segment>, FormatError> {
 /// Writes a `.lex`/`.ldr` file atomically; non-finite coordinates are
 /// refused (kind `Range`) and nothing is written.
 pub fn write_lines(path: &Path, segs: &[Segment]) -> Result<(), FormatError> {
+    write_bytes(path, encode_checked(path, segs)?.as_bytes())
+}
+
+/// The text [`write_lines`] writes, after its check (`path` names the file
+/// in errors).
+pub fn encode_checked(path: &Path, segs: &[Segment]) -> Result<String, FormatError> {
     if let Some(k) = segs
         .iter()
         .position(|s| ![s.a.x, s.a.y, s.b.x, s.b.y].iter().all(|v| v.is_finite()))
@@ -159,7 +165,7 @@ pub fn write_lines(path: &Path, segs: &[Segment]) -> Result<(), FormatError> {
             format!("segment {} has a non-finite coordinate", k + 1),
         ));
     }
-    write_bytes(path, format_lines(segs).as_bytes())
+    Ok(format_lines(segs))
 }
 
 /// The bounding box `(min, max)` of the endpoints, `None` for no segments.

@@ -120,3 +120,50 @@ fn inputs_must_be_regular_files_within_their_bound() {
     let e = read_input(dir.path(), 1 << 20).unwrap_err();
     assert!(e.to_string().contains("folder"), "{e}");
 }
+
+/// Issue 34, N11: a replaced file keeps its mode (a 0600 `.cdf` stayed
+/// 0600 only until the first save, which made it 0644).
+#[test]
+fn a_replaced_file_keeps_its_mode() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("cam1.cdf");
+    write_atomic(&p, b"first").unwrap();
+    for mode in [0o600, 0o640, 0o444] {
+        fs::set_permissions(&p, fs::Permissions::from_mode(mode)).unwrap();
+        write_atomic(&p, b"again").unwrap();
+        let got = fs::metadata(&p).unwrap().permissions().mode() & 0o7777;
+        assert_eq!(got, mode, "{mode:o} became {got:o}");
+    }
+}
+
+/// Issue 34, N9: outputs written as a set: a failure while staging leaves
+/// every target as it was (no mix of old and new), and nothing behind.
+#[test]
+fn staged_writes_replace_all_or_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("x1.hpo"), dir.path().join("x1.vpo"));
+    write_atomic(&a, b"old a").unwrap();
+    write_atomic(&b, b"old b").unwrap();
+    // The second target cannot be staged (a folder is in its place).
+    let c = dir.path().join("x1.lex");
+    fs::create_dir(&c).unwrap();
+    let mut set = StagedWrites::new();
+    set.stage(&a, b"new a").unwrap();
+    assert!(set.stage(&c, b"new c").is_err());
+    drop(set);
+    assert_eq!(fs::read(&a).unwrap(), b"old a");
+    assert_eq!(
+        fs::read_dir(dir.path()).unwrap().count(),
+        3,
+        "temporary files left"
+    );
+    let mut set = StagedWrites::new();
+    set.stage(&a, b"new a").unwrap();
+    set.stage(&b, b"new b").unwrap();
+    assert_eq!(fs::read(&a).unwrap(), b"old a", "replaced before commit");
+    assert_eq!(set.commit().unwrap(), vec![a.clone(), b.clone()]);
+    assert_eq!(fs::read(&a).unwrap(), b"new a");
+    assert_eq!(fs::read(&b).unwrap(), b"new b");
+    assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 3);
+}

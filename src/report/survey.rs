@@ -145,7 +145,9 @@ pub fn image_report(s: &Session, k: u32) -> Result<ImageReport, SessionError> {
         ))
     )];
     for g in &rec.grey {
-        match formats::img::read_img(&s.path(&g.file)) {
+        // The size from the header first: a picture the report cannot draw
+        // is a note, before its pixels are read.
+        match formats::img::read_img_sized(&s.path(&g.file), check_picture_size) {
             Ok(f) => {
                 let light = m
                     .lighting

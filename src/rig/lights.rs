@@ -1,6 +1,7 @@
 //! The relay board that switches the lights: [`LightSwitch`], the Numato
 //! driver ([`NumatoBoard`]) and the LCUS/CH340 driver ([`LcusBoard`], in
-//! `lights/lcus.rs`: binary frames, no replies, state remembered). The
+//! `lights/lcus.rs`: binary frames, no replies, so every process sends the
+//! whole mask and the remembered state only reports). The
 //! board kind is a profile setting.
 //!
 //! Numato: every command is sent, then the reply is read up to the `>`
@@ -44,6 +45,11 @@ pub trait LightSwitch: Send {
     }
     /// For a board that cannot be read: what vss last set on it, and when.
     fn last_set(&self) -> Option<LastSet> {
+        None
+    }
+    /// Something the operator should know about the board's remembered
+    /// state (an LCUS state file that was ignored, and why).
+    fn note(&self) -> Option<String> {
         None
     }
     fn port_name(&self) -> &str;

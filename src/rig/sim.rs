@@ -345,20 +345,50 @@ impl SimCell {
     }
 
     /// Keeps a symlink at `link` pointing at the grabber's pseudo-terminal,
-    /// also across [`SimCell::replug_grabber`]: a stable device name.
+    /// also across [`SimCell::replug_grabber`]: a stable device name. Only
+    /// a symbolic link (one an earlier `vss sim --link` left) is replaced:
+    /// a file or folder at `link` is refused, never replaced or deleted.
     #[cfg(unix)]
     pub fn link_grabber(&mut self, link: &Path) -> Result<(), RigError> {
-        let name = link.file_name().map(|n| n.to_string_lossy().into_owned());
-        let tmp = link.with_file_name(format!(".{}.new", name.unwrap_or_default()));
-        let _ = std::fs::remove_file(&tmp);
-        std::os::unix::fs::symlink(&self.grabber.path, &tmp)
-            .and_then(|()| std::fs::rename(&tmp, link))
-            .map_err(|e| {
-                RigError::Sim(format!(
-                    "cannot link {} to the grabber: {e}",
+        let fail = |e: String| {
+            RigError::Sim(format!(
+                "cannot link {} to the grabber: {e}",
+                link.display()
+            ))
+        };
+        match std::fs::symlink_metadata(link) {
+            Ok(m) if !m.file_type().is_symlink() => {
+                return Err(fail(format!(
+                    "{} exists and is not a symbolic link; vss replaces only a link                      (remove it or choose another name)",
                     link.display()
-                ))
-            })?;
+                )));
+            }
+            _ => {}
+        }
+        let name = link.file_name().map(|n| n.to_string_lossy().into_owned());
+        // A name of this process's own, made by symlink(2), which never
+        // replaces anything: whatever else is there stays.
+        let tmp = link.with_file_name(format!(
+            ".{}.new.{}",
+            name.unwrap_or_default(),
+            std::process::id()
+        ));
+        if std::fs::symlink_metadata(&tmp).is_ok_and(|m| m.file_type().is_symlink()) {
+            let _ = std::fs::remove_file(&tmp);
+        }
+        std::os::unix::fs::symlink(&self.grabber.path, &tmp).map_err(|e| fail(e.to_string()))?;
+        // Checked again right before the rename, which replaces what is there.
+        if std::fs::symlink_metadata(link).is_ok_and(|m| !m.file_type().is_symlink()) {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(fail(format!(
+                "{} appeared and is not a link",
+                link.display()
+            )));
+        }
+        if let Err(e) = std::fs::rename(&tmp, link) {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(fail(e.to_string()));
+        }
         *self
             .grabber_link
             .lock()
@@ -400,7 +430,10 @@ impl SimCell {
             .lock()
             .unwrap_or_else(PoisonError::into_inner)
             .take();
-        if let Some(link) = link {
+        // Only the link this cell made, still pointing at its grabber.
+        if let Some(link) = link
+            && std::fs::read_link(&link).is_ok_and(|t| t == Path::new(&self.grabber.path))
+        {
             let _ = std::fs::remove_file(link);
         }
     }

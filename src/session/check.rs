@@ -1,9 +1,11 @@
 //! `vss session check`: every file the manifest names exists and parses with
 //! the format readers; files changed since they were recorded, stale
-//! outputs, a `.ses` that disagrees and leftovers of interrupted saves are
-//! listed. Problems (missing or unreadable files) make the check fail;
+//! outputs, a `.ses` that disagrees, leftovers of interrupted saves and
+//! VSS-named data files the manifest does not record (a second writer's, or
+//! a save that failed before its record) are listed. Problems (missing or unreadable files) make the check fail;
 //! the rest are warnings a person should read.
 
+use std::collections::HashSet;
 use std::path::Path;
 
 use super::progress::{OutputState, output_state};
@@ -33,6 +35,7 @@ impl CheckReport {
 pub fn check(s: &Session) -> CheckReport {
     let mut r = CheckReport::default();
     let m = s.manifest();
+    let mut recorded: HashSet<String> = HashSet::new();
     for rec in &m.image {
         let mut expected: Vec<(String, &str)> = Vec::new();
         expected.extend(rec.cdf.iter().map(|f| (f.file.clone(), f.hash.as_str())));
@@ -51,6 +54,7 @@ pub fn check(s: &Session) -> CheckReport {
             expected.push((ldr, e.hash.as_str()));
         }
         for (file, hash) in expected {
+            recorded.insert(file.clone());
             check_file(&s.path(&file), &file, hash, &mut r);
         }
         if let OutputState::Stale(why) = output_state(rec) {
@@ -78,6 +82,13 @@ pub fn check(s: &Session) -> CheckReport {
             }
         }
     }
+    for file in unrecorded(s, &recorded) {
+        r.warnings.push(format!(
+            "{}: a file of this session that the manifest does not record (another \
+             writer's, or a save that failed): outputs and reports ignore it",
+            s.path(&file).display()
+        ));
+    }
     for p in s.leftovers() {
         r.warnings.push(format!(
             "{}: left over from an interrupted save; opening the session for writing removes it",
@@ -85,6 +96,28 @@ pub fn check(s: &Session) -> CheckReport {
         ));
     }
     r
+}
+
+/// The extensions of the files a manifest records.
+const DATA_EXTS: [&str; 7] = ["img", "imc", "hpo", "vpo", "lex", "ldr", "cdf"];
+
+/// Data files in the session folder under this session's VSS names that
+/// are not in `recorded`, sorted.
+fn unrecorded(s: &Session, recorded: &HashSet<String>) -> Vec<String> {
+    let Ok(rd) = std::fs::read_dir(s.dir()) else {
+        return Vec::new();
+    };
+    let mut v: Vec<String> = rd
+        .flatten()
+        .filter_map(|e| e.file_name().to_str().map(str::to_string))
+        .filter(|n| !recorded.contains(n))
+        .filter(|n| {
+            formats::names::VssFile::parse_in(n, s.name())
+                .is_ok_and(|f| &f.session == s.name() && DATA_EXTS.contains(&f.ext.as_str()))
+        })
+        .collect();
+    v.sort();
+    v
 }
 
 fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) {

@@ -6,8 +6,16 @@
 //! temporary file and hard-linked into place, which fails if a lock exists.
 //! A lock is stale when its holder ran on this host and that process is gone
 //! (checked through `/proc`, including the process start time so a reused
-//! pid is not mistaken for the holder). A stale lock, or one held on another
-//! host, can be taken over on request; a live holder on this host never.
+//! pid is not mistaken for the holder), or when the process it names is not
+//! a vss at all (a lock file anyone could have planted). A stale lock, or one
+//! held on another host, can be taken over on request; a live holder on this
+//! host never — it can only be asked to leave ([`ask_holder_to_leave`]), and
+//! only when the process is provably the lock's vss: same start time, same
+//! user, a vss executable.
+//!
+//! Each lock carries a random token, so a writer can tell that the lock is
+//! still its own ([`Lock::check_held`]) even against a holder with the same
+//! pid and host: after a take-over, the displaced writer's saves fail.
 
 use std::fs;
 use std::io::{self, Write};
@@ -32,6 +40,10 @@ pub struct LockInfo {
     /// `/proc/PID/stat`); 0 when unknown.
     #[serde(default)]
     pub proc_start: u64,
+    /// Random, different for every lock taken: tells this lock from any
+    /// other with the same holder fields. Empty in older lock files.
+    #[serde(default)]
+    pub token: String,
 }
 
 impl std::fmt::Display for LockInfo {
@@ -60,21 +72,102 @@ impl LockInfo {
             user: username(),
             started: stamp::now_rfc3339(),
             proc_start: proc_start(pid).unwrap_or(0),
+            token: random_token(),
         }
     }
 
     /// Whether the holder is certainly gone: it ran on this host and its
     /// process no longer exists (or is a zombie, or is another process that
     /// reused the pid).
+    ///
+    /// A process that is certainly not a vss (its executable is readable
+    /// and is something else) is not the holder either: the lock was left
+    /// by a vss whose pid was reused, or planted.
     pub fn is_stale(&self) -> bool {
         if self.host != hostname() || !Path::new("/proc/self/stat").exists() {
             return false;
         }
         match proc_start(self.pid) {
             None => true,
-            Some(start) => self.proc_start != 0 && start != self.proc_start,
+            Some(start) if self.proc_start != 0 && start != self.proc_start => true,
+            Some(_) => exe_is_vss(self.pid) == Some(false),
         }
     }
+}
+
+/// Asks the live holder of a lock on this host to end (SIGTERM: a vss
+/// console finishes its saves and releases the lock, as on a hang-up) —
+/// only when the process is provably that holder: its start time is the
+/// lock's `proc_start`, it runs as this user, and its executable is vss.
+/// The signal goes through the `kill` system call, not a program found on
+/// `PATH`. `Err` says why nothing was signalled.
+pub fn ask_holder_to_leave(holder: &LockInfo) -> Result<(), String> {
+    let pid = holder.pid;
+    if holder.host != hostname() {
+        return Err(format!(
+            "the holder runs on host {}, not this one",
+            crate::formats::sanitize(&holder.host)
+        ));
+    }
+    if pid <= 1 || pid == std::process::id() {
+        return Err(format!("process {pid} cannot be the holder"));
+    }
+    let Some(start) = proc_start(pid) else {
+        return Err(format!("process {pid} no longer runs"));
+    };
+    if holder.proc_start == 0 {
+        return Err(format!(
+            "the lock records no start time, so process {pid} cannot be told from another"
+        ));
+    }
+    if start != holder.proc_start {
+        return Err(format!(
+            "process {pid} started at another time than the lock's holder: it is another process"
+        ));
+    }
+    if proc_uid(pid) != proc_uid(std::process::id()) {
+        return Err(format!("process {pid} belongs to another user"));
+    }
+    if exe_is_vss(pid) != Some(true) {
+        return Err(format!("process {pid} is not a vss"));
+    }
+    let pid_t = i32::try_from(pid)
+        .ok()
+        .and_then(rustix::process::Pid::from_raw)
+        .ok_or_else(|| format!("process {pid}: not a pid"))?;
+    rustix::process::kill_process(pid_t, rustix::process::Signal::TERM)
+        .map_err(|e| format!("cannot signal process {pid}: {e}"))
+}
+
+/// The owner of `/proc/PID` (the process's effective user).
+fn proc_uid(pid: u32) -> Option<u32> {
+    use std::os::unix::fs::MetadataExt;
+    fs::metadata(format!("/proc/{pid}")).ok().map(|m| m.uid())
+}
+
+/// Whether process `pid` runs vss: its executable is named `vss` or is this
+/// program. `None` when that cannot be read (another user's process).
+fn exe_is_vss(pid: u32) -> Option<bool> {
+    let exe = fs::read_link(format!("/proc/{pid}/exe")).ok()?;
+    // A binary replaced since it started reads as "PATH (deleted)".
+    let text = exe.to_string_lossy();
+    let exe = PathBuf::from(text.strip_suffix(" (deleted)").unwrap_or(&text));
+    let named_vss = exe.file_name().is_some_and(|n| n == "vss");
+    let this = std::env::current_exe().is_ok_and(|me| me == exe);
+    Some(named_vss || this)
+}
+
+/// 16 hex digits from the standard library's randomly seeded hasher.
+fn random_token() -> String {
+    use std::hash::{BuildHasher, Hasher};
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u128(
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos()),
+    );
+    h.write_u32(std::process::id());
+    format!("{:016x}", h.finish())
 }
 
 /// A held lock; released (the file removed) on drop if it is still ours.
@@ -158,6 +251,27 @@ impl Lock {
 
     pub fn info(&self) -> &LockInfo {
         &self.info
+    }
+
+    /// The lock file at `path()`.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Checks that the lock file still names this lock: after a take-over
+    /// (or a removed lock) this writer no longer owns the session, and its
+    /// saves must fail rather than overwrite the new holder's.
+    pub fn check_held(&self) -> Result<(), SessionError> {
+        match read_holder(&self.path) {
+            Some(h) if h == self.info => Ok(()),
+            h => Err(SessionError::LockLost {
+                path: self.path.clone(),
+                holder: h.map_or_else(
+                    || "nobody (the lock file is gone or unreadable)".to_string(),
+                    |h| h.to_string(),
+                ),
+            }),
+        }
     }
 }
 
@@ -263,6 +377,114 @@ mod tests {
         assert!(err.contains("take-over"), "{err}");
         let l = Lock::acquire(&p, true).unwrap();
         assert_eq!(read_holder(&p).unwrap(), *l.info());
+    }
+
+    /// A child running `sleep`, copied to `dir/name` first when given.
+    fn sleeper(dir: &Path, name: Option<&str>) -> std::process::Child {
+        let sleep = ["/bin/sleep", "/usr/bin/sleep"]
+            .into_iter()
+            .find(|p| Path::new(p).exists())
+            .expect("sleep");
+        let exe = match name {
+            Some(n) => {
+                let to = dir.join(n);
+                fs::copy(sleep, &to).unwrap();
+                to
+            }
+            None => PathBuf::from(sleep),
+        };
+        // A copy just written may be "text file busy" while another test
+        // thread forks: try again.
+        for _ in 0..50 {
+            match std::process::Command::new(&exe).arg("30").spawn() {
+                Ok(c) => return c,
+                Err(e) if e.raw_os_error() == Some(libc::ETXTBSY) => {
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                }
+                Err(e) => panic!("{}: {e}", exe.display()),
+            }
+        }
+        panic!("{}: text file busy", exe.display())
+    }
+
+    /// Issue 34, N2: a planted lock naming a live process that is not a
+    /// vss console gets it no signal, with or without its start time, and
+    /// the lock is stale; a process that is the lock's vss is asked.
+    #[test]
+    fn only_the_locks_own_vss_is_signalled() {
+        use std::os::unix::process::ExitStatusExt;
+        let dir = tempfile::tempdir().unwrap();
+        let mut victim = sleeper(dir.path(), None);
+        let pid = victim.id();
+        let start = proc_start(pid).expect("running");
+        for proc_start in [start, 0] {
+            let planted = LockInfo {
+                pid,
+                proc_start,
+                ..LockInfo::current()
+            };
+            let why = ask_holder_to_leave(&planted).expect_err("sleep is not a vss");
+            assert!(why.contains(&pid.to_string()), "{why}");
+            assert!(planted.is_stale(), "a lock naming `sleep` is not held");
+        }
+        // Through the session's lock: taken over, nobody signalled.
+        let p = dir.path().join("s.lock");
+        let planted = LockInfo {
+            pid,
+            proc_start: start,
+            ..LockInfo::current()
+        };
+        fs::write(&p, toml::to_string(&planted).unwrap()).unwrap();
+        assert!(Lock::acquire(&p, true).is_ok());
+        std::thread::sleep(std::time::Duration::from_millis(100));
+        assert!(victim.try_wait().unwrap().is_none(), "sleep was signalled");
+        victim.kill().unwrap();
+        victim.wait().unwrap();
+
+        // A vss with the lock's start time: asked to end (SIGTERM)…
+        let mut vss = sleeper(dir.path(), Some("vss"));
+        let pid = vss.id();
+        let start = proc_start(pid).expect("running");
+        let wrong = LockInfo {
+            pid,
+            proc_start: start + 1,
+            ..LockInfo::current()
+        };
+        // …but not when the start time differs (a reused pid) or is unknown.
+        assert!(ask_holder_to_leave(&wrong).is_err());
+        let unknown = LockInfo {
+            proc_start: 0,
+            ..wrong.clone()
+        };
+        assert!(ask_holder_to_leave(&unknown).is_err());
+        assert!(!unknown.is_stale(), "a live vss without a start time");
+        assert!(vss.try_wait().unwrap().is_none());
+        let holder = LockInfo {
+            proc_start: start,
+            ..wrong
+        };
+        assert!(!holder.is_stale());
+        assert_eq!(ask_holder_to_leave(&holder), Ok(()));
+        assert_eq!(vss.wait().unwrap().signal(), Some(libc::SIGTERM));
+    }
+
+    #[test]
+    fn a_taken_over_lock_is_no_longer_held() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("s.lock");
+        let a = Lock::acquire(&p, false).unwrap();
+        assert!(a.check_held().is_ok());
+        // The holder seen from another host: taken over from there.
+        let mut other = a.info().clone();
+        other.host = "cell-pc-2".into();
+        other.token = random_token();
+        fs::write(&p, toml::to_string(&other).unwrap()).unwrap();
+        let e = a.check_held().expect_err("taken over").to_string();
+        assert!(e.contains("cell-pc-2") && e.contains("NOT saved"), "{e}");
+        // Same pid, host and second, another lock: told apart by the token.
+        fs::remove_file(&p).unwrap();
+        let b = Lock::acquire(&p, false).unwrap();
+        assert!(b.check_held().is_ok() && a.check_held().is_err());
     }
 
     #[test]

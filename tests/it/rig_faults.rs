@@ -346,3 +346,39 @@ fn lossy_line_timings() {
 }
 
 mod matrix;
+
+/// Issue 34, N10: `vss sim --link PATH` never replaces nor deletes a
+/// regular file at PATH (it did both); a link it left before is replaced,
+/// and removed when the cell stops.
+#[test]
+fn sim_link_never_replaces_or_deletes_a_file() {
+    use vss::rig::sim::{SimCell, SimOptions};
+    let tmp = tempfile::tempdir().expect("tmp");
+    let file = tmp.path().join("notes.txt");
+    std::fs::write(&file, "keep me").expect("file");
+    let mut sim = SimCell::start(SimOptions::new(32, 32)).expect("sim");
+    let e = sim.link_grabber(&file).expect_err("a file is not a link");
+    assert!(e.to_string().contains("not a symbolic link"), "{e}");
+    sim.stop();
+    assert_eq!(std::fs::read_to_string(&file).expect("kept"), "keep me");
+    // A link left by an earlier run is replaced, and goes with the cell.
+    let link = tmp.path().join("ttyVSG0");
+    std::os::unix::fs::symlink("/dev/pts/nowhere", &link).expect("old link");
+    let mut sim = SimCell::start(SimOptions::new(32, 32)).expect("sim");
+    sim.link_grabber(&link).expect("link");
+    assert_eq!(
+        std::fs::read_link(&link).expect("link"),
+        std::path::Path::new(sim.grabber_path())
+    );
+    sim.stop();
+    assert!(
+        std::fs::symlink_metadata(&link).is_err(),
+        "link left behind"
+    );
+    let names: Vec<_> = std::fs::read_dir(tmp.path())
+        .expect("dir")
+        .flatten()
+        .map(|e| e.file_name())
+        .collect();
+    assert_eq!(names.len(), 1, "{names:?}");
+}

@@ -1,6 +1,7 @@
 //! Both relay protocols over real pseudo-terminals: the Numato driver
 //! against the simulated board (and raw Numato commands typed into it), the
-//! LCUS driver against a pty peer that reads its frames; and lighting
+//! LCUS driver against a pty peer that reads its frames (and a fake LCUS
+//! board that decodes them and can lose power between runs); and lighting
 //! configurations through `Cell`.
 
 use std::io::{Read, Write};
@@ -143,70 +144,256 @@ fn a_prompt_long_after_the_echo_keeps_the_numato_driver_in_step() {
     );
 }
 
-/// Reads LCUS frames from the device side of a pty for `wait`.
-fn frames(peer: &mut TTYPort, wait: Duration) -> Vec<u8> {
-    let deadline = Instant::now() + wait;
-    let mut got = Vec::new();
-    let mut buf = [0u8; 64];
-    while Instant::now() < deadline {
-        if let Ok(n) = peer.read(&mut buf) {
-            got.extend_from_slice(&buf[..n]);
+/// A fake LCUS board on the device side of a pty: decodes the frames it is
+/// sent into its relay mask, as the real board does, and can lose power
+/// (every relay off) like a board replugged or power-cycled.
+struct FakeLcus {
+    mask: std::sync::Arc<std::sync::atomic::AtomicU32>,
+    frames: std::sync::Arc<std::sync::atomic::AtomicUsize>,
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl FakeLcus {
+    fn start(mut peer: TTYPort) -> FakeLcus {
+        use std::sync::Arc;
+        use std::sync::atomic::{AtomicBool, AtomicU32, AtomicUsize, Ordering};
+        peer.set_timeout(Duration::from_millis(10))
+            .expect("timeout");
+        let mask = Arc::new(AtomicU32::new(0));
+        let frames = Arc::new(AtomicUsize::new(0));
+        let stop = Arc::new(AtomicBool::new(false));
+        let (m, f, st) = (mask.clone(), frames.clone(), stop.clone());
+        let thread = std::thread::spawn(move || {
+            let mut buf = [0u8; 64];
+            let mut rx: Vec<u8> = Vec::new();
+            while !st.load(Ordering::SeqCst) {
+                if let Ok(n) = peer.read(&mut buf) {
+                    rx.extend_from_slice(&buf[..n]);
+                }
+                // Resynchronise on 0xA0, as the board's parser does.
+                while rx.len() >= 4 {
+                    if let Some((relay, on)) = vss::rig::protocol::lcus_parse(&rx[..4]) {
+                        if on {
+                            m.fetch_or(1 << relay, Ordering::SeqCst);
+                        } else {
+                            m.fetch_and(!(1 << relay), Ordering::SeqCst);
+                        }
+                        f.fetch_add(1, Ordering::SeqCst);
+                        rx.drain(..4);
+                    } else {
+                        rx.remove(0);
+                    }
+                }
+            }
+        });
+        FakeLcus {
+            mask,
+            frames,
+            stop,
+            thread: Some(thread),
         }
     }
-    got
+    fn mask(&self) -> u32 {
+        self.mask.load(std::sync::atomic::Ordering::SeqCst)
+    }
+    fn frames(&self) -> usize {
+        self.frames.load(std::sync::atomic::Ordering::SeqCst)
+    }
+    /// The board loses power: every relay drops.
+    fn power_cycle(&self) {
+        self.mask.store(0, std::sync::atomic::Ordering::SeqCst);
+    }
+    /// Waits until `frames` frames in all have arrived (or 2 s).
+    fn wait_frames(&self, frames: usize) {
+        let end = Instant::now() + Duration::from_secs(2);
+        while self.frames() < frames && Instant::now() < end {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        std::thread::sleep(Duration::from_millis(30));
+    }
+}
+
+impl Drop for FakeLcus {
+    fn drop(&mut self) {
+        self.stop.store(true, std::sync::atomic::Ordering::SeqCst);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// A profile whose relay board is the LCUS board on `port` (and whose
+/// grabber is the simulated one), written into `dir`.
+fn lcus_profile(dir: &std::path::Path, port: &str) -> (std::path::PathBuf, vss::profile::Profile) {
+    let mut p = cell_profile(32, 32);
+    p.relay.kind = vss::profile::RelayKind::Lcus;
+    p.relay.port = port.to_string();
+    p.relay.settle_ms = 0;
+    let prof = dir.join("lcus.toml");
+    std::fs::write(&prof, toml::to_string(&p).expect("toml")).expect("profile");
+    (prof, p)
+}
+
+/// `vss --profile PROF ARGS` with its own state folder; stdout + stderr.
+fn vss_with_state(prof: &std::path::Path, state: &std::path::Path, args: &[&str]) -> String {
+    let o = std::process::Command::new(assert_cmd::cargo::cargo_bin("vss"))
+        .arg("--profile")
+        .arg(prof)
+        .args(args)
+        .env("XDG_STATE_HOME", state)
+        .output()
+        .expect("vss");
+    let text =
+        String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{args:?}: {text}");
+    text
 }
 
 #[test]
-fn lcus_status_switches_nothing_and_set_sends_only_what_changes() {
+fn lcus_status_switches_nothing_and_set_sends_the_whole_mask() {
     let tmp = tempfile::tempdir().expect("tmp");
-    let (mut peer, dev) = TTYPort::pair().expect("pty");
-    peer.set_timeout(Duration::from_millis(20))
-        .expect("timeout");
+    let (peer, dev) = TTYPort::pair().expect("pty");
     let port = dev.name().expect("pty name");
-    let mut p = cell_profile(32, 32);
-    p.relay.kind = vss::profile::RelayKind::Lcus;
-    p.relay.port = port.clone();
-    p.relay.settle_ms = 0;
-    let prof = tmp.path().join("lcus.toml");
-    std::fs::write(&prof, toml::to_string(&p).expect("toml")).expect("profile");
+    let (prof, _) = lcus_profile(tmp.path(), &port);
+    let state = tmp.path().join("state");
+    let board = FakeLcus::start(peer);
     let lights = |action: &[&str]| {
-        let o = std::process::Command::new(assert_cmd::cargo::cargo_bin("vss"))
-            .arg("--profile")
-            .arg(&prof)
-            .arg("lights")
-            .args(action)
-            .env("XDG_STATE_HOME", tmp.path().join("state"))
-            .output()
-            .expect("vss lights");
-        let text =
-            String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
-        assert!(o.status.success(), "{action:?}: {text}");
-        text
+        let mut args = vec!["lights"];
+        args.extend_from_slice(action);
+        vss_with_state(&prof, &state, &args)
     };
     let out = lights(&["status"]);
     assert!(out.contains("LCUS boards cannot be read"), "{out}");
     assert!(out.contains("nothing recorded"), "{out}");
-    assert!(
-        frames(&mut peer, Duration::from_millis(300)).is_empty(),
-        "status switched relays"
-    );
-    // a: relay 0 on. Nothing was known, so all 8 channels go once.
+    std::thread::sleep(Duration::from_millis(200));
+    assert_eq!(board.frames(), 0, "status switched relays");
+    // a: relay 0 on, and all 8 channels are sent.
     lights(&["set", "a"]);
-    let got = frames(&mut peer, Duration::from_millis(300));
-    assert_eq!(got.len(), 8 * 4, "{got:02x?}");
-    assert_eq!(&got[..4], &[0xA0, 1, 1, 0xA2]);
-    // b: relay 0 off, relay 1 on; the rest stays as it is, unsent.
+    board.wait_frames(8);
+    assert_eq!((board.frames(), board.mask()), (8, 0b1));
+    // b: again every channel, though vss set a before.
     lights(&["set", "b"]);
-    let got = frames(&mut peer, Duration::from_millis(300));
-    assert_eq!(got, [0xA0, 1, 0, 0xA1, 0xA0, 2, 1, 0xA3]);
+    board.wait_frames(16);
+    assert_eq!((board.frames(), board.mask()), (16, 0b10));
     let out = lights(&["status"]);
     assert!(
         out.contains("last set by vss: relays 0002") && out.contains("right-front"),
         "{out}"
     );
+    std::thread::sleep(Duration::from_millis(200));
+    assert_eq!(board.frames(), 16, "status switched relays");
+    // A state file that does not fit the board is ignored, with a note.
+    let file = std::fs::read_dir(state.join("vss/relays"))
+        .expect("state folder")
+        .flatten()
+        .next()
+        .expect("state file")
+        .path();
+    let text = std::fs::read_to_string(&file).expect("state");
+    std::fs::write(&file, text.replace("mask = 2", "mask = 65535")).expect("plant");
+    let out = lights(&["status"]);
     assert!(
-        frames(&mut peer, Duration::from_millis(300)).is_empty(),
-        "status switched relays"
+        out.contains("ignored the LCUS state file") && out.contains("beyond"),
+        "{out}"
+    );
+    assert!(out.contains("nothing recorded"), "{out}");
+    drop(dev);
+}
+
+/// N1 of issue 34: an LCUS board that loses its relays between two runs of
+/// vss (a USB replug, a power cycle) while its state file says otherwise.
+/// Every run must leave the board as vss says: 0 wrong states.
+#[test]
+fn lcus_board_that_loses_power_between_runs_ends_as_vss_says() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let (peer, dev) = TTYPort::pair().expect("pty");
+    let port = dev.name().expect("pty name");
+    let (prof, p) = lcus_profile(tmp.path(), &port);
+    let state = tmp.path().join("state");
+    let board = FakeLcus::start(peer);
+    let mask_of = |letter: char| -> u32 {
+        let cfg = p
+            .lighting
+            .iter()
+            .find(|l| l.letter == letter)
+            .expect("lighting");
+        cfg.on
+            .iter()
+            .map(|n| 1u32 << p.lights.iter().find(|l| &l.name == n).expect("light").relay)
+            .fold(0, |a, b| a | b)
+    };
+    let all_on = p.lights.iter().fold(0u32, |a, l| a | 1 << l.relay);
+    // Runs, and whether the board loses power before each: the same
+    // lighting again after a power loss is the case that went wrong.
+    let runs: &[(&[&str], u32, bool)] = &[
+        (&["set", "a"], mask_of('a'), false),
+        (&["set", "a"], mask_of('a'), true),
+        (&["set", "b"], mask_of('b'), false),
+        (&["set", "b"], mask_of('b'), true),
+        (&["on"], all_on, true),
+        (&["on"], all_on, true),
+        (&["set", "c"], mask_of('c'), false),
+        (&["set", "c"], mask_of('c'), true),
+        (&["set", "d"], mask_of('d'), true),
+        (&["off"], 0, false),
+        (&["set", "a"], mask_of('a'), true),
+        (&["set", "a"], mask_of('a'), false),
+    ];
+    let mut wrong = Vec::new();
+    for (i, (args, want, power_loss)) in runs.iter().enumerate() {
+        if *power_loss {
+            board.power_cycle();
+        }
+        let before = board.frames();
+        let mut a = vec!["lights"];
+        a.extend_from_slice(args);
+        let out = vss_with_state(&prof, &state, &a);
+        board.wait_frames(before + 8);
+        if board.mask() != *want {
+            wrong.push(format!(
+                "run {i} {args:?} (power lost before: {power_loss}): board {:04x}, vss set {want:04x}; {out}",
+                board.mask()
+            ));
+        }
+    }
+    // A capture sets its lighting's whole mask, whatever the state file
+    // says: grab under `b` twice, the board losing power in between.
+    let session = tmp.path().join("s/g");
+    let session = session.to_str().expect("utf-8 path");
+    for (image, power_loss) in [("1", false), ("2", true)] {
+        if power_loss {
+            board.power_cycle();
+        }
+        let before = board.frames();
+        let out = vss_with_state(
+            &prof,
+            &state,
+            &[
+                "grab",
+                "--session",
+                session,
+                "--image",
+                image,
+                "--camera",
+                "1",
+                "--lighting",
+                "b",
+            ],
+        );
+        board.wait_frames(before + 8);
+        if board.mask() != mask_of('b') {
+            wrong.push(format!(
+                "grab {image} (power lost before: {power_loss}): board {:04x}; {out}",
+                board.mask()
+            ));
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "{} wrong states:\n{}",
+        wrong.len(),
+        wrong.join("\n")
     );
     drop(dev);
 }
@@ -264,4 +451,35 @@ fn cell_switches_lighting_configurations_and_knows_what_is_on() {
     assert!(cell.lights_on().is_empty());
     let e = cell.switch_lighting('z').expect_err("no z");
     assert!(e.to_string().contains("abcde"), "{e}");
+}
+
+/// Issue 34, N12: a relative `XDG_STATE_HOME` is ignored (XDG base
+/// directory specification): the LCUS state goes under `~/.local/state`,
+/// not into whatever folder vss runs in.
+#[test]
+fn a_relative_xdg_state_home_is_ignored() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let (peer, dev) = TTYPort::pair().expect("pty");
+    let port = dev.name().expect("pty name");
+    let (prof, _) = lcus_profile(tmp.path(), &port);
+    let _board = FakeLcus::start(peer);
+    let (work, home) = (tmp.path().join("work"), tmp.path().join("home"));
+    std::fs::create_dir_all(&work).expect("work");
+    std::fs::create_dir_all(&home).expect("home");
+    let o = std::process::Command::new(assert_cmd::cargo::cargo_bin("vss"))
+        .arg("--profile")
+        .arg(&prof)
+        .args(["lights", "set", "a"])
+        .current_dir(&work)
+        .env("HOME", &home)
+        .env("XDG_STATE_HOME", "rel/state")
+        .output()
+        .expect("vss");
+    assert!(o.status.success(), "{o:?}");
+    assert!(
+        !work.join("rel").exists(),
+        "state written under the working folder"
+    );
+    assert!(home.join(".local/state/vss/relays").is_dir());
+    drop(dev);
 }

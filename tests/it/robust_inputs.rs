@@ -221,3 +221,179 @@ fn a_nonsensical_cdf_is_refused_naming_file_and_field() {
         "{out}"
     );
 }
+
+/// Issue 34 (residue of earlier fixes): a `.cdf` with a focal length of
+/// 1e-300 mm or an image centre a billion pixels away is refused, naming
+/// the file, the line and the field.
+#[test]
+fn a_cdf_with_an_absurd_focal_length_or_centre_is_refused() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let root = tmp.path();
+    for (name, text, line, field) in [
+        (
+            "tiny_f.cdf",
+            "S=A\n0.01\n0.01\nC=A\n32.0\n32.0\nf=A\n1e-300\n",
+            ":8",
+            "focal length",
+        ),
+        (
+            "far_c.cdf",
+            "S=A\n0.01\n0.01\nC=A\n1e9\n1e9\nf=A\n8.0\n",
+            ":5",
+            "image centre",
+        ),
+    ] {
+        std::fs::write(root.join(name), text).expect("cdf");
+        let (ok, out) = vss(root, &["info", name]);
+        assert!(!ok, "{name} accepted: {out}");
+        assert!(
+            out.contains(&format!("{name}{line}")) && out.contains(field),
+            "{out}"
+        );
+    }
+}
+
+/// Issue 34, N5: `vss info` of the largest `.img` there is (65535², sparse:
+/// 4 GiB of pixels) reads the header and samples rows, within 512 MiB of
+/// address space (it read the whole file: 8.4 GB, 47 s).
+#[test]
+fn info_of_the_largest_img_reads_its_header_and_samples() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let root = tmp.path();
+    sparse_img(&root.join("huge1a.img"), u16::MAX, u16::MAX);
+    let t = std::time::Instant::now();
+    let (ok, out) = vss_limited(root, 512, &["info", "huge1a.img"]);
+    assert!(ok, "{out}");
+    assert!(
+        out.contains("65535 × 65535")
+            && out.contains("grey levels 0 to 0")
+            && out.contains("sampled"),
+        "{out}"
+    );
+    assert!(t.elapsed() < Duration::from_secs(20), "{:?}", t.elapsed());
+}
+
+/// Issue 34, N5: `report --img` of a 20000² image is refused from its
+/// header, within 512 MiB (it cost 2 GB and wrote a 774 MB PostScript
+/// file); a picture the report draws still prints.
+#[test]
+fn report_refuses_an_image_it_cannot_page_from_its_header() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let root = tmp.path();
+    sparse_img(&root.join("big1a.img"), 20000, 20000);
+    let (ok, out) = vss_limited(root, 512, &["report", "--img", "big1a.img"]);
+    assert!(!ok, "{out}");
+    assert!(
+        out.contains("big1a.img") && out.contains("20000 x 20000"),
+        "{out}"
+    );
+    assert!(!root.join("big1a.ps").exists());
+    sparse_img(&root.join("small1a.img"), 640, 480);
+    let (ok, out) = vss_limited(root, 512, &["report", "--img", "small1a.img"]);
+    assert!(ok, "{out}");
+    assert!(root.join("small1a.ps").exists());
+}
+
+/// `vss` in `work` with its own home (no config folder, no XDG variables
+/// but `extra`).
+fn vss_at_home(work: &Path, home: &Path, extra: &[(&str, &Path)], args: &[&str]) -> (bool, String) {
+    let mut c = Command::cargo_bin("vss").expect("vss");
+    c.args(args)
+        .current_dir(work)
+        .env("HOME", home)
+        .env_remove("XDG_CONFIG_HOME")
+        .env_remove("XDG_STATE_HOME")
+        .timeout(Duration::from_secs(60));
+    for (k, v) in extra {
+        c.env(k, v);
+    }
+    let o = c.output().expect("vss");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    (o.status.success(), text)
+}
+
+/// A profile named `name` that is the simulated cell.
+fn named_profile(name: &str) -> String {
+    let mut p = vss::rig::sim::cell_profile(32, 32);
+    p.name = name.into();
+    toml::to_string(&p).expect("toml")
+}
+
+/// Issue 34, N12: a `profiles/default.toml` in the working folder does not
+/// replace the built-in profile of a bare `vss`; a profile found by name in
+/// the working folder is named on stderr.
+#[test]
+fn a_default_profile_in_the_working_folder_is_not_taken_silently() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let (work, home) = (tmp.path().join("work"), tmp.path().join("home"));
+    std::fs::create_dir_all(work.join("profiles")).expect("work");
+    std::fs::create_dir_all(&home).expect("home");
+    std::fs::write(work.join("profiles/default.toml"), named_profile("planted")).expect("plant");
+    std::fs::write(work.join("profiles/cell.toml"), named_profile("local cell")).expect("cell");
+    let (ok, out) = vss_at_home(&work, &home, &[], &["session", "new", "s1", "--dir", "."]);
+    assert!(ok, "{out}");
+    let m = std::fs::read_to_string(work.join("s1/s1.toml")).expect("manifest");
+    assert!(
+        m.contains("simulated cell") && !m.contains("planted"),
+        "{m}"
+    );
+    let (ok, out) = vss_at_home(
+        &work,
+        &home,
+        &[],
+        &["--profile", "cell", "session", "new", "s2", "--dir", "."],
+    );
+    assert!(ok, "{out}");
+    assert!(
+        out.contains("profiles/cell.toml") && out.contains("working folder"),
+        "{out}"
+    );
+}
+
+/// Issue 34, N6: a profile that is a symbolic link (as dotfile managers
+/// install `~/.config`) is read through the link.
+#[test]
+fn a_profile_that_is_a_symbolic_link_is_read() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let (work, home) = (tmp.path().join("work"), tmp.path().join("home"));
+    let config = home.join(".config/vss/profiles");
+    std::fs::create_dir_all(&config).expect("config");
+    std::fs::create_dir_all(&work).expect("work");
+    let dotfiles = tmp.path().join("dotfiles");
+    std::fs::create_dir_all(&dotfiles).expect("dotfiles");
+    std::fs::write(dotfiles.join("cell.toml"), named_profile("linked cell")).expect("profile");
+    symlink(dotfiles.join("cell.toml"), config.join("cell.toml")).expect("link");
+    let (ok, out) = vss_at_home(
+        &work,
+        &home,
+        &[],
+        &["--profile", "cell", "session", "new", "s1", "--dir", "."],
+    );
+    assert!(ok, "{out}");
+    let m = std::fs::read_to_string(work.join("s1/s1.toml")).expect("manifest");
+    assert!(m.contains("linked cell"), "{m}");
+}
+
+/// Issue 34, N13: a standard error that cannot be written (`/dev/full`,
+/// closed) loses the message, not the exit status (it was 101, a panic).
+#[test]
+fn a_closed_stderr_keeps_the_exit_status() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let bin = assert_cmd::cargo::cargo_bin("vss");
+    for redirect in ["2>/dev/full", "2>&-"] {
+        let o = Command::new("bash")
+            .args([
+                "-c",
+                &format!("'{}' info missing.img {redirect}", bin.display()),
+            ])
+            .current_dir(tmp.path())
+            .timeout(Duration::from_secs(30))
+            .output()
+            .expect("bash");
+        assert_eq!(o.status.code(), Some(1), "{redirect}: {o:?}");
+    }
+}

@@ -194,3 +194,152 @@ fn a_bad_session_name_is_reported_once() {
         );
     }
 }
+
+/// Issue 34, N4: two cell PCs write one survey folder. The second takes
+/// the session over (the first holder is on another host, as its lock
+/// file says); the displaced writer's next save fails, says so, and
+/// writes nothing; every data file on disk is recorded: 0 lost records.
+#[test]
+fn a_displaced_writer_cannot_save_and_no_record_is_lost() {
+    use vss::formats::img::ImgFile;
+    use vss::llv::GreyImage;
+    use vss::session::{Session, SessionError, lock};
+    let tmp = tempfile::tempdir().expect("tmp");
+    let p = cell_profile(32, 32);
+    let grey = |v: u8| ImgFile::new(GreyImage::filled(16, 16, v).expect("image"));
+    let mut a = Session::create(tmp.path(), "tw", &p).expect("create");
+    a.save_image(1, 'a', &grey(1)).expect("a saves 1");
+    // Writer A's lock as the other PC wrote it: another host.
+    let lock_path = a.dir().join("tw.lock");
+    let mut holder = lock::read_holder(&lock_path).expect("lock");
+    holder.host = "cell-pc-1".into();
+    std::fs::write(&lock_path, toml::to_string(&holder).expect("toml")).expect("lock");
+    let mut b = Session::open_take_over(a.dir()).expect("take over a foreign lock");
+    b.save_image(2, 'a', &grey(2)).expect("b saves 2");
+    let e = a
+        .save_image(3, 'a', &grey(3))
+        .expect_err("the displaced writer saved");
+    assert!(matches!(e, SessionError::LockLost { .. }), "{e:?}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("taken over") && msg.contains("NOT saved") && msg.contains("tw.lock"),
+        "{msg}"
+    );
+    assert!(
+        !a.dir().join("tw3a.img").exists(),
+        "the refused image was written"
+    );
+    assert!(a.set_planned_images(9).is_err(), "any write is refused");
+    b.save_image(4, 'a', &grey(4)).expect("b saves 4");
+    drop(a);
+    drop(b);
+    // Every image on disk is recorded, and check finds nothing unrecorded.
+    let s = Session::inspect(&tmp.path().join("tw")).expect("inspect");
+    let recorded: Vec<u32> = s.manifest().image.iter().map(|r| r.number).collect();
+    assert_eq!(recorded, [1, 2, 4]);
+    let on_disk: Vec<String> = std::fs::read_dir(s.dir())
+        .expect("dir")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".img"))
+        .collect();
+    assert_eq!(on_disk.len(), 3, "{on_disk:?}");
+    let r = s.check();
+    assert!(r.is_ok() && r.warnings.is_empty(), "{r:?}");
+}
+
+/// `session check` lists a data file under the session's names that the
+/// manifest does not record (it said "ok" before).
+#[test]
+fn check_lists_files_the_manifest_does_not_record() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    write_profile(tmp.path());
+    let (ok, out) = grab(tmp.path(), "1", "1", "a");
+    assert!(ok, "{out}");
+    let dir = tmp.path().join("s/g");
+    std::fs::copy(dir.join("g1a.img"), dir.join("g2b.img")).expect("plant");
+    std::fs::write(dir.join("notes.txt"), "not a VSS name").expect("plant");
+    let (ok, out) = vss(tmp.path(), &["session", "check", "s/g"]);
+    assert!(ok, "{out}");
+    assert!(
+        out.contains("g2b.img") && out.contains("does not record"),
+        "{out}"
+    );
+    assert!(!out.contains("notes.txt"), "{out}");
+    let (ok, out) = vss(tmp.path(), &["session", "check", "--strict", "s/g"]);
+    assert!(!ok, "{out}");
+}
+
+/// Issue 34, N14: a session whose files' paths would exceed PATH_MAX is
+/// refused before anything is made (it was made, then "no manifest").
+#[test]
+fn a_session_path_beyond_path_max_is_refused_up_front() {
+    use vss::session::{Session, SessionError};
+    let tmp = tempfile::tempdir().expect("tmp");
+    // Folders of 200 bytes, down to about 4000 bytes of path: still a path
+    // the system takes, but not with the session's names under it.
+    let mut deep = tmp.path().to_path_buf();
+    while deep.as_os_str().len() < 3900 {
+        deep = deep.join("d".repeat(200));
+    }
+    std::fs::create_dir_all(&deep).expect("deep folders");
+    let name = "s".repeat(32);
+    let e = Session::create(&deep, &name, &cell_profile(32, 32)).expect_err("too long");
+    assert!(matches!(e, SessionError::PathTooLong { .. }), "{e:?}");
+    assert!(e.to_string().contains("shorter path"), "{e}");
+    assert!(!deep.join(&name).exists(), "the session folder was made");
+}
+
+/// Issue 34, N9: a save whose record cannot be written (a full disk fails
+/// there: the image went, the manifest did not; here the manifest's name is
+/// taken by a folder) leaves no image the manifest does not record, and
+/// keeps the recorded image it would have replaced.
+#[test]
+fn a_save_that_cannot_be_recorded_leaves_the_folder_as_it_was() {
+    use vss::formats::img::{ImgFile, encode_img};
+    use vss::llv::GreyImage;
+    use vss::session::Session;
+    let tmp = tempfile::tempdir().expect("tmp");
+    let grey = |v: u8| ImgFile::new(GreyImage::filled(16, 16, v).expect("image"));
+    let mut s = Session::create(tmp.path(), "fd", &cell_profile(32, 32)).expect("create");
+    s.save_image(1, 'a', &grey(1)).expect("save 1");
+    let dir = s.dir().to_path_buf();
+    std::fs::remove_file(dir.join("fd.toml")).expect("manifest");
+    std::fs::create_dir(dir.join("fd.toml")).expect("a folder in its place");
+    let e = s
+        .save_image(2, 'a', &grey(2))
+        .expect_err("recorded nowhere");
+    assert!(e.to_string().contains("fd.toml"), "{e}");
+    assert!(
+        !dir.join("fd2a.img").exists(),
+        "an unrecorded image is left"
+    );
+    let e = s
+        .save_image(1, 'a', &grey(9))
+        .expect_err("recorded nowhere");
+    assert!(e.to_string().contains("fd.toml"), "{e}");
+    assert_eq!(
+        std::fs::read(dir.join("fd1a.img")).expect("image 1"),
+        encode_img(&grey(1)).expect("bytes"),
+        "the recorded image was replaced"
+    );
+    let left: Vec<String> = std::fs::read_dir(&dir)
+        .expect("dir")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
+/// Issue 34, N9/N6: an I/O error is told once ("(os error 28)" and the
+/// profile's "more than" were printed twice: the wrapper's message and its
+/// source).
+#[test]
+fn an_io_error_is_told_once() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    std::fs::write(tmp.path().join("big.toml"), "#".repeat(2 << 20)).expect("profile");
+    let (ok, out) = vss(tmp.path(), &["--profile", "big.toml", "lights", "status"]);
+    assert!(!ok, "{out}");
+    assert_eq!(out.matches("more than").count(), 1, "{out}");
+}

@@ -181,6 +181,34 @@ fn a_frame_whose_crc_differs_from_freeze_is_refused() {
     );
 }
 
+/// Issue 34: once, under load, a clean grab failed with "the frame's CRC
+/// does not match FREEZE's". A READ given up on in an earlier transfer was
+/// answered after the re-sync's quiet time, with an older frame's bytes
+/// under the offset and length of a READ of this frame. The frame is read
+/// again (the grabber still holds it), not refused.
+#[test]
+fn a_block_of_an_older_frame_makes_the_frame_read_again() {
+    let old = [1u8, 2, 3, 4, 5, 6, 7, 8];
+    let new = [9u8, 9, 9, 9, 8, 8, 8, 8];
+    let crc = crc32(&new);
+    // READ 0 4 is answered first by the late DATA 0 4 of the older frame,
+    // then by its own (skipped as late).
+    let mut first = data(0, &old[..4]);
+    first.extend(data(0, &new[..4]));
+    let mut c = client(vec![
+        line(HELLO),
+        line(&format!("OK FRAME 4 2 {crc:08X}")),
+        first,
+        data(4, &new[4..]),
+        data(0, &new[..4]),
+        data(4, &new[4..]),
+    ]);
+    assert!(c.hello().is_ok() && c.freeze().is_ok());
+    let img = c.transfer(&mut |_, _| true);
+    assert_eq!(img.ok().map(|i| i.data().to_vec()), Some(new.to_vec()));
+    assert_eq!(sent(&mut c).matches("READ 0 4").count(), 2);
+}
+
 #[test]
 fn a_late_data_reply_is_skipped() {
     let pixels = [9u8, 8, 7, 6, 5, 4, 3, 2];

@@ -362,6 +362,7 @@ impl<P: Link> VsgClient<P> {
         progress: &mut dyn FnMut(usize, usize) -> bool,
     ) -> Result<GreyImage, RigError> {
         let mut recovered = 0;
+        let mut crc_miss: Option<RigError> = None;
         loop {
             match self.read_frame(frame, progress) {
                 Err(e @ RigError::NoFrame { .. }) if recovered < super::FRAME_RECOVERIES => {
@@ -370,6 +371,21 @@ impl<P: Link> VsgClient<P> {
                         Some(f) => frame = f,
                         None => return Err(e),
                     }
+                }
+                // Every block passed its own CRC, the frame did not pass
+                // FREEZE's: a block came from another frame. A READ given
+                // up on in an earlier transfer (the line was slow: a loaded
+                // machine) can be answered after the re-sync's quiet time,
+                // and its DATA names the same offset and length as a READ
+                // of this frame. The grabber still holds this frame: it is
+                // read once more, after the re-sync that read_frame did.
+                Err(e @ RigError::FrameCrc { .. }) if crc_miss.is_none() => {
+                    crc_miss = Some(e);
+                }
+                // The second read failed too: the CRC mismatch is what went
+                // wrong, unless the device went away or the operator stopped.
+                Err(e) if !(e.is_vanished() || matches!(e, RigError::Cancelled { .. })) => {
+                    return Err(crc_miss.unwrap_or(e));
                 }
                 r => return r,
             }

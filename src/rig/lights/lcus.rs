@@ -1,15 +1,22 @@
 //! The LCUS/CH340 relay boards: 9600 8N1, one frame `A0 ch state sum` per
-//! switch, and no reply at all — the board cannot be read. So the driver
-//! remembers what it set, and keeps that in a small state file per port,
-//! so that the next `vss` (a `vss lights status`, the console started
-//! again) knows what is on without switching anything:
+//! switch, and no reply at all — the board cannot be read, and it loses its
+//! relays when it loses power (a USB replug, a power cycle of the cabinet)
+//! while its port name stays.
+//!
+//! So nothing remembered decides what is sent: the first switch a process
+//! makes on a board sends every channel (the whole mask), and so does every
+//! [`LightSwitch::set_mask`] — a capture sets its lighting's whole mask.
+//! Only a single-relay switch after that sends one frame. Re-sending a
+//! relay's state does not toggle it, so lights that stay on do not flicker.
+//!
+//! What vss last set is kept in a small state file per port, for *reporting*
+//! only (`vss lights status`, which switches nothing):
 //! `$XDG_STATE_HOME/vss/relays/PORT.toml` (`~/.local/state/vss/relays/`
-//! without `XDG_STATE_HOME`; `PORT` is the device path with every
-//! character but letters, digits, `.` and `-` made `_`), written
-//! atomically after every switch. Opening the board sends nothing; a
-//! mask is sent as the frames of the channels that change from what is
-//! remembered (all of them when nothing is), so lights that stay on do not
-//! flicker.
+//! without an absolute `XDG_STATE_HOME`; `PORT` is the device path with
+//! every character but letters, digits, `.` and `-` made `_`), written
+//! atomically after every switch. A state file that does not fit the board
+//! (another port, another channel count, relays beyond the board, not a
+//! state file at all) is ignored, with a note saying why.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -45,12 +52,7 @@ const MAX_STATE_LEN: u64 = 4096;
 /// The state file of the LCUS board on `port` (see the module doc), or
 /// `None` when neither `XDG_STATE_HOME` nor `HOME` is set.
 pub fn lcus_state_file(port: &str) -> Option<PathBuf> {
-    let base = match std::env::var_os("XDG_STATE_HOME").filter(|v| !v.is_empty()) {
-        Some(d) => PathBuf::from(d),
-        None => {
-            PathBuf::from(std::env::var_os("HOME").filter(|v| !v.is_empty())?).join(".local/state")
-        }
-    };
+    let base = crate::profile::state_home()?;
     let name: String = port
         .chars()
         .map(|c| {
@@ -70,7 +72,13 @@ pub struct LcusBoard<P: Link> {
     name: String,
     timeout: Duration,
     channels: u32,
+    /// What the state file says vss last set (reporting only).
     last: Option<LastSet>,
+    /// What this process sent since it opened the board: `None` until its
+    /// first switch, which therefore sends every channel.
+    sent: Option<u32>,
+    /// Why the state file was ignored, if it was.
+    note: Option<String>,
     state_file: Option<PathBuf>,
 }
 
@@ -96,15 +104,26 @@ impl<P: Link> LcusBoard<P> {
             timeout,
             channels: channels.clamp(1, 32),
             last: None,
+            sent: None,
+            note: None,
             state_file: None,
         }
     }
 
-    /// Keeps the state in `file` too, and starts from what it says (a
-    /// missing or unreadable file, or one for another port or board size,
-    /// means nothing is known).
+    /// Keeps the state in `file` too, and reports what it says (a missing
+    /// file means nothing is recorded; one that does not fit this board is
+    /// ignored, and [`LightSwitch::note`] says why). What is sent never
+    /// depends on it.
     pub fn with_state_file(mut self, file: PathBuf) -> Self {
-        self.last = load(&file, &self.name, self.channels);
+        match load(&file, &self.name, self.channels) {
+            Ok(last) => self.last = last,
+            Err(why) => {
+                self.note = Some(format!(
+                    "{}: ignored the LCUS state file: {why}",
+                    file.display()
+                ));
+            }
+        }
         self.state_file = Some(file);
         self
     }
@@ -147,6 +166,7 @@ impl<P: Link> LcusBoard<P> {
             mask,
             when: crate::session::stamp::now_rfc3339(),
         };
+        self.sent = Some(mask);
         self.last = Some(last.clone());
         let Some(file) = &self.state_file else {
             return Ok(());
@@ -170,29 +190,58 @@ impl<P: Link> LcusBoard<P> {
     }
 }
 
-fn load(file: &Path, port: &str, channels: u32) -> Option<LastSet> {
-    let text = crate::fsutil::read_input_text(file, MAX_STATE_LEN).ok()?;
-    let s: StateFile = toml::from_str(&text).ok()?;
-    (s.port == port && s.channels == channels).then_some(s.last)
+/// What the state file at `file` records for the board on `port` with
+/// `channels` relays: `Ok(None)` when there is no file, `Err(why)` when
+/// there is one that does not fit.
+fn load(file: &Path, port: &str, channels: u32) -> Result<Option<LastSet>, String> {
+    let text = match crate::fsutil::read_input_text(file, MAX_STATE_LEN) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(e.to_string()),
+    };
+    let s: StateFile = toml::from_str(&text)
+        .map_err(|e| format!("not a state file vss wrote ({})", e.message()))?;
+    let clean = crate::formats::sanitize;
+    if s.port != port {
+        return Err(format!("it is for port {:?}, not {port:?}", clean(&s.port)));
+    }
+    if s.channels != channels {
+        return Err(format!(
+            "it is for a {}-channel board, this one has {channels}",
+            s.channels
+        ));
+    }
+    if channels < 32 && s.last.mask >> channels != 0 {
+        return Err(format!(
+            "its mask {:x} names relays beyond this {channels}-channel board",
+            s.last.mask
+        ));
+    }
+    if s.last.when.len() > 64 || s.last.when.chars().any(char::is_control) {
+        return Err("its time stamp is not one vss writes".into());
+    }
+    Ok(Some(s.last))
 }
 
 impl<P: Link> LightSwitch for LcusBoard<P> {
     fn set(&mut self, relay: u32, on: bool) -> Result<(), RigError> {
         self.exists(relay)?;
-        let base = self.last.as_ref().map_or(0, |l| l.mask);
+        let Some(base) = self.sent else {
+            // This process's first switch of the board: the whole mask
+            // (the board may have lost power since the state file was
+            // written; what vss last set is not what the board has).
+            return self.set_mask(if on { 1 << relay } else { 0 });
+        };
         let mask = if on {
             base | 1 << relay
         } else {
             base & !(1 << relay)
         };
-        if self.last.is_none() {
-            // Nothing known: every channel is sent once, so it is.
-            return self.set_mask(mask);
-        }
         self.send(relay, on)?;
         self.remember(mask)
     }
 
+    /// Sends every channel, whatever was set before.
     fn set_mask(&mut self, mask: u32) -> Result<(), RigError> {
         if self.channels < 32 && mask >> self.channels != 0 {
             return Err(RigError::Board {
@@ -203,18 +252,22 @@ impl<P: Link> LightSwitch for LcusBoard<P> {
                 ),
             });
         }
-        let known = self.last.as_ref().map(|l| l.mask);
+        // Sent or not, the board's state is now unknown until every frame
+        // went out.
+        self.sent = None;
         for relay in 0..self.channels {
-            let want = mask & (1 << relay) != 0;
-            if known.is_none_or(|k| (k & (1 << relay) != 0) != want) {
-                self.send(relay, want)?;
-            }
+            self.send(relay, mask & (1 << relay) != 0)?;
         }
         self.remember(mask)
     }
 
+    /// What this process set, else what vss last set (the state file):
+    /// an LCUS board cannot be asked.
     fn read_mask(&mut self) -> Result<u32, RigError> {
-        Ok(self.last.as_ref().map_or(0, |l| l.mask))
+        Ok(self
+            .sent
+            .or(self.last.as_ref().map(|l| l.mask))
+            .unwrap_or(0))
     }
 
     fn reads_back(&self) -> bool {
@@ -223,6 +276,10 @@ impl<P: Link> LightSwitch for LcusBoard<P> {
 
     fn last_set(&self) -> Option<LastSet> {
         self.last.clone()
+    }
+
+    fn note(&self) -> Option<String> {
+        self.note.clone()
     }
 
     fn port_name(&self) -> &str {

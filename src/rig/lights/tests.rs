@@ -103,11 +103,16 @@ fn no_answer_is_a_timeout_counted_right() {
 }
 
 #[test]
-fn lcus_sends_what_changes_and_remembers() {
+fn lcus_sends_the_whole_mask_and_single_switches_after_it() {
     let s = Script::new(b'\n', vec![]);
     let mut b = LcusBoard::new(s, "/dev/lcus", 4, Duration::from_millis(50));
     assert!(!b.reads_back() && b.last_set().is_none());
-    // Nothing known: every channel once.
+    // A mask: every channel, every time (the board may have lost it).
+    let all = |m: u32| -> Vec<u8> {
+        (0..4u32)
+            .flat_map(|r| crate::rig::protocol::lcus_frame(r, m & 1 << r != 0).unwrap())
+            .collect()
+    };
     assert!(b.set_mask(0b0001).is_ok());
     assert_eq!(
         b.port_mut().sent,
@@ -116,31 +121,67 @@ fn lcus_sends_what_changes_and_remembers() {
         ]
     );
     b.port_mut().sent.clear();
-    // Then only the channels that change.
     assert!(b.set_mask(0b1001).is_ok());
-    assert_eq!(b.port_mut().sent, vec![0xA0, 4, 1, 0xA5]);
+    assert_eq!(b.port_mut().sent, all(0b1001));
     b.port_mut().sent.clear();
+    // After a whole mask, one relay is one frame.
     assert!(b.set(0, false).is_ok());
     assert_eq!(b.port_mut().sent, vec![0xA0, 1, 0, 0xA1]);
     assert_eq!(b.read_mask().ok(), Some(0b1000));
     assert!(matches!(b.set(4, true), Err(RigError::Board { .. })));
     assert!(matches!(b.set_mask(1 << 6), Err(RigError::Board { .. })));
+    // A process's first single switch sends the whole mask: the others off.
+    let mut b = LcusBoard::new(Script::new(b'\n', vec![]), "/dev/lcus", 4, Duration::ZERO);
+    assert!(b.set(2, true).is_ok());
+    assert_eq!(b.port_mut().sent, all(0b0100));
 }
 
 #[test]
-fn lcus_state_survives_in_its_file() {
+fn lcus_state_file_reports_and_never_decides_what_is_sent() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("relays/x.toml");
-    let mut b = LcusBoard::new(Script::new(b'\n', vec![]), "/dev/lcus", 8, Duration::ZERO)
-        .with_state_file(file.clone());
+    let open = |port: &str| {
+        LcusBoard::new(Script::new(b'\n', vec![]), port, 8, Duration::ZERO)
+            .with_state_file(file.clone())
+    };
+    let mut b = open("/dev/lcus");
     assert!(b.set_mask(0b101).is_ok());
-    let b2 = LcusBoard::new(Script::new(b'\n', vec![]), "/dev/lcus", 8, Duration::ZERO)
-        .with_state_file(file.clone());
+    let mut b2 = open("/dev/lcus");
     assert_eq!(b2.last_set().map(|l| l.mask), Some(0b101));
-    // Another port's board is not this one.
-    let b3 = LcusBoard::new(Script::new(b'\n', vec![]), "/dev/other", 8, Duration::ZERO)
-        .with_state_file(file);
+    assert!(b2.note().is_none());
+    // The next process sets the same mask: all 8 channels go again.
+    assert!(b2.set_mask(0b101).is_ok());
+    assert_eq!(b2.port_mut().sent.len(), 8 * 4);
+    // Another port's board is not this one: ignored, with a note.
+    let b3 = open("/dev/other");
     assert!(b3.last_set().is_none());
+    assert!(
+        b3.note().is_some_and(|n| n.contains("/dev/other")),
+        "{:?}",
+        b3.note()
+    );
+    // Relays beyond the board, garbage: ignored, with a note.
+    for (bad, why) in [
+        (
+            "port = \"/dev/lcus\"\nchannels = 8\nmask = 4095\nwhen = \"x\"\n",
+            "beyond",
+        ),
+        ("\u{0}\u{1}garbage", "not a state file"),
+    ] {
+        std::fs::write(&file, bad).unwrap();
+        let b = open("/dev/lcus");
+        assert!(b.last_set().is_none(), "{bad:?}");
+        assert!(
+            b.note()
+                .is_some_and(|n| n.contains(why) && n.contains("ignored")),
+            "{bad:?}: {:?}",
+            b.note()
+        );
+    }
+    // No file: nothing recorded, nothing to note.
+    std::fs::remove_file(&file).unwrap();
+    let b = open("/dev/lcus");
+    assert!(b.last_set().is_none() && b.note().is_none());
 }
 
 #[test]

@@ -50,6 +50,12 @@ pub enum StoreError {
         dir.display()
     )]
     TakeOver { dir: PathBuf, holder: String },
+    #[error("session {} is held by {holder}, which was not asked to end: {why}; nothing changed", dir.display())]
+    TakeOverRefused {
+        dir: PathBuf,
+        holder: String,
+        why: String,
+    },
     #[error("the profile names no .cdf for camera {camera}: add it to [survey] cdf")]
     NoCdf { camera: u32 },
     #[error("{} NOT written: {source}", path.display())]
@@ -430,9 +436,17 @@ impl Store {
                 h.pid,
                 dir.display()
             )));
-            let _ = std::process::Command::new("kill")
-                .args(["-TERM", &h.pid.to_string()])
-                .status();
+            // Only the lock's own vss console is signalled (a stale lock is
+            // taken over below without signalling anyone).
+            if let Err(why) = crate::session::lock::ask_holder_to_leave(h)
+                && !h.is_stale()
+            {
+                return Err(StoreError::TakeOverRefused {
+                    dir: dir.to_path_buf(),
+                    holder: h.to_string(),
+                    why,
+                });
+            }
             let end = Instant::now() + Duration::from_secs(15);
             loop {
                 match Session::open(dir) {

@@ -16,15 +16,11 @@ pub struct LogFile {
 
 /// The log file while no session is open.
 pub fn state_path() -> Option<PathBuf> {
-    let base = std::env::var_os("XDG_STATE_HOME")
-        .filter(|v| !v.is_empty())
-        .map(PathBuf::from)
-        .or_else(|| {
-            std::env::var_os("HOME")
-                .filter(|v| !v.is_empty())
-                .map(|h| PathBuf::from(h).join(".local/state"))
-        })?;
-    Some(base.join("vss").join("console.log"))
+    Some(
+        crate::profile::state_home()?
+            .join("vss")
+            .join("console.log"),
+    )
 }
 
 impl LogFile {
