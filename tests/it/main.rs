@@ -15,6 +15,7 @@ mod cli_pipe;
 mod cli_standalone;
 mod formats_malformed;
 mod formats_roundtrip;
+mod golden;
 mod llv_alloc;
 mod llv_auto;
 mod llv_auto_cli;
