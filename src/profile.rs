@@ -292,6 +292,14 @@ impl Profile {
     /// The camera description of camera `cam` (1-based) that `survey.cdf`
     /// names: `None` when it names none. A file named but missing or
     /// malformed is an error naming the file.
+    ///
+    /// This is the one owner of "which camera model does camera N have":
+    /// the console's pipeline, Calibrate, the session's recorded `NAMEk.cdf`,
+    /// `vss llv --camera`, `vss calibrate`, `vss grab` and `vss session new`
+    /// all ask it. For the built-in profile a file at the named path (one
+    /// the Calibrate screen or `vss calibrate` wrote there) wins over the
+    /// compiled-in description, which is served when there is none, so the
+    /// built-in cell corrects its lenses from any folder.
     pub fn camera_cdf(&self, cam: u32) -> Result<Option<crate::formats::cdf::Cdf>, ProfileError> {
         let Some(named) = usize::try_from(cam)
             .ok()
@@ -305,6 +313,7 @@ impl Profile {
             source,
         };
         if self.builtin
+            && !self.resolve_path(named).exists()
             && let Some((_, text)) = BUILTIN_CDF.iter().find(|(n, _)| Path::new(n) == named)
         {
             let shown = Path::new(BUILTIN_NAME).join(named);
@@ -343,7 +352,22 @@ impl Profile {
         }
     }
 
-    /// The `.cdf` file of camera `cam` (1-based), resolved.
+    /// Where [`Profile::camera_cdf`] takes camera `cam`'s description
+    /// from, for messages: the resolved file, or the compiled-in one
+    /// ("sim/cam1.cdf (built in)"); `None` when the profile names none.
+    pub fn cdf_shown(&self, cam: u32) -> Option<String> {
+        let i = usize::try_from(cam).ok()?.checked_sub(1)?;
+        let named = self.survey.cdf.get(i)?;
+        let path = self.resolve_path(named);
+        if self.builtin && !path.exists() && BUILTIN_CDF.iter().any(|(n, _)| Path::new(n) == named)
+        {
+            return Some(format!("{} (built in)", named.display()));
+        }
+        Some(path.display().to_string())
+    }
+
+    /// The `.cdf` file of camera `cam` (1-based), resolved: where a new
+    /// calibration is written (read it through [`Profile::camera_cdf`]).
     pub fn cdf_path(&self, cam: u32) -> Option<PathBuf> {
         let i = usize::try_from(cam).ok()?.checked_sub(1)?;
         self.survey.cdf.get(i).map(|p| self.resolve_path(p))

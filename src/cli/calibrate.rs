@@ -191,11 +191,16 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
 /// `S` of camera `cam`'s `.cdf` in the profile.
 fn stated_scale(profile: &crate::profile::Profile, cam: u32) -> anyhow::Result<(f64, f64)> {
     let hint = "give --scale SX,SY (mm per pixel, from the camera's data sheet)";
-    let Some(path) = profile.cdf_path(cam) else {
+    // The camera's description as the one owner serves it (a file, or the
+    // built-in cell's compiled-in one).
+    let Some(c) = profile
+        .camera_cdf(cam)
+        .with_context(|| format!("the scale S: {hint}"))?
+    else {
         bail!("the profile names no .cdf for camera {cam}, so no scale S: {hint}");
     };
-    let c = cdf::read_cdf(&path).with_context(|| format!("the scale S: {hint}"))?;
-    calib::scale_of(&c).with_context(|| format!("{} has no scale S: {hint}", path.display()))
+    let shown = profile.cdf_shown(cam).unwrap_or_default();
+    calib::scale_of(&c).with_context(|| format!("{shown} has no scale S: {hint}"))
 }
 
 fn print_calibration(c: &Calibration) -> anyhow::Result<()> {

@@ -43,6 +43,10 @@ pub struct Args {
     /// Camera description: lens-correct the images and write .imc files.
     #[arg(long, value_name = "CAMERA.cdf")]
     pub cdf: Option<PathBuf>,
+    /// Lens-correct with camera N's description as the profile gives it
+    /// (its `.cdf` file, or the built-in cell's own), and write .imc files.
+    #[arg(long, value_name = "N", conflicts_with = "cdf")]
+    pub camera: Option<u32>,
     /// Change a parameter for this run: --set edges.per_region=12 (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<String>,
@@ -144,14 +148,30 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         let r = from_edges(hpo, vpo, &a, &p);
         return finish(r.map(|()| 0));
     }
-    let camera = match &a.cdf {
-        Some(path) => Some(cdf::read_cdf(path)?.camera_model().with_context(|| {
-            format!(
-                "{}: the camera description lacks S, C or f (or marks them N): cannot correct the lens",
-                path.display()
-            )
-        })?),
-        None => None,
+    let lacks = |shown: &dyn std::fmt::Display| {
+        format!(
+            "{shown}: the camera description lacks S, C or f (or marks them N): cannot correct the lens"
+        )
+    };
+    let camera = match (&a.cdf, a.camera) {
+        (Some(path), _) => Some((
+            cdf::read_cdf(path)?
+                .camera_model()
+                .with_context(|| lacks(&path.display()))?,
+            path.clone(),
+        )),
+        // The one owner of a camera's description (as the console uses).
+        (None, Some(cam)) => {
+            let shown = profile.cdf_shown(cam).unwrap_or_default();
+            let c = profile.camera_cdf(cam)?.with_context(|| {
+                format!("the profile names no .cdf for camera {cam} ([survey] cdf)")
+            })?;
+            Some((
+                c.camera_model().with_context(|| lacks(&shown))?,
+                PathBuf::from(shown),
+            ))
+        }
+        (None, None) => None,
     };
     // An ambient image given by name is subtracted from every image given;
     // else the profile's rule picks it among the lightings of one view.
@@ -165,7 +185,15 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     let mut runner = Runner::new();
     let mut failed = 0;
     for grp in group(&a.images) {
-        if let Err(e) = run_group(&grp, &a, &p, camera, &rule, ambient.as_ref(), &mut runner) {
+        if let Err(e) = run_group(
+            &grp,
+            &a,
+            &p,
+            camera.as_ref(),
+            &rule,
+            ambient.as_ref(),
+            &mut runner,
+        ) {
             if super::is_broken_pipe(&e) {
                 return Err(e);
             }
@@ -192,7 +220,7 @@ fn run_group(
     grp: &Group,
     a: &Args,
     p: &Params,
-    camera: Option<CameraModel>,
+    camera: Option<&(CameraModel, PathBuf)>,
     rule: &FrameRule,
     ambient: Option<&(PathBuf, GreyImage)>,
     runner: &mut Runner,
@@ -219,7 +247,7 @@ fn run_group(
                 .copied()
                 .zip(files.iter().map(|f| f.image.clone())),
         )
-        .with_camera(camera);
+        .with_camera(camera.map(|c| c.0));
     if let Some((_, img)) = ambient {
         input.ambient = Some(('-', img.clone()));
     }
@@ -235,8 +263,8 @@ fn run_group(
             .map(|i| grp.files[i].clone()),
     };
     let size = input.size();
-    if let (Some(m), Some(cdf_path)) = (camera.as_ref(), &a.cdf) {
-        cdf::check_camera_area(m, size.0, size.1, cdf_path)?;
+    if let Some((m, shown)) = camera {
+        cdf::check_camera_area(m, size.0, size.1, shown)?;
     }
     let proposal = match &a.auto {
         Some(t) => {

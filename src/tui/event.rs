@@ -200,8 +200,9 @@ pub enum StoreEvent {
     Updated(SessionView),
     /// An image number read back from disk (resume, going back).
     Loaded(Box<LoadedImage>),
-    /// The camera models, index 0 = camera 1 (`None` where no `.cdf`).
-    Cameras(Vec<Option<CameraModel>>),
+    /// The camera models, index 0 = camera 1, or why a camera has none
+    /// (no `.cdf` named, unreadable, or lacking S, C or f).
+    Cameras(Vec<Result<CameraModel, String>>),
     Saved(String),
     /// A note worth a log line (a stale lock taken over).
     Note(String),

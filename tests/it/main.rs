@@ -48,6 +48,7 @@ mod tui_device;
 mod tui_flow;
 mod tui_harness;
 mod tui_pty;
+mod tui_pty_builtin;
 mod tui_pty_feedback;
 mod tui_pty_review;
 mod tui_pty_trouble;

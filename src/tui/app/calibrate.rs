@@ -177,15 +177,13 @@ impl CalibrateScreen {
 
     fn solve(&mut self, cam: u32, ctx: &mut Ctx) {
         let Some(m) = ctx.cell.camera_model(cam) else {
-            let file = ctx
+            let why = ctx
                 .cell
-                .cdf_paths
-                .get(cam as usize - 1)
-                .cloned()
-                .flatten()
-                .map_or("none named".into(), |p| p.display().to_string());
+                .camera_problem(cam)
+                .unwrap_or("its camera description is not read yet")
+                .to_string();
             ctx.error(format!(
-                "camera {cam}: no scale S to calibrate with — the profile's .cdf ({file}) is missing or lacks S, C or f; `vss calibrate --camera {cam} --scale SX,SY IMAGES…` makes the first one"
+                "camera {cam}: no scale S to calibrate with — {why}; `vss calibrate --camera {cam} --scale SX,SY IMAGES…` makes the first one"
             ));
             return;
         };

@@ -38,8 +38,11 @@ pub struct CellState {
     /// Lighting configuration letter → names of the lights on.
     pub lighting_on: Vec<(char, Vec<String>)>,
     pub cameras: u32,
-    pub camera_models: Vec<Option<CameraModel>>,
-    /// The profile's `.cdf` of each camera (index 0 is camera 1).
+    /// Each camera's model (index 0 is camera 1), or why it has none —
+    /// as [`Profile::camera_cdf`] gives them (the store worker asks it).
+    pub camera_models: Vec<Result<CameraModel, String>>,
+    /// Where each camera's `.cdf` is written by Calibrate (index 0 is
+    /// camera 1).
     pub cdf_paths: Vec<Option<std::path::PathBuf>>,
     pub device: DeviceState,
     /// The latest frame of the live view or a single grab (camera, image).
@@ -78,8 +81,19 @@ impl CellState {
     /// The camera model of camera `cam` (1-based), if its `.cdf` has one.
     pub fn camera_model(&self, cam: u32) -> Option<CameraModel> {
         self.camera_models
-            .get(cam.checked_sub(1)? as usize)
+            .get(cam.checked_sub(1)? as usize)?
+            .as_ref()
+            .ok()
             .copied()
-            .flatten()
+    }
+
+    /// Why camera `cam` (1-based) has no model for lens correction, once
+    /// the store has said (`None` while it has not, or when it has one).
+    pub fn camera_problem(&self, cam: u32) -> Option<&str> {
+        self.camera_models
+            .get(cam.checked_sub(1)? as usize)?
+            .as_ref()
+            .err()
+            .map(String::as_str)
     }
 }

@@ -181,7 +181,23 @@ impl App {
             }
             StoreEvent::Loaded(img) => self.ctx().images_loaded(*img),
             StoreEvent::Cameras(models) => {
+                let models: Vec<_> = models
+                    .into_iter()
+                    .map(|m| m.map_err(|e| clean(&e)))
+                    .collect();
+                let enabled = self.tracker.params.lens.enabled;
+                let problems: Vec<String> = models
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, m)| m.as_ref().err().map(|e| (i + 1, e)))
+                    .map(|(cam, e)| format!("camera {cam}: {e}"))
+                    .collect();
                 self.cell.camera_models = models;
+                if enabled {
+                    for p in problems {
+                        self.ctx().warn(format!("lens correction OFF for {p}"));
+                    }
+                }
                 Vec::new()
             }
             StoreEvent::Saved(what) => {

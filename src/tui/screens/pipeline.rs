@@ -273,6 +273,17 @@ fn params_panel(app: &App, area: Rect, buf: &mut Buffer) {
         .collect();
     let mut lines = window(rows, sel, room, t);
     let cur = app.tracker.current.as_ref();
+    // Lens correction asked for but impossible: said where the lens time
+    // would show, with why (the log has it whole).
+    if params.lens.enabled
+        && let Some(c) = cur
+        && let Some(why) = app.cell.camera_problem(c.camera)
+    {
+        lines.push(Line::styled(
+            format!("lens OFF — camera {}: {why}", c.camera),
+            t.warn(),
+        ));
+    }
     match cur.and_then(|c| c.outputs.as_ref()) {
         Some(o) => {
             let ms = |us: u64| us as f64 / 1000.0;

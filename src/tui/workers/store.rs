@@ -151,7 +151,10 @@ impl Store {
         location: u32,
         image: GreyImage,
     ) -> Result<String, StoreError> {
-        let cdf = self.cdf_path(camera);
+        // The camera's description as the profile serves it (built in or a
+        // file), recorded as the image's NAMEk.cdf; a problem with it is
+        // said on the Pipeline screen (`cameras`), not here.
+        let cdf = self.profile.camera_cdf(camera).ok().flatten();
         let s = self.session_mut()?;
         let known = s
             .manifest()
@@ -161,7 +164,7 @@ impl Store {
         if known.is_none_or(|(c, l, has_cdf)| {
             c != camera || l != location || (!has_cdf && cdf.is_some())
         }) {
-            s.set_image_info(k, camera, location, cdf.as_deref())
+            s.set_image_camera(k, camera, location, cdf.as_ref())
                 .map_err(session_err(what.clone()))?;
         }
         let file = s.file_name(k, Some(letter), "img");
@@ -304,12 +307,23 @@ impl Store {
                     .profile
                     .cdf_path(camera)
                     .ok_or(StoreError::NoCdf { camera })?;
-                crate::calib::write_intrinsics(&path, &calibration).map_err(|source| {
-                    StoreError::Cdf {
-                        path: path.clone(),
-                        source,
-                    }
-                })?;
+                // The entries kept (T, a stated C) are those of the
+                // description the camera had — the compiled-in one of the
+                // built-in cell when no file is there yet.
+                let old = self.profile.camera_cdf(camera).ok().flatten();
+                let cdf = crate::calib::cdf_with_intrinsics(old.as_ref(), &calibration);
+                let cdf_err = |source| StoreError::Cdf {
+                    path: path.clone(),
+                    source,
+                };
+                if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
+                    && !dir.is_dir()
+                {
+                    std::fs::create_dir_all(dir).map_err(|e| {
+                        cdf_err(formats::FormatError::io(dir, "create the folder", &e))
+                    })?;
+                }
+                crate::calib::write_cdf_keeping(&path, &cdf).map_err(cdf_err)?;
                 let recorded = match self.session.as_mut() {
                     Some(s) => {
                         s.record_calibration(camera, &path, &calibration)
@@ -470,15 +484,19 @@ impl Store {
         Session::open_take_over(dir).map_err(err)
     }
 
-    fn cdf_path(&self, camera: u32) -> Option<PathBuf> {
-        self.profile.cdf_path(camera).filter(|p| p.is_file())
-    }
-
-    fn camera_models(&self) -> Vec<Option<CameraModel>> {
+    /// Each camera's model (index 0 = camera 1) from
+    /// [`Profile::camera_cdf`], or why lens correction cannot use it.
+    fn camera_models(&self) -> Vec<Result<CameraModel, String>> {
         (1..=self.profile.survey.cameras.max(1))
-            .map(|c| {
-                let p = self.cdf_path(c)?;
-                formats::cdf::read_cdf(&p).ok()?.camera_model()
+            .map(|c| match self.profile.camera_cdf(c) {
+                Ok(Some(cdf)) => cdf.camera_model().ok_or_else(|| {
+                    format!(
+                        "{} lacks S, C or f (or marks them N)",
+                        self.profile.cdf_shown(c).unwrap_or_default()
+                    )
+                }),
+                Ok(None) => Err("the profile names no .cdf for it ([survey] cdf)".into()),
+                Err(e) => Err(e.to_string()),
             })
             .collect()
     }

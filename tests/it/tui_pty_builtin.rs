@@ -1,0 +1,185 @@
+//! The console on the built-in simulated cell as a new operator meets it:
+//! the real binary started with no profile in an empty folder, with an
+//! empty home and the XDG folders inside it, so nothing beside the binary
+//! can stand in for what is compiled in. Lens correction must run there
+//! (its time on the Pipeline screen, a corrected view that is not the grey
+//! one), the Calibrate screen must compute with the built-in camera's
+//! scale, and accepting writes the camera's `.cdf` where the profile names
+//! it, keeping the built-in description's other entries.
+
+use vss::formats::cdf::{Status, read_cdf};
+use vss::tui::keymap::{
+    Action, CalibrateAction as CA, GlobalAction, PipelineAction, Scope, ScreenId,
+};
+
+use super::tui_harness::{Console, PIPELINE};
+
+/// The console with the built-in profile in an empty folder, `HOME` and
+/// the XDG folders in another empty one (kept alive by the caller).
+fn start_bare(cols: u16, rows: u16, home: &std::path::Path) -> Console {
+    let dir = tempfile::tempdir().unwrap();
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    let h = |sub: &str| home.join(sub).to_string_lossy().into_owned();
+    let env = [
+        ("HOME", home.to_string_lossy().into_owned()),
+        ("XDG_CONFIG_HOME", h(".config")),
+        ("XDG_DATA_HOME", h(".local/share")),
+        ("XDG_CACHE_HOME", h(".cache")),
+        ("XDG_STATE_HOME", h(".local/state")),
+    ];
+    let env: Vec<(&str, &str)> = env.iter().map(|(k, v)| (*k, v.as_str())).collect();
+    Console::start_in(dir, cols, rows, &env, &[])
+}
+
+/// The milliseconds of the lens stage on the Pipeline screen.
+fn lens_ms(screen: &str) -> Option<f64> {
+    let at = screen.find("ms lens ")? + "ms lens ".len();
+    screen[at..].split_whitespace().next()?.parse().ok()
+}
+
+/// The cells of the preview box (inside its border, above the cursor
+/// row) with their colours: what the operator sees of the picture.
+fn picture(c: &Console, cols: u16, rows: u16) -> Vec<String> {
+    c.with_screen(|s| {
+        let mut out = Vec::new();
+        for r in 3..rows.saturating_sub(5) {
+            for col in 34..cols.saturating_sub(1) {
+                if let Some(cell) = s.cell(r, col) {
+                    out.push(format!(
+                        "{}{:?}{:?}",
+                        cell.contents(),
+                        cell.fgcolor(),
+                        cell.bgcolor()
+                    ));
+                }
+            }
+        }
+        out
+    })
+}
+
+#[test]
+fn builtin_cell_from_an_empty_folder_corrects_lenses_and_calibrates() {
+    let home = tempfile::tempdir().unwrap();
+    let (cols, rows) = (80, 24);
+    let mut c = start_bare(cols, rows, home.path());
+    c.wait_text("simulated cell", 15);
+    c.create_session("cube");
+    c.capture_current(1);
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
+    );
+    let s = c.wait("the lens time", 30, |s| lens_ms(s).is_some());
+    let ms = lens_ms(&s).unwrap();
+    assert!(
+        ms > 0.0,
+        "lens correction ran on the built-in cell (lens {ms} ms):\n{s}"
+    );
+    assert!(!s.contains("lens OFF"), "{s}");
+    // The views in turn from the overlay: the grey one, then the corrected.
+    c.press(PIPELINE, Action::Pipeline(PipelineAction::ViewNext));
+    c.wait_text("· grey ─", 10);
+    let grey = picture(&c, cols, rows);
+    c.press(PIPELINE, Action::Pipeline(PipelineAction::ViewNext));
+    let s = c.wait_text("· corrected ─", 10);
+    assert!(!s.contains("not corrected"), "{s}");
+    let corrected = picture(&c, cols, rows);
+    assert_eq!(grey.len(), corrected.len());
+    let differ = grey.iter().zip(&corrected).filter(|(a, b)| a != b).count();
+    assert!(
+        differ > 0,
+        "the corrected view is the grey one cell for cell:\n{s}"
+    );
+
+    // Calibrate with the built-in camera 1's stated scale S.
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
+    );
+    c.wait_text("views kept: 0", 10);
+    let cb = Scope::Screen(ScreenId::Calibrate);
+    c.press(cb, Action::Calibrate(CA::Plate));
+    c.wait_text("plate shown (p)", 10);
+    for n in 1..=6 {
+        c.press(cb, Action::Calibrate(CA::Grab));
+        c.wait("a grid in the new frame", 30, |s| {
+            s.contains("corners found")
+        });
+        c.press(cb, Action::Calibrate(CA::Keep));
+        c.wait_text(&format!("views kept: {n}"), 10);
+    }
+    // The centre stated at the image's middle, as for the cell's cameras.
+    c.press(cb, Action::Calibrate(CA::Centre));
+    c.wait_text("stated, image middle", 10);
+    c.press(cb, Action::Calibrate(CA::Solve));
+    let s = c.wait("the calibration or a refusal", 60, |s| {
+        s.contains("RMS") || s.contains("no scale S")
+    });
+    assert!(!s.contains("no scale S"), "{s}");
+    c.press(cb, Action::Calibrate(CA::Accept));
+    c.wait_text("write S, C, f, D", 10);
+    c.yes();
+    let cdf = c.dir.path().join("sim/cam1.cdf");
+    c.wait("the .cdf written", 15, |_| cdf.is_file());
+    c.wait_text("wrote", 10);
+    let got = read_cdf(&cdf).unwrap();
+    assert_eq!(got.get("D").unwrap().status, Status::Calibrated);
+    assert!(
+        got.get("T").is_some(),
+        "the built-in description's T is kept: {got:?}"
+    );
+    c.send("q");
+    c.wait_exit(15);
+}
+
+/// Lens correction on, and camera 1's `.cdf` named but not there: the
+/// Pipeline screen says lens correction is off for it and why, where the
+/// lens time shows (before, the time read 0.0 and nothing said why).
+#[test]
+fn a_camera_without_its_cdf_is_said_on_the_pipeline_screen() {
+    let mut c = Console::start_with(
+        &super::tui_harness::five_lightings(true),
+        80,
+        24,
+        &[],
+        |_| {},
+    );
+    c.create_session("cube");
+    c.capture_current(1);
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
+    );
+    let s = c.wait_words("lens OFF — camera 1:", 30);
+    assert!(super::tui_harness::flat(&s).contains("cam1.cdf"), "{s}");
+    c.send("q");
+    c.wait_exit(15);
+}
+
+/// `vss llv --camera 1` in an empty folder on the built-in profile takes
+/// camera 1's description from the same owner as the console (the
+/// compiled-in one) and lens-corrects: the `.imc` is written and differs
+/// from the input.
+#[test]
+fn llv_camera_uses_the_builtin_description_from_an_empty_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let home = tempfile::tempdir().unwrap();
+    let img = super::support::llv_scene::scene(512, 512, 1.0, 5);
+    let input = dir.path().join("view.img");
+    vss::formats::img::write_img(&input, &vss::formats::img::ImgFile::new(img.clone())).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_vss"))
+        .current_dir(dir.path())
+        .env("HOME", home.path())
+        .env("XDG_CONFIG_HOME", home.path().join(".config"))
+        .args(["llv", "--camera", "1", "view.img"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let imc = vss::formats::img::read_img(&dir.path().join("view.imc")).unwrap();
+    assert_ne!(imc.image, img, "the .imc is lens-corrected");
+}
