@@ -250,11 +250,17 @@ pub fn parse_edges(bytes: &[u8], path: &Path) -> Result<EdgePoints, FormatError>
     })
 }
 
-/// The largest edge file read: a header line and two points for every pixel
-/// of the largest image the LLV stages take (a scan finds at most one edge
-/// point a pixel per direction; two leave room for hand-made files).
+/// The most points an edge file holds: 4 Mi, one for every sixteenth
+/// pixel of the largest image the LLV stages take (a scan finds at most one
+/// edge point a pixel, and edges are a small share of a picture's pixels).
+/// `llv --from-edges` of two such files stays within 512 MiB (two of 8 Mi
+/// points took 560 MiB, docs/reliability.md); the earlier bound, two points
+/// a pixel (1.5 GiB a file), let a 600 MB file cost 2.4 GB.
+pub const MAX_POINTS: usize = crate::llv::image::MAX_PIXELS / 16;
+
+/// The largest edge file read: a header line and [`MAX_POINTS`] points.
 pub fn max_file_len() -> u64 {
-    (MAX_HEADER + 2 * POINT_LEN * crate::llv::image::MAX_PIXELS) as u64
+    (MAX_HEADER + POINT_LEN * MAX_POINTS) as u64
 }
 
 /// Reads a `.hpo`/`.vpo` file: the header first (checked against the
