@@ -128,9 +128,8 @@ impl FormatError {
 /// broken file from costing gigabytes):
 /// - `.img`/`.imc`: the 64-byte header, a 200-byte comment and 65535 × 65535
 ///   pixels, the most its 16-bit size fields can describe;
-/// - `.hpo`/`.vpo`: a header line and 12 bytes for each of up to two points
-///   per pixel of the largest image the LLV stages take
-///   ([`crate::llv::image::MAX_PIXELS`]), 1.5 GiB;
+/// - `.hpo`/`.vpo`: a header line and 12 bytes for each of up to
+///   [`edgefile::MAX_POINTS`] points, 48 MiB;
 /// - PNG, PGM, TIFF, BMP: 512 MiB (the decoded image may have at most
 ///   256 MiB, and none of these is larger than what it decodes to by much);
 /// - `.lex`/`.ldr`: 256 MiB of text (about 4 M segments);

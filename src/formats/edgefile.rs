@@ -250,11 +250,17 @@ pub fn parse_edges(bytes: &[u8], path: &Path) -> Result<EdgePoints, FormatError>
     })
 }
 
-/// The largest edge file read: a header line and two points for every pixel
-/// of the largest image the LLV stages take (a scan finds at most one edge
-/// point a pixel per direction; two leave room for hand-made files).
+/// The most points an edge file holds: 4 Mi, one for every sixteenth
+/// pixel of the largest image the LLV stages take (a scan finds at most one
+/// edge point a pixel, and edges are a small share of a picture's pixels).
+/// `llv --from-edges` of two such files stays within 512 MiB (two of 8 Mi
+/// points took 560 MiB, docs/reliability.md); the earlier bound, two points
+/// a pixel (1.5 GiB a file), let a 600 MB file cost 2.4 GB.
+pub const MAX_POINTS: usize = crate::llv::image::MAX_PIXELS / 16;
+
+/// The largest edge file read: a header line and [`MAX_POINTS`] points.
 pub fn max_file_len() -> u64 {
-    (MAX_HEADER + 2 * POINT_LEN * crate::llv::image::MAX_PIXELS) as u64
+    (MAX_HEADER + POINT_LEN * MAX_POINTS) as u64
 }
 
 /// Reads a `.hpo`/`.vpo` file: the header first (checked against the
@@ -345,8 +351,9 @@ pub fn read_edges_count(path: &Path) -> Result<usize, FormatError> {
     open_header(path).map(|(_, _, h, _)| h.count)
 }
 
-/// Writes a `.hpo`/`.vpo` file atomically; non-finite values and a width or
-/// height over [`MAX_SIDE`] (which [`read_edges`] would refuse) are refused.
+/// Writes a `.hpo`/`.vpo` file atomically; non-finite values, a width or
+/// height over [`MAX_SIDE`] and more than [`MAX_POINTS`] points (which
+/// [`read_edges`] would refuse) are refused.
 pub fn write_edges(path: &Path, e: &EdgePoints) -> Result<(), FormatError> {
     write_bytes(path, &encode_checked(path, e)?)
 }
@@ -354,6 +361,18 @@ pub fn write_edges(path: &Path, e: &EdgePoints) -> Result<(), FormatError> {
 /// The bytes [`write_edges`] writes, after its checks (`path` names the
 /// file in errors).
 pub fn encode_checked(path: &Path, e: &EdgePoints) -> Result<Vec<u8>, FormatError> {
+    // Nothing is written that the reader would refuse.
+    if e.points.len() > MAX_POINTS {
+        return Err(FormatError::new(
+            path,
+            super::Location::None,
+            K::Range,
+            format!(
+                "{} edge points are more than the {MAX_POINTS} an edge file holds",
+                e.points.len()
+            ),
+        ));
+    }
     if e.width > MAX_SIDE || e.height > MAX_SIDE {
         return Err(FormatError::new(
             path,
@@ -407,6 +426,32 @@ mod tests {
         assert!(b.starts_with(b"VSSEDGE 1 V 64 48 2\n"));
         assert_eq!(b.len(), 20 + 24);
         assert_eq!(parse_edges(&b, Path::new("a.vpo")).unwrap(), e);
+    }
+
+    /// The writer refuses what the reader would (issue 34: edge files hold
+    /// at most MAX_POINTS points).
+    #[test]
+    fn more_points_than_a_file_holds_are_not_written() {
+        let p = EdgePoint {
+            x: 1.0,
+            y: 1.0,
+            response: 10.0,
+        };
+        let mut e = EdgePoints {
+            dir: Some(ScanDir::Horizontal),
+            width: 8192,
+            height: 8192,
+            points: vec![p; MAX_POINTS + 1],
+        };
+        let err = encode_checked(Path::new("x.hpo"), &e).unwrap_err();
+        assert_eq!(err.kind, K::Range);
+        assert!(err.to_string().contains("more than"), "{err}");
+        e.points.truncate(MAX_POINTS);
+        let b = encode_checked(Path::new("x.hpo"), &e).unwrap();
+        assert!(
+            b.len() as u64 <= max_file_len(),
+            "the reader would refuse it"
+        );
     }
 
     #[test]

@@ -22,11 +22,13 @@ use crate::llv::{Params, Segment};
 /// Version of the manifest schema this console writes.
 pub const FORMAT: u32 = 1;
 
-/// The largest manifest read: 16 MiB. TOML parsing costs 25–50 times the
-/// text in memory, so a 98 MB file once took 2.5 GB; a real manifest takes
-/// a few KiB an image (see docs/reliability.md), so this bound holds
-/// thousands of fully processed images. Larger files are refused unread.
-pub const MAX_LEN: usize = 16 << 20;
+/// The largest manifest read: 4 MiB. TOML parsing costs 21 to 76 times the
+/// text in memory (76 for a file of nothing but one-digit array values: a
+/// 16 MiB one took 1.27 GB), so this bound keeps any manifest under about
+/// 320 MB; a real manifest takes about 4 KiB a fully processed image (see
+/// docs/reliability.md), so it holds about a thousand. Larger files are
+/// refused unread.
+pub const MAX_LEN: usize = 4 << 20;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -52,11 +52,13 @@ impl Session {
         }
         if let Some(e) = set.edges_h {
             let file = self.file_name(k, None, "hpo");
-            written.push(self.put(file, &formats::edgefile::encode_edges(e))?);
+            let bytes = formats::edgefile::encode_checked(&self.path(&file), e)?;
+            written.push(self.put(file, &bytes)?);
         }
         if let Some(e) = set.edges_v {
             let file = self.file_name(k, None, "vpo");
-            written.push(self.put(file, &formats::edgefile::encode_edges(e))?);
+            let bytes = formats::edgefile::encode_checked(&self.path(&file), e)?;
+            written.push(self.put(file, &bytes)?);
         }
         if let Some(l) = set.lines_raw {
             let file = self.file_name(k, None, "lex");

@@ -58,10 +58,17 @@ fn cdf_param(name: String) -> BoxedStrategy<CdfParam> {
             any::<bool>(),
         )
             .prop_map(move |(status, mut rows, empty)| {
-                // Scale factors and focal length are positive unless marked N.
-                if status != Status::NotAvailable && (name == "S" || name == "f") {
+                // Scale factors, focal length and centre lie in the ranges
+                // the reader takes (issue 34) unless marked N.
+                let range = match name.as_str() {
+                    "S" => Some((1e-7, 1e3)),
+                    "f" => Some((1e-2, 1e5)),
+                    "C" => Some((-1e5, 1e5)),
+                    _ => None,
+                };
+                if let (true, Some((lo, hi))) = (status != Status::NotAvailable, range) {
                     for v in rows.iter_mut().flatten() {
-                        *v = v.abs().max(1e-6);
+                        *v = if name == "C" { *v } else { v.abs() }.clamp(lo, hi);
                     }
                 }
                 CdfParam {

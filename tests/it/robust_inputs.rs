@@ -189,7 +189,7 @@ fn oversized_profiles_and_manifests_are_refused_unread() {
     let (ok, out) = vss(root, &["session", "show", "s/cube"]);
     assert!(!ok, "a 17 MB manifest was read");
     assert!(
-        out.contains("cube.toml") && out.contains("16777216"),
+        out.contains("cube.toml") && out.contains(&vss::session::manifest::MAX_LEN.to_string()),
         "{out}"
     );
 }
@@ -396,4 +396,64 @@ fn a_closed_stderr_keeps_the_exit_status() {
             .expect("bash");
         assert_eq!(o.status.code(), Some(1), "{redirect}: {o:?}");
     }
+}
+
+/// A session folder `name` whose manifest is `len` bytes of the costliest
+/// TOML there is to parse: one-digit array values (76 bytes of memory per
+/// byte of text).
+fn costly_manifest(root: &Path, name: &str, len: usize) {
+    let dir = root.join(name);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let head = format!(
+        "format = 1\n[session]\nname = \"{name}\"\ncreated = \"x\"\nmodified = \"x\"\n\
+         version = \"0.1.0\"\nprofile = \"p\"\nplanned_images = 1\ncameras = 1\n\
+         [[lighting]]\nletter = \"a\"\nnote = \"x\"\non = ["
+    );
+    let n = (len - head.len() - 2) / 2;
+    let text = format!("{head}{}]\n", "1,".repeat(n));
+    std::fs::write(dir.join(format!("{name}.toml")), text).expect("manifest");
+}
+
+/// Issue 34, N5: a manifest within the bound costs at most 512 MiB to read,
+/// however it is written (a 16 MiB one of one-digit values took 1.27 GB);
+/// one over the bound is refused unread.
+#[test]
+fn any_manifest_within_the_bound_reads_within_512_mib() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let root = tmp.path();
+    let max = vss::session::manifest::MAX_LEN;
+    costly_manifest(root, "edge", max - 16);
+    let (ok, out) = vss_limited(root, 512, &["session", "show", "edge"]);
+    // The values are not light names: refused, but read and parsed.
+    assert!(!ok && out.contains("expected a string"), "{out}");
+    costly_manifest(root, "over", 16 << 20);
+    let (ok, out) = vss_limited(root, 512, &["session", "show", "over"]);
+    assert!(!ok && out.contains("more than"), "{out}");
+}
+
+/// Issue 34, N5: `llv --from-edges` of a 600 MB `.hpo` (it cost 2.4 GB) is
+/// refused unread; an edge file at the bound is read within 512 MiB.
+#[test]
+fn a_huge_edge_file_is_refused_unread() {
+    use vss::formats::edgefile::MAX_POINTS;
+    let tmp = tempfile::tempdir().expect("tmp");
+    let root = tmp.path();
+    // Sparse: the points are zeros (finite).
+    let sparse_edges = |name: &str, dir: char, count: usize| {
+        let head = format!("VSSEDGE 1 {dir} 4096 4096 {count}\n");
+        let f = std::fs::File::create(root.join(name)).expect("create");
+        use std::io::Write as _;
+        (&f).write_all(head.as_bytes()).expect("header");
+        f.set_len((head.len() + 12 * count) as u64).expect("sparse");
+    };
+    sparse_edges("big.hpo", 'H', 50_000_000);
+    sparse_edges("big.vpo", 'V', 1);
+    let (ok, out) = vss_limited(root, 512, &["llv", "--from-edges", "big.hpo", "big.vpo"]);
+    assert!(
+        !ok && out.contains("big.hpo") && out.contains("more than"),
+        "{out}"
+    );
+    sparse_edges("edge.hpo", 'H', MAX_POINTS);
+    let (ok, out) = vss_limited(root, 512, &["info", "edge.hpo"]);
+    assert!(ok && out.contains(&format!("{MAX_POINTS} points")), "{out}");
 }
