@@ -276,6 +276,32 @@ impl Store {
                 let img = load::image(s, k);
                 self.reply(StoreEvent::Loaded(Box::new(img)));
             }
+            StoreCmd::Remake(k) => {
+                let fallback = self.profile.llv.clone();
+                let s = self.session_mut()?;
+                let params = s
+                    .manifest()
+                    .image(k)
+                    .and_then(|r| r.outputs.as_ref())
+                    .map_or(fallback, |o| o.params.clone());
+                let what = format!("outputs of image {k} NOT made again");
+                let summary = s
+                    .redo(k, crate::llv::params::Stage::Lens, &params)
+                    .map_err(session_err(what))?;
+                let mut files: Vec<String> = ["hpo", "vpo", "lex", "ldr"]
+                    .iter()
+                    .map(|e| s.file_name(k, None, e))
+                    .collect();
+                files.extend(s.letters().iter().map(|l| s.file_name(k, Some(*l), "imc")));
+                self.forget_problems(&files);
+                self.reply(StoreEvent::Note(format!(
+                    "{summary}, from its saved frames with its recorded values"
+                )));
+                self.updated();
+                if let Some(s) = &self.session {
+                    self.reply(StoreEvent::Loaded(Box::new(load::image(s, k))));
+                }
+            }
             StoreCmd::Redo(k) => {
                 self.session_mut()?;
                 self.reply(StoreEvent::Note(format!(
