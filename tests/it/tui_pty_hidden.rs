@@ -171,3 +171,67 @@ fn damage_is_counted_listed_first_and_a_damaged_ldr_made_again() {
     c.send("q");
     c.wait_exit(15);
 }
+
+/// The session list puts the session worked on last first (alphabetical
+/// put `alpha` over the `zulu` just worked on), marks the one open in
+/// this console as such (not "in use by" its own user), and after a
+/// restart Enter opens the one just worked on.
+#[test]
+fn sessions_are_listed_most_recent_first_and_the_open_one_marked() {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("alpha");
+    c.press(SURVEY, Action::Survey(SurveyAction::NewSession));
+    c.wait_text("new session name", 5);
+    c.send("zulu\r");
+    c.wait_text("session zulu", 10);
+    c.capture_current(1);
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    c.wait_text("Image 2: camera", 20);
+    // Wait for the list the store made after the capture to be asked for.
+    c.press(SURVEY, Action::Survey(SurveyAction::OpenPicker));
+    let s = c.wait_text("open another session", 10);
+    let rows: Vec<&str> = s.lines().filter(|l| l.contains(" done")).collect();
+    assert!(
+        rows.first()
+            .is_some_and(|r| r.contains("zulu") && r.contains("(open here)")),
+        "{s}"
+    );
+    assert!(!s.contains("in use by"), "{s}");
+    c.send("\x1b");
+    let mut c = c.restart(80, 24, &[]);
+    c.wait_text("zulu", 10);
+    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    c.wait_text("session zulu", 10);
+    c.send("q");
+    c.wait_exit(15);
+}
+
+/// At 60 × 20 during a capture the screen still says what is captured and
+/// shows the question `q` asks, with its keys; when the capture ends the
+/// question no longer applies and closes itself, and the enlarged window
+/// shows no stale "Quit anyway?".
+#[test]
+fn too_small_keeps_the_capture_and_the_question_in_sight() {
+    let profile = super::tui_harness::PROFILE
+        .replace("settle_ms = 5", "settle_ms = 400")
+        .replace("width = 128\nheight = 128", "width = 256\nheight = 256");
+    let mut c = Console::start_with(&profile, 80, 24, &[], |_| {});
+    c.create_session("cube");
+    c.wait_text("Image 1: camera", 10);
+    c.resize(20, 60);
+    c.wait_text("terminal too small", 10);
+    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    c.wait_words("capturing image 1", 10);
+    c.send("q");
+    let s = wait_words(&c, "A capture is under way. Quit anyway?", 10);
+    assert!(s.contains("y yes"), "{s}");
+    let s = c.wait("the question closed after the capture", 60, |s| {
+        !s.contains("capturing") && s.contains("q quits")
+    });
+    assert!(!flat(&s).contains("Quit anyway"), "{s}");
+    c.resize(24, 80);
+    let s = c.wait_text("before CONNECT", 30);
+    assert!(!flat(&s).contains("Quit anyway"), "{s}");
+    c.send("q");
+    c.wait_exit(15);
+}

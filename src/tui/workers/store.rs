@@ -421,7 +421,8 @@ impl Store {
         let Ok(rd) = std::fs::read_dir(&self.profile.survey.dir) else {
             return Vec::new();
         };
-        let mut out: Vec<SessionEntry> = rd
+        let here = self.session.as_ref().map(|s| s.dir().to_path_buf());
+        let mut out: Vec<(std::time::SystemTime, SessionEntry)> = rd
             .flatten()
             .filter(|e| e.path().is_dir())
             .filter_map(|e| {
@@ -430,28 +431,50 @@ impl Store {
                 match Session::inspect(&dir) {
                     Ok(s) => {
                         let (done, all) = s.progress().done();
-                        let busy = s
-                            .lock_holder()
-                            .map_or(String::new(), |h| format!(" (in use by {})", h.user));
-                        Some(SessionEntry {
-                            name: s.name().as_str().to_string(),
-                            dir,
-                            summary: format!("{done}/{all} done{busy}"),
-                            damaged: None,
-                        })
+                        let name = s.name().as_str().to_string();
+                        // The session this console has open is ours, not
+                        // "in use by" someone.
+                        let busy = if here.as_deref() == Some(dir.as_path()) {
+                            " (open here)".to_string()
+                        } else {
+                            s.lock_holder()
+                                .map_or(String::new(), |h| format!(" (in use by {})", h.user))
+                        };
+                        let when = std::fs::metadata(dir.join(format!("{name}.toml")))
+                            .and_then(|m| m.modified())
+                            .unwrap_or(std::time::UNIX_EPOCH);
+                        Some((
+                            when,
+                            SessionEntry {
+                                name,
+                                dir,
+                                summary: format!("{done}/{all} done{busy}"),
+                                damaged: None,
+                            },
+                        ))
                     }
                     Err(SessionError::NotASession { .. }) => None,
-                    Err(e) => Some(SessionEntry {
-                        name: folder,
-                        dir,
-                        summary: "DAMAGED".into(),
-                        damaged: Some(e.to_string()),
-                    }),
+                    Err(e) => Some((
+                        std::time::UNIX_EPOCH,
+                        SessionEntry {
+                            name: folder,
+                            dir,
+                            summary: "DAMAGED".into(),
+                            damaged: Some(e.to_string()),
+                        },
+                    )),
                 }
             })
             .collect();
-        out.sort_by(|a, b| a.name.cmp(&b.name));
-        out
+        // Damaged sessions first (they need a look), then the most recently
+        // worked on: after a dropped connection the session just worked on
+        // is the one chosen.
+        out.sort_by(|a, b| {
+            (b.1.damaged.is_some(), b.0)
+                .cmp(&(a.1.damaged.is_some(), a.0))
+                .then_with(|| a.1.name.cmp(&b.1.name))
+        });
+        out.into_iter().map(|(_, e)| e).collect()
     }
 
     /// Opens a session held by a console that still runs on this host, by
