@@ -392,8 +392,10 @@ fn step_lines(app: &App) -> Vec<Line<'static>> {
         }
     };
     let mut text = text;
-    if matches!(w.phase, Phase::Setup | Phase::Processing | Phase::Review)
-        && let Some(l) = changed_line(app)
+    if matches!(
+        w.phase,
+        Phase::Setup | Phase::Processing | Phase::Review | Phase::Complete
+    ) && let Some(l) = changed_line(app)
     {
         text.push(l);
     }
