@@ -157,6 +157,37 @@ impl App {
 
     /// Applies one message; returns the work it asks of the workers.
     pub fn update(&mut self, msg: Msg) -> Vec<Cmd> {
+        let cmds = self.apply(msg);
+        self.close_stale_question();
+        cmds
+    }
+
+    /// Closes a question that no longer applies, saying so: "quit anyway?"
+    /// asked because a capture was under way or a lighting not saved, once
+    /// neither holds (quitting is then safe, and `q` quits at once).
+    fn close_stale_question(&mut self) {
+        let quit_asked = matches!(
+            &self.chrome.modal,
+            Some(Modal::Confirm {
+                on_yes: Pending::Quit,
+                ..
+            })
+        );
+        let still = self.session.work.phase == Phase::Capturing
+            || self.cell.device.transfer.is_some()
+            || self
+                .tracker
+                .current
+                .as_ref()
+                .is_some_and(|c| !c.unsaved.is_empty());
+        if quit_asked && !still {
+            self.chrome.modal = None;
+            self.ctx()
+                .info("the question to quit closed: nothing is under way now — q quits");
+        }
+    }
+
+    fn apply(&mut self, msg: Msg) -> Vec<Cmd> {
         match msg {
             Msg::Key(k) => self.on_key(k),
             Msg::Pointer(p) => self.on_pointer(p),

@@ -131,6 +131,39 @@ impl SessionView {
     pub fn problems(&self) -> usize {
         self.files.iter().filter(|f| !f.ok).count()
     }
+
+    /// What is damaged, in words an operator acts on, image by image:
+    /// `image 2 lighting b`, `image 4 lines`; then other files.
+    pub fn problem_list(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for i in &self.images {
+            if !i.damaged.is_empty() {
+                let letters: String = i.damaged.iter().map(|d| d.0).collect();
+                out.push(format!("image {} lighting {letters}", i.k));
+            }
+            if i.outputs_damaged.is_some() {
+                out.push(format!("image {} lines", i.k));
+            }
+        }
+        // Damage no image row accounts for (the manifest's own files).
+        if out.is_empty() && self.problems() > 0 {
+            out.push(format!("{} damaged file(s), listed on 5", self.problems()));
+        }
+        out
+    }
+
+    /// "survey complete" with what is damaged, for where the survey ends.
+    pub fn complete_text(&self) -> String {
+        let p = self.problem_list();
+        match p.len() {
+            0 => "Survey complete.".into(),
+            n => format!(
+                "survey complete, {n} problem{}: {}",
+                if n == 1 { "" } else { "s" },
+                p.join(", ")
+            ),
+        }
+    }
 }
 
 /// A session of the survey folder, as the picker lists it.
@@ -158,6 +191,8 @@ pub struct LoadedImage {
     pub lines: Option<Vec<Segment>>,
     /// The session holds accepted (current) outputs of the image.
     pub accepted: bool,
+    /// Why its recorded outputs did not load (a file damaged or missing).
+    pub outputs_damaged: Option<String>,
 }
 
 /// Outputs read from a session's files, with the values they were made with.
@@ -181,6 +216,8 @@ pub struct ImageState {
     pub damaged: Vec<(char, String)>,
     /// Why an output file (`.hpo .vpo .lex .ldr`) is missing or does not read.
     pub outputs_damaged: Option<String>,
+    /// The parameter values its outputs were made with, as recorded.
+    pub params: Option<Params>,
 }
 
 /// A file of the session and how it stands.
@@ -311,6 +348,10 @@ pub enum StoreCmd {
     Load(u32),
     /// Forget the captured data of an image number before it is redone.
     Redo(u32),
+    /// Make image `k`'s outputs again from its saved frames with the
+    /// values they were made with (what `vss session redo` does), then
+    /// read it back.
+    Remake(u32),
     Export,
     /// Re-read the session, checking every file.
     Refresh,

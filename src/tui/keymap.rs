@@ -131,6 +131,9 @@ pub enum SurveyAction {
     Camera,
     Location,
     CancelCapture,
+    /// Every parameter back to the profile's value (the next capture and
+    /// run use them).
+    ResetParams,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -162,6 +165,10 @@ pub enum PipelineAction {
     /// Which image the grey view shows: each lighting, the combined
     /// response, the ambient image.
     GreySource,
+    /// The chosen parameter back to the profile's value.
+    ResetParam,
+    /// Every parameter back to the profile's value.
+    ResetAll,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -240,9 +247,12 @@ impl Action {
         match self {
             Action::Survey(a) => matches!(
                 a,
-                SurveyAction::Accept | SurveyAction::Redo | SurveyAction::NewSession
+                SurveyAction::Accept
+                    | SurveyAction::Redo
+                    | SurveyAction::NewSession
+                    | SurveyAction::ResetParams
             ),
-            Action::Pipeline(a) => a == PipelineAction::Save,
+            Action::Pipeline(a) => matches!(a, PipelineAction::Save | PipelineAction::ResetAll),
             Action::Edit(a) => matches!(
                 a,
                 EditAction::Connect

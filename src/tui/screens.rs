@@ -244,12 +244,50 @@ impl Widget for &App {
     fn render(self, area: Rect, buf: &mut Buffer) {
         if area.width < MIN_SIZE.0 || area.height < MIN_SIZE.1 {
             let t = self.theme();
-            let text = vec![
+            let mut text = vec![
                 Line::styled("terminal too small", t.error()),
-                Line::raw(format!("now {} × {}", area.width, area.height)),
-                Line::raw(format!("vss needs {} × {}", MIN_SIZE.0, MIN_SIZE.1)),
-                Line::raw("enlarge the window; q quits"),
+                Line::raw(format!(
+                    "now {} × {}, vss needs {} × {}: enlarge the window",
+                    area.width, area.height, MIN_SIZE.0, MIN_SIZE.1
+                )),
             ];
+            // What goes on and what is asked stay in sight: a capture under
+            // way, and an open question with its keys.
+            if let Some((purpose, done, total)) = self.cell.device.transfer {
+                let what = match purpose {
+                    crate::tui::event::FramePurpose::Survey { letter, .. } => {
+                        format!("image {} lighting {letter}", self.session.work.k)
+                    }
+                    _ => "a frame".to_string(),
+                };
+                let pct = (done * 100).checked_div(total).unwrap_or(0);
+                text.push(Line::styled(
+                    format!("capturing {what}: {pct}% — Esc stops"),
+                    t.warn(),
+                ));
+            } else if self.session.work.phase == crate::tui::app::Phase::Capturing {
+                text.push(Line::styled(
+                    format!("capturing image {} — Esc stops", self.session.work.k),
+                    t.warn(),
+                ));
+            }
+            match &self.chrome.modal {
+                Some(crate::tui::app::Modal::Confirm {
+                    question, on_all, ..
+                }) => {
+                    text.push(Line::styled(question.clone(), t.title()));
+                    text.push(Line::raw(if on_all.is_some() {
+                        "y yes  a all  n no"
+                    } else {
+                        "y yes  n no"
+                    }));
+                }
+                Some(crate::tui::app::Modal::Prompt(p)) => {
+                    text.push(Line::styled(format!("{} {}", p.title, p.text), t.title()));
+                    text.push(Line::raw("Enter accept  Esc cancel"));
+                }
+                None => text.push(Line::raw("q quits")),
+            }
             Paragraph::new(text)
                 .wrap(Wrap { trim: true })
                 .render(area, buf);

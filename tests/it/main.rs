@@ -50,6 +50,7 @@ mod tui_harness;
 mod tui_pty;
 mod tui_pty_builtin;
 mod tui_pty_feedback;
+mod tui_pty_hidden;
 mod tui_pty_review;
 mod tui_pty_trouble;
 mod tui_pty_tuning;

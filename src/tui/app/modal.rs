@@ -19,6 +19,9 @@ pub enum Pending {
         k: u32,
         letters: Vec<char>,
     },
+    /// Make image `k`'s outputs again from its saved frames with its
+    /// recorded values.
+    Remake(u32),
     /// Accept the image under review (save its outputs, go on).
     Accept,
     /// Save the outputs on screen over an image's accepted ones.
@@ -283,6 +286,7 @@ impl App {
                 vec![Cmd::Device(crate::tui::event::DeviceCmd::Cancel)]
             }
             Pending::Retake { k, letters } => self.ctx().retake(k, letters),
+            Pending::Remake(k) => self.ctx().remake(k),
             Pending::Accept => self.ctx().accept(true),
             Pending::SaveOutputs => self.ctx().save_outputs(true).unwrap_or_default(),
             Pending::Switch(dir) => vec![Cmd::Store(StoreCmd::Open(dir))],

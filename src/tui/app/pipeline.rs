@@ -119,6 +119,8 @@ impl PipelineScreen {
                 );
             }
             PipelineAction::Save => return ctx.save_outputs(false).unwrap_or_default(),
+            PipelineAction::ResetParam => return ctx.reset_params(Some(self.param_spec().key)),
+            PipelineAction::ResetAll => return ctx.reset_params(None),
             PipelineAction::ViewNext => self.view = StageView::ALL[(self.view.index() + 1) % n],
             PipelineAction::ViewPrev => {
                 self.view = StageView::ALL[(self.view.index() + n - 1) % n];

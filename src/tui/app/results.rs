@@ -186,16 +186,25 @@ impl App {
                     .map(|m| m.map_err(|e| clean(&e)))
                     .collect();
                 let enabled = self.tracker.params.lens.enabled;
-                let problems: Vec<String> = models
-                    .iter()
-                    .enumerate()
-                    .filter_map(|(i, m)| m.as_ref().err().map(|e| (i + 1, e)))
-                    .map(|(cam, e)| format!("camera {cam}: {e}"))
-                    .collect();
+                // One line per reason, naming its cameras: a profile that
+                // names no .cdf at all gets one line, not one a camera.
+                let mut problems: Vec<(Vec<String>, String)> = Vec::new();
+                for (i, m) in models.iter().enumerate() {
+                    if let Err(e) = m {
+                        match problems.iter_mut().find(|p| p.1 == *e) {
+                            Some(p) => p.0.push((i + 1).to_string()),
+                            None => problems.push((vec![(i + 1).to_string()], e.clone())),
+                        }
+                    }
+                }
                 self.cell.camera_models = models;
                 if enabled {
-                    for p in problems {
-                        self.ctx().warn(format!("lens correction OFF for {p}"));
+                    for (cams, why) in problems {
+                        let s = if cams.len() == 1 { "" } else { "s" };
+                        self.ctx().warn(format!(
+                            "lens correction OFF for camera{s} {}: {why}",
+                            cams.join(", ")
+                        ));
                     }
                 }
                 Vec::new()
@@ -209,9 +218,34 @@ impl App {
                 Vec::new()
             }
             StoreEvent::Reports(paths) => {
-                for p in paths {
-                    let p = clean(&p.display().to_string());
-                    self.ctx().info(format!("report written: {p}"));
+                // One message: the survey's page and how many image pages,
+                // and the problems the report shows (said here, not only
+                // inside the pages).
+                let ps = paths
+                    .iter()
+                    .find(|p| p.extension().is_some_and(|e| e == "ps"))
+                    .or(paths.first())
+                    .map(|p| clean(&p.display().to_string()))
+                    .unwrap_or_default();
+                let svg = paths
+                    .iter()
+                    .filter(|p| p.extension().is_some_and(|e| e == "svg"))
+                    .count();
+                let problems = self
+                    .session
+                    .view
+                    .as_ref()
+                    .map(|v| v.problem_list())
+                    .unwrap_or_default();
+                let text = format!("report written: {ps} and {svg} SVG page(s)");
+                if problems.is_empty() {
+                    self.ctx().info(text);
+                } else {
+                    self.ctx().warn(format!(
+                        "{text} — {} problem(s) marked in it: {}",
+                        problems.len(),
+                        problems.join(", ")
+                    ));
                 }
                 Vec::new()
             }

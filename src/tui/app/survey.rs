@@ -145,6 +145,7 @@ impl SurveyScreen {
                 }
             }
             SurveyAction::Accept => ctx.accept(false),
+            SurveyAction::ResetParams => ctx.reset_params(None),
             SurveyAction::Redo => {
                 let k = self.row(&ctx.session.work);
                 self.row = None;
@@ -442,8 +443,13 @@ impl Ctx<'_> {
             phase,
         };
         if phase == Phase::Complete {
+            let text = v.complete_text();
+            let text = match text.strip_prefix("Survey complete") {
+                Some(_) => "survey complete".to_string(),
+                None => text,
+            };
             self.info(format!(
-                "survey complete: 5 writes the report; ↑↓ Enter goes back to an image, \
+                "{text}: 5 writes the report; ↑↓ Enter goes back to an image, \
                  Enter on no image starts image {k} beyond the plan"
             ));
         }
@@ -474,6 +480,19 @@ impl Ctx<'_> {
         }
         if img.images.is_empty() && img.damaged.is_empty() {
             return Vec::new();
+        }
+        if img.damaged.is_empty()
+            && let Some(why) = &img.outputs_damaged
+        {
+            self.error(format!(
+                "image {k}: its saved outputs do not read ({why}) — R makes them again from \
+                 its saved frames with its recorded values"
+            ));
+        }
+        // Run again (or captured again in part) with what the image was
+        // made with, never with values tuned on another image.
+        if img.saved.is_none() {
+            self.use_recorded_params(k);
         }
         let version = self.tracker.next_version();
         let camera = if k == work_k {
@@ -585,6 +604,26 @@ impl Ctx<'_> {
             k,
             letters: Vec::new(),
         };
+        let outputs_damaged = self
+            .session
+            .image(k)
+            .and_then(|i| i.outputs_damaged.clone());
+        if damaged.is_empty()
+            && let Some(why) = outputs_damaged
+        {
+            // The frames are good: making the outputs again from them is
+            // the remedy; a new capture is the second choice.
+            self.chrome.modal = Some(Modal::Confirm {
+                question: format!(
+                    "Image {k}: its outputs are damaged ({why}). y makes them again from its \
+                     saved frames with its recorded values (its hand edits are lost), a \
+                     captures every lighting again, n nothing."
+                ),
+                on_yes: Pending::Remake(k),
+                on_all: Some(all),
+            });
+            return;
+        }
         if damaged.is_empty() {
             self.ask(
                 format!(
@@ -615,6 +654,7 @@ impl Ctx<'_> {
         self.session.work.k = k;
         self.session.work.phase = Phase::Setup;
         self.follow_plan();
+        self.use_recorded_params(k);
         if letters.is_empty() {
             let mut l = Loaded::new(k, self.session.work.camera);
             l.accepted = self.session.accepted(k);
@@ -635,6 +675,28 @@ impl Ctx<'_> {
             }
             _ => vec![Cmd::Store(StoreCmd::Load(k))],
         }
+    }
+
+    /// Makes image `k`'s outputs again from its saved frames with its
+    /// recorded values (the session's redo, as `vss session redo`); the
+    /// store reads the image back when done.
+    pub fn remake(&mut self, k: u32) -> Vec<Cmd> {
+        if matches!(
+            self.session.work.phase,
+            Phase::Capturing | Phase::Processing
+        ) {
+            self.warn("busy with the image under work: wait for it, or Esc stops the capture");
+            return Vec::new();
+        }
+        self.session.work.k = k;
+        self.session.work.phase = Phase::Setup;
+        self.follow_plan();
+        self.use_recorded_params(k);
+        self.tracker.current = None;
+        self.info(format!(
+            "image {k}: making its outputs again from its saved frames…"
+        ));
+        vec![Cmd::Store(StoreCmd::Remake(k))]
     }
 
     /// Accepts the image under review: saves its outputs when they differ
@@ -706,9 +768,24 @@ impl Ctx<'_> {
                 let max = self.session.numbers().into_iter().max().unwrap_or(done);
                 self.session.work.k = max.max(done) + 1;
                 self.session.work.phase = Phase::Complete;
-                self.warn(format!(
-                    "survey complete: all {planned} planned images done — 5 writes the report"
-                ));
+                let problems = self
+                    .session
+                    .view
+                    .as_ref()
+                    .map(|v| v.problem_list())
+                    .unwrap_or_default();
+                if problems.is_empty() {
+                    self.warn(format!(
+                        "survey complete: all {planned} planned images done — 5 writes the report"
+                    ));
+                } else {
+                    self.error(format!(
+                        "survey complete, {} problem(s): {} — all {planned} planned images \
+                         done; R on one puts it right, 5 writes the report",
+                        problems.len(),
+                        problems.join(", ")
+                    ));
+                }
             }
             None => {
                 self.session.work.k = done + 1;

@@ -115,6 +115,20 @@ impl Tracker {
         }
     }
 
+    /// The panel's values that differ from the profile's, as
+    /// `key value` in panel order: what the next capture or run will use
+    /// that the profile does not say.
+    pub fn changed(&self) -> Vec<String> {
+        crate::llv::params::PARAMS
+            .iter()
+            .filter_map(|sp| {
+                let v = self.params.get(sp.key)?;
+                (Some(v) != self.profile_params.get(sp.key))
+                    .then(|| format!("{} {}", sp.key, crate::llv::params::fmt_value(v)))
+            })
+            .collect()
+    }
+
     pub fn next_version(&mut self) -> u64 {
         self.version_counter += 1;
         self.version_counter
@@ -179,6 +193,67 @@ impl Ctx<'_> {
     pub fn set_params(&mut self, p: Params) -> Vec<Cmd> {
         self.tracker.params = p;
         self.tracker.request(self.cell).into_iter().collect()
+    }
+
+    /// Puts parameter `key` (every one with `None`) back to the profile's
+    /// value, says what changed, and re-runs the current image.
+    pub fn reset_params(&mut self, key: Option<&'static str>) -> Vec<Cmd> {
+        let mut p = self.tracker.params.clone();
+        match key {
+            Some(k) => {
+                if let Some(v) = self.tracker.profile_params.get(k)
+                    && p.set(k, v).is_err()
+                {
+                    return Vec::new();
+                }
+            }
+            None => p = self.tracker.profile_params.clone(),
+        }
+        if p == self.tracker.params {
+            match key {
+                Some(k) => self.info(format!("{k} is at the profile's value already")),
+                None => self.info("every parameter is at the profile's value already"),
+            }
+            return Vec::new();
+        }
+        let fmt = crate::llv::params::fmt_value;
+        let moved: Vec<String> = crate::llv::params::PARAMS
+            .iter()
+            .filter_map(|sp| {
+                let (old, new) = (self.tracker.params.get(sp.key)?, p.get(sp.key)?);
+                (old != new).then(|| format!("{} {} → {}", sp.key, fmt(old), fmt(new)))
+            })
+            .collect();
+        self.info(format!(
+            "back to the profile's values: {}",
+            moved.join(", ")
+        ));
+        self.set_params(p)
+    }
+
+    /// Makes the panel show the values image `k` was made with (recorded
+    /// in the session), saying so, before it is run again or captured
+    /// again: what an image was made with is never decided by values
+    /// tuned on another. Returns whether the panel changed.
+    pub fn use_recorded_params(&mut self, k: u32) -> bool {
+        let Some(p) = self.session.image(k).and_then(|i| i.params.clone()) else {
+            return false;
+        };
+        if p == self.tracker.params {
+            return false;
+        }
+        self.tracker.params = p;
+        let changed = self.tracker.changed();
+        self.info(format!(
+            "image {k}: the panel now shows the values image {k} was made with{} — D (Survey) \
+             or d/D (Pipeline) go back to the profile's",
+            if changed.is_empty() {
+                " (the profile's)".to_string()
+            } else {
+                format!(": {}", changed.join(", "))
+            }
+        ));
+        true
     }
 
     /// The commands that save the outputs on screen, or `None` (said in the

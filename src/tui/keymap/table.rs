@@ -120,6 +120,7 @@ pub const KEYMAP: &[Binding] = rows! {
     SU, ch('c'), Survey(Camera), "next camera for the image to capture", "camera";
     SU, ch('p'), Survey(Location), "next camera location for the image to capture", "place";
     SU, k(K::Esc), Survey(CancelCapture), "stop the capture under way", "";
+    SU, ch('D'), Survey(ResetParams), "every parameter back to the profile's value (the next capture uses them)", "";
     // Calibrate.
     CB, ch('p'), Calibrate(Plate), "simulated cell: the calibration plate in view / away", "plate";
     CB, ch('v'), Calibrate(ToggleLive), "live view on/off", "live";
@@ -163,6 +164,8 @@ pub const KEYMAP: &[Binding] = rows! {
     PI, ch('b'), Pipeline(SideBySide), "all views side by side / one view", "both";
     PI, ch('i'), Pipeline(GreySource), "grey view: next lighting, combined response, ambient", "image";
     PI, ctrl('s'), Pipeline(Save), "save these outputs to the session (asks if accepted)", "save";
+    PI, ch('d'), Pipeline(ResetParam), "the chosen parameter back to the profile's value", "profile";
+    PI, ch('D'), Pipeline(ResetAll), "every parameter back to the profile's value", "";
     // Edit.
     ED, ch('n'), Edit(LineNext), "highlight the next line", "next";
     ED, k(K::Tab), Edit(LineNext), "highlight the next line", "";

@@ -46,7 +46,8 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     if !reports.is_empty() {
         info.push(Line::styled("reports written", t.title()));
         for e in reports.iter().rev().take(4) {
-            let name = e.text.rsplit('/').next().unwrap_or(&e.text);
+            let what = e.text.split(" — ").next().unwrap_or(&e.text);
+            let name = what.rsplit('/').next().unwrap_or(what);
             info.push(Line::raw(format!(" {} {name}", e.time)));
         }
     }
@@ -55,35 +56,52 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         .block(block(app, "session"))
         .render(panel, buf);
     let problems = s.problems();
-    let mut lines = vec![if problems > 0 {
-        Line::styled(
-            format!("{problems} problem(s): the files in red do not read or are missing"),
+    let inner_w = right.width.saturating_sub(2) as usize;
+    let wrapped = |text: &str, st| -> Vec<Line<'static>> {
+        super::chrome::wrap(text, inner_w)
+            .into_iter()
+            .map(|l| Line::styled(l, st))
+            .collect()
+    };
+    let mut lines: Vec<Line> = if problems > 0 {
+        wrapped(
+            &format!(
+                "{problems} problem(s), listed first: {} — R on the Survey screen (1) puts an \
+                 image right",
+                s.problem_list().join(", ")
+            ),
             t.error(),
         )
     } else if s.checked {
-        Line::styled("every file reads", t.ok())
+        vec![Line::styled("every file reads", t.ok())]
     } else {
-        Line::styled("no problems known (c checks every file)", t.ok())
-    }];
-    let inner_w = right.width.saturating_sub(2) as usize;
-    let rows: Vec<Line> = s
-        .files
-        .iter()
-        .map(|f| {
-            let st = if f.ok { t.ok() } else { t.error() };
-            let text = format!("{:<16} {}", f.name, f.state);
-            let text: String = if text.chars().count() > inner_w {
-                text.chars()
-                    .take(inner_w.saturating_sub(1))
-                    .collect::<String>()
-                    + "…"
-            } else {
-                text
-            };
-            Line::styled(text, st)
-        })
-        .collect();
-    let room = right.height.saturating_sub(3) as usize;
+        vec![Line::styled(
+            "no problems known (c checks every file)",
+            t.ok(),
+        )]
+    };
+    // Problems first, each wrapped whole (why a file is damaged is what
+    // the operator came for); the files that read one row each.
+    let mut files: Vec<&crate::tui::event::FileState> = s.files.iter().collect();
+    files.sort_by_key(|f| f.ok);
+    let mut rows: Vec<Line> = Vec::new();
+    for f in files {
+        let text = format!("{:<16} {}", f.name, f.state);
+        if !f.ok {
+            rows.extend(wrapped(&text, t.error()));
+            continue;
+        }
+        let text: String = if text.chars().count() > inner_w {
+            text.chars()
+                .take(inner_w.saturating_sub(1))
+                .collect::<String>()
+                + "…"
+        } else {
+            text
+        };
+        rows.push(Line::styled(text, t.ok()));
+    }
+    let room = (right.height.saturating_sub(2) as usize).saturating_sub(lines.len());
     lines.extend(window(rows, app.screens.files.scroll, room, t));
     Paragraph::new(lines)
         .block(block(app, &format!("files ({})", s.files.len())))

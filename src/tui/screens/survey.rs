@@ -23,8 +23,20 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     } else {
         checklist(app, panel, buf);
     }
-    let [step, prev] = Layout::vertical([Constraint::Length(5), Constraint::Min(1)]).areas(right);
-    step_box(app, step, buf);
+    let lines = step_lines(app);
+    // The box grows by the rows its text wraps to (the values the next
+    // capture uses that are not the profile's), up to half the column.
+    let inner_w = right.width.saturating_sub(2) as usize;
+    let rows: usize = lines
+        .iter()
+        .map(|l| super::chrome::wrap(&l.to_string(), inner_w).len().max(1))
+        .sum();
+    let h = (rows as u16 + 2).max(5).min((right.height / 2).max(5));
+    let [step, prev] = Layout::vertical([Constraint::Length(h), Constraint::Min(1)]).areas(right);
+    Paragraph::new(lines)
+        .wrap(Wrap { trim: true })
+        .block(block(app, "next step"))
+        .render(step, buf);
     preview(app, prev, buf);
 }
 
@@ -229,7 +241,26 @@ fn checklist(app: &App, area: Rect, buf: &mut Buffer) {
         .render(area, buf);
 }
 
-fn step_box(app: &App, area: Rect, buf: &mut Buffer) {
+/// The values the panel holds that are not the profile's, which the next
+/// capture or run uses, and the key that puts them back.
+fn changed_line(app: &App) -> Option<Line<'static>> {
+    let t = app.theme();
+    let changed = app.tracker.changed();
+    if changed.is_empty() {
+        return None;
+    }
+    Some(Line::from(vec![
+        Span::styled(
+            format!("not the profile's: {}", changed.join(", ")),
+            t.warn(),
+        ),
+        Span::raw(" · "),
+        Span::styled("D", t.key()),
+        Span::raw(" profile's"),
+    ]))
+}
+
+fn step_lines(app: &App) -> Vec<Line<'static>> {
     let t = app.theme();
     let w = &app.session.work;
     let key = |k: &'static str| Span::styled(k, t.key());
@@ -343,7 +374,12 @@ fn step_box(app: &App, area: Rect, buf: &mut Buffer) {
                 }
             }
             Phase::Complete => vec![
-                Line::styled("Survey complete.", t.ok()),
+                match app.session.view.as_ref().map(|v| (v.complete_text(), v)) {
+                    Some((text, v)) if !v.problem_list().is_empty() => {
+                        Line::styled(format!("{text} — R on one puts it right"), t.error())
+                    }
+                    _ => Line::styled("Survey complete.", t.ok()),
+                },
                 Line::from(vec![key("5"), Span::raw(" writes the report (e)")]),
                 // One line of at most 44 columns: the box's width at 80.
                 Line::from(vec![
@@ -355,8 +391,13 @@ fn step_box(app: &App, area: Rect, buf: &mut Buffer) {
             ],
         }
     };
-    Paragraph::new(text)
-        .wrap(Wrap { trim: true })
-        .block(block(app, "next step"))
-        .render(area, buf);
+    let mut text = text;
+    if matches!(
+        w.phase,
+        Phase::Setup | Phase::Processing | Phase::Review | Phase::Complete
+    ) && let Some(l) = changed_line(app)
+    {
+        text.push(l);
+    }
+    text
 }

@@ -282,6 +282,32 @@ impl Store {
                 let img = load::image(s, k);
                 self.reply(StoreEvent::Loaded(Box::new(img)));
             }
+            StoreCmd::Remake(k) => {
+                let fallback = self.profile.llv.clone();
+                let s = self.session_mut()?;
+                let params = s
+                    .manifest()
+                    .image(k)
+                    .and_then(|r| r.outputs.as_ref())
+                    .map_or(fallback, |o| o.params.clone());
+                let what = format!("outputs of image {k} NOT made again");
+                let summary = s
+                    .redo(k, crate::llv::params::Stage::Lens, &params)
+                    .map_err(session_err(what))?;
+                let mut files: Vec<String> = ["hpo", "vpo", "lex", "ldr"]
+                    .iter()
+                    .map(|e| s.file_name(k, None, e))
+                    .collect();
+                files.extend(s.letters().iter().map(|l| s.file_name(k, Some(*l), "imc")));
+                self.forget_problems(&files);
+                self.reply(StoreEvent::Note(format!(
+                    "{summary}, from its saved frames with its recorded values"
+                )));
+                self.updated();
+                if let Some(s) = &self.session {
+                    self.reply(StoreEvent::Loaded(Box::new(load::image(s, k))));
+                }
+            }
             StoreCmd::Redo(k) => {
                 self.session_mut()?;
                 self.reply(StoreEvent::Note(format!(
@@ -401,7 +427,8 @@ impl Store {
         let Ok(rd) = std::fs::read_dir(&self.profile.survey.dir) else {
             return Vec::new();
         };
-        let mut out: Vec<SessionEntry> = rd
+        let here = self.session.as_ref().map(|s| s.dir().to_path_buf());
+        let mut out: Vec<(std::time::SystemTime, SessionEntry)> = rd
             .flatten()
             .filter(|e| e.path().is_dir())
             .filter_map(|e| {
@@ -410,28 +437,50 @@ impl Store {
                 match Session::inspect(&dir) {
                     Ok(s) => {
                         let (done, all) = s.progress().done();
-                        let busy = s
-                            .lock_holder()
-                            .map_or(String::new(), |h| format!(" (in use by {})", h.user));
-                        Some(SessionEntry {
-                            name: s.name().as_str().to_string(),
-                            dir,
-                            summary: format!("{done}/{all} done{busy}"),
-                            damaged: None,
-                        })
+                        let name = s.name().as_str().to_string();
+                        // The session this console has open is ours, not
+                        // "in use by" someone.
+                        let busy = if here.as_deref() == Some(dir.as_path()) {
+                            " (open here)".to_string()
+                        } else {
+                            s.lock_holder()
+                                .map_or(String::new(), |h| format!(" (in use by {})", h.user))
+                        };
+                        let when = std::fs::metadata(dir.join(format!("{name}.toml")))
+                            .and_then(|m| m.modified())
+                            .unwrap_or(std::time::UNIX_EPOCH);
+                        Some((
+                            when,
+                            SessionEntry {
+                                name,
+                                dir,
+                                summary: format!("{done}/{all} done{busy}"),
+                                damaged: None,
+                            },
+                        ))
                     }
                     Err(SessionError::NotASession { .. }) => None,
-                    Err(e) => Some(SessionEntry {
-                        name: folder,
-                        dir,
-                        summary: "DAMAGED".into(),
-                        damaged: Some(e.to_string()),
-                    }),
+                    Err(e) => Some((
+                        std::time::UNIX_EPOCH,
+                        SessionEntry {
+                            name: folder,
+                            dir,
+                            summary: "DAMAGED".into(),
+                            damaged: Some(e.to_string()),
+                        },
+                    )),
                 }
             })
             .collect();
-        out.sort_by(|a, b| a.name.cmp(&b.name));
-        out
+        // Damaged sessions first (they need a look), then the most recently
+        // worked on: after a dropped connection the session just worked on
+        // is the one chosen.
+        out.sort_by(|a, b| {
+            (b.1.damaged.is_some(), b.0)
+                .cmp(&(a.1.damaged.is_some(), a.0))
+                .then_with(|| a.1.name.cmp(&b.1.name))
+        });
+        out.into_iter().map(|(_, e)| e).collect()
     }
 
     /// Opens a session held by a console that still runs on this host, by

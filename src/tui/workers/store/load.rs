@@ -24,10 +24,13 @@ pub fn image(s: &Session, k: u32) -> LoadedImage {
     let state = crate::session::progress::output_state(rec);
     out.accepted = state == OutputState::Done && out.damaged.is_empty();
     out.lines = s.load_lines(k).ok();
+    let read = rec.outputs.as_ref().map(|o| (o, saved(s, k, o)));
+    if let Some((_, Err(why))) = &read {
+        out.outputs_damaged = Some(why.clone());
+    }
     if state == OutputState::Done
         && out.damaged.is_empty()
-        && let Some(o) = rec.outputs.as_ref()
-        && let Some(outputs) = saved(s, k, o)
+        && let Some((o, Ok(outputs))) = read
     {
         out.saved = Some(SavedOutputs {
             outputs,
@@ -39,16 +42,21 @@ pub fn image(s: &Session, k: u32) -> LoadedImage {
     out
 }
 
-/// The outputs of image `k` from its files (`None` if one does not read).
-fn saved(s: &Session, k: u32, o: &crate::session::manifest::OutputRecord) -> Option<StageOutputs> {
+/// The outputs of image `k` from its files, or why one does not read.
+fn saved(
+    s: &Session,
+    k: u32,
+    o: &crate::session::manifest::OutputRecord,
+) -> Result<StageOutputs, String> {
     let path = |ext: &str| s.path(&s.file_name(k, None, ext));
-    let edges_h = formats::edgefile::read_edges(&path("hpo")).ok()?;
-    let edges_v = formats::edgefile::read_edges(&path("vpo")).ok()?;
-    let mut lines_raw = formats::lines::read_lines(&path("lex")).ok()?;
+    let text = |e: &dyn std::fmt::Display| e.to_string();
+    let edges_h = formats::edgefile::read_edges(&path("hpo")).map_err(|e| text(&e))?;
+    let edges_v = formats::edgefile::read_edges(&path("vpo")).map_err(|e| text(&e))?;
+    let mut lines_raw = formats::lines::read_lines(&path("lex")).map_err(|e| text(&e))?;
     if let Some(a) = &o.lex_attributes {
         a.apply(&mut lines_raw);
     }
-    let lines = s.load_lines(k).ok()?;
+    let lines = s.load_lines(k).map_err(|e| text(&e))?;
     let mut corrected = Vec::new();
     let mut imc: Vec<&str> = o
         .files
@@ -58,9 +66,13 @@ fn saved(s: &Session, k: u32, o: &crate::session::manifest::OutputRecord) -> Opt
         .collect();
     imc.sort_unstable();
     for f in imc {
-        corrected.push(formats::img::read_img(&s.path(f)).ok()?.image);
+        corrected.push(
+            formats::img::read_img(&s.path(f))
+                .map_err(|e| text(&e))?
+                .image,
+        );
     }
-    Some(StageOutputs {
+    Ok(StageOutputs {
         corrected,
         edges_h,
         edges_v,

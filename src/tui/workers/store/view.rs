@@ -50,6 +50,9 @@ pub fn view(s: &Session, check: Option<&CheckReport>, checked: bool) -> SessionV
                 edits: i.edits,
                 damaged,
                 outputs_damaged,
+                params: rec
+                    .and_then(|r| r.outputs.as_ref())
+                    .map(|o| o.params.clone()),
             }
         })
         .collect();
