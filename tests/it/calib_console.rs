@@ -75,7 +75,7 @@ fn a_camera_calibrated_on_the_calibrate_screen() {
     let s = c.wait("the calibration", 30, |s| {
         s.contains("RMS 0.") && s.contains("worst views")
     });
-    assert!(s.contains("residuals ×"), "{s}");
+    assert!(s.contains("mean residual ×"), "{s}");
     c.press(cb, Action::Calibrate(CA::Accept));
     c.wait_text("write S, C, f, D", 10);
     c.yes();
@@ -211,7 +211,7 @@ fn a_camera_calibrated_from_a_folder_of_photographs_at_80_by_24() {
     c.press(cb, Action::Calibrate(CA::PlateFile));
     c.wait_text("plate:", 10);
     c.send("board.toml\r");
-    c.wait_text("plate board.toml (f)", 10);
+    c.wait_text("plate board.toml", 10);
     c.press(cb, Action::Calibrate(CA::Open));
     c.wait_text("photographs to load:", 10);
     c.send("photos\r");
@@ -257,8 +257,11 @@ fn a_camera_calibrated_from_a_folder_of_photographs_at_80_by_24() {
     let got = read_cdf(&dir.join("cam1.cdf")).unwrap();
     assert_eq!(got.get("C").unwrap().status, Status::Calibrated);
     let m = got.camera_model().unwrap();
-    // About OpenCV's centre (334.4, 303.9) on these photographs.
-    assert!((m.cx - 334.4).hypot(m.cy - 303.9) < 5.0, "{m:?}");
+    // OpenCV on the same twelve views with one radial term (k2, k3 fixed):
+    // fx 706.2, C 331.6 294.5 ± 2.0 2.3 px; vss's C is about ± 2.2 px
+    // here, so within three standard errors.
+    assert!((m.f / m.sx - 706.2).abs() / 706.2 < 0.005, "{m:?}");
+    assert!((m.cx - 331.6).hypot(m.cy - 294.5) < 7.0, "{m:?}");
     c.send("q");
     c.wait_exit(10);
 }

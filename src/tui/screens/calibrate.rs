@@ -148,7 +148,7 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     );
     let mut lines = vec![
         Line::styled(
-            format!("camera {cam} (c)  plate {} (f)", short_name(&s.plate_name)),
+            format!("camera {cam} (c) plate {} (f)", short_name(&s.plate_name)),
             t.title(),
         ),
         Line::raw(format!(
@@ -165,7 +165,7 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     }
     let views = s.views_of(cam);
     lines.push(Line::raw(format!(
-        "views kept: {} (Space/Bksp, o files)",
+        "views kept: {} (Space/Bksp)",
         views.len()
     )));
     if solved.is_none() {
