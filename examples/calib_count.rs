@@ -50,6 +50,7 @@ fn main() {
         sy: m.sy,
         estimate_scale: false,
         centre: None,
+        full_model: false,
     };
     let mut total = 0usize;
     for i in 0..n {

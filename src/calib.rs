@@ -6,15 +6,20 @@
 //! The method, step by step:
 //! - [`plate`]: the plate file — squares or checkerboard, sizes, the origin
 //!   corner and the plate's place in the cell;
-//! - [`detect`]: the grid found with the LLV engine — corners are where the
-//!   fitted lines of two squares' sides cross, never fitted from corner
-//!   pixels alone;
+//! - [`detect`]: the grid found — on a squares plate with the LLV engine,
+//!   corners where the fitted lines of two squares' sides cross; on a
+//!   checkerboard by its inner corners (`saddle`: saddle points grown into
+//!   a lattice of alternating squares, refined as `cornerSubPix`), so that
+//!   frames, margins, cut-off outer squares and text round a real board do
+//!   not matter;
 //! - `zhang`: starting values in closed form — a homography per view,
 //!   Zhang's method for the pinhole, each view's pose;
 //! - `solve`: Levenberg–Marquardt on the reprojection error of every
 //!   corner through the forward model (`model`: the pinhole, then the
 //!   distortion of [`CameraModel`](crate::llv::lens::CameraModel), the same
 //!   function lens correction inverts), standard errors from the Jacobian,
+//!   distortion terms the views cannot tell from zero fixed at zero, the
+//!   projection's uncertainty, a cross-validation from halves of the views,
 //!   and the checks on the set of views (few, alike, the plate always in
 //!   the middle);
 //! - [`extrinsic`]: one view at the plate's place gives `T`, world → camera.
@@ -29,6 +34,7 @@ mod lm;
 pub mod model;
 pub mod plate;
 mod quads;
+mod saddle;
 mod solve;
 mod zhang;
 
@@ -37,8 +43,8 @@ use std::path::Path;
 pub use detect::{Corner, DetectError, Detection, Detector};
 pub use plate::{Plate, PlateError, PlateKind};
 pub use solve::{
-    CENTRE_SE, COVERAGE, Calibration, Estimate, FEW_VIEWS, Options, PARALLEL_DEPTH, View, ViewFit,
-    calibrate, coverage, solve_pose,
+    CENTRE_SE, COVERAGE, Calibration, CrossCheck, Estimate, FEW_VIEWS, Options, PARALLEL_DEPTH,
+    View, ViewFit, calibrate, coverage, cross_validate, solve_pose, uncertainty_points,
 };
 
 use crate::formats::cdf::{Cdf, CdfParam, Status};
@@ -62,11 +68,11 @@ pub enum CalibError {
     )]
     NoConvergence { why: String },
     #[error(
-        "{name} = {value:.6e} has a standard error of {se:.3e}, larger than itself: the views do not determine it; {}",
-        if matches!(*name, "Cx" | "Cy" | "g3" | "g4") {
-            "the centre C and the decentering terms g3, g4 trade off in Weng's model, and more views hardly help: state the centre (--centre X,Y from the lens's data sheet, or --centre image)"
+        "{name} = {value:.6e} has a standard error of {se:.3e}, larger than itself: the views do not determine it ({}); take more views, tilted more (20–45° in different directions), with the plate near the image's edges and corners",
+        if matches!(*name, "Cx" | "Cy") {
+            "the centre can also be stated: vss calibrate --centre X,Y or --centre image, on the Calibrate screen S or s"
         } else {
-            "take more views, tilted more, with the plate near the image's edges and corners"
+            "it cannot be left out"
         }
     )]
     WeakParameter {
@@ -138,40 +144,69 @@ pub fn cdf_with_extrinsic(old: &Cdf, t: &[[f64; 4]; 3]) -> Cdf {
     cdf
 }
 
-/// Writes `cdf` to `path` atomically; an existing file is kept first as
-/// `path.bak` (itself written atomically).
-pub fn write_cdf_keeping(path: &Path, cdf: &Cdf) -> Result<(), crate::formats::FormatError> {
+/// Where the file at `path` is kept before it is replaced: `path.bak`,
+/// or when that exists (an earlier backup, never overwritten)
+/// `path.bak.1`, `path.bak.2`, … the first that does not.
+pub fn backup_name(path: &Path) -> std::path::PathBuf {
+    let mut base = path.as_os_str().to_owned();
+    base.push(".bak");
+    let first = std::path::PathBuf::from(&base);
+    if std::fs::symlink_metadata(&first).is_err() {
+        return first;
+    }
+    (1u32..)
+        .map(|k| {
+            let mut n = base.clone();
+            n.push(format!(".{k}"));
+            std::path::PathBuf::from(n)
+        })
+        .find(|p| std::fs::symlink_metadata(p).is_err())
+        .unwrap_or(first)
+}
+
+/// Writes `cdf` to `path` atomically; an existing file is kept first under
+/// [`backup_name`] (itself written atomically), which is returned.
+pub fn write_cdf_keeping(
+    path: &Path,
+    cdf: &Cdf,
+) -> Result<Option<std::path::PathBuf>, crate::formats::FormatError> {
+    let mut kept = None;
     if path.is_file() {
         let old = crate::formats::cdf::read_cdf(path)?;
-        let mut bak = path.as_os_str().to_owned();
-        bak.push(".bak");
-        crate::formats::cdf::write_cdf(Path::new(&bak), &old)?;
+        let bak = backup_name(path);
+        crate::formats::cdf::write_cdf(&bak, &old)?;
+        kept = Some(bak);
     }
-    crate::formats::cdf::write_cdf(path, cdf)
+    crate::formats::cdf::write_cdf(path, cdf)?;
+    Ok(kept)
 }
 
 /// Writes a new intrinsic calibration into the `.cdf` at `path` (kept
-/// entries as [`cdf_with_intrinsics`]; the old file as `path.bak`).
-pub fn write_intrinsics(path: &Path, c: &Calibration) -> Result<Cdf, crate::formats::FormatError> {
+/// entries as [`cdf_with_intrinsics`]; the old file kept as
+/// [`backup_name`] says, its name returned).
+pub fn write_intrinsics(
+    path: &Path,
+    c: &Calibration,
+) -> Result<Option<std::path::PathBuf>, crate::formats::FormatError> {
     let old = if path.is_file() {
         Some(crate::formats::cdf::read_cdf(path)?)
     } else {
         None
     };
     let cdf = cdf_with_intrinsics(old.as_ref(), c);
-    write_cdf_keeping(path, &cdf)?;
-    Ok(cdf)
+    write_cdf_keeping(path, &cdf)
 }
 
-/// Writes `T` into the `.cdf` at `path` (the old file as `path.bak`).
+/// Writes `T` into the `.cdf` at `path` (the old file kept as
+/// [`backup_name`] says).
 pub fn write_extrinsic(
     path: &Path,
     old: &Cdf,
     t: &[[f64; 4]; 3],
-) -> Result<Cdf, crate::formats::FormatError> {
+) -> Result<(Cdf, Option<std::path::PathBuf>), crate::formats::FormatError> {
     let cdf = cdf_with_extrinsic(old, t);
-    write_cdf_keeping(path, &cdf)?;
-    Ok(cdf)
+    let bak = write_cdf_keeping(path, &cdf)?;
+    Ok((cdf, bak))
 }
 
 /// The plate found in a set of images.
@@ -215,9 +250,29 @@ pub fn scale_of(cdf: &Cdf) -> Option<(f64, f64)> {
     }
 }
 
+/// A number to three significant figures, in plain decimals between 0.001
+/// and 10 000 (`5.52`, `0.0131`, `706`) and in powers of ten outside
+/// (`1.23e-5`), never `5.5e0`.
+pub fn sig3(x: f64) -> String {
+    let a = x.abs();
+    if !x.is_finite() {
+        return format!("{x}");
+    }
+    if a == 0.0 {
+        return "0".into();
+    }
+    if (1e-3..1e4).contains(&a) {
+        let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
 /// The solution in words, as the CLI prints it and the report's page shows
-/// it: a header, each parameter with its standard error and unit, then `C`
-/// when it was stated and `S` with how it was found. `pm` is the
+/// it: a header, each parameter with its standard error and unit, the terms
+/// fixed at zero, then `C` when it was stated, `S` with how it was found,
+/// and the projection's uncertainty across the image. `pm` is the
 /// plus-minus sign (`±`, or `+-` where the font has only ASCII).
 pub fn parameter_lines(c: &Calibration, pm: &str) -> Vec<String> {
     let mut t = vec!["parameter  value            standard error".to_string()];
@@ -229,9 +284,22 @@ pub fn parameter_lines(c: &Calibration, pm: &str) -> Vec<String> {
             _ => "",
         };
         t.push(format!(
-            "{:<9}  {:<16.9} {pm} {:.3e}{unit}",
-            p.name, p.value, p.se
+            "{:<9}  {:<16.9} {pm} {}{unit}",
+            p.name,
+            p.value,
+            sig3(p.se)
         ));
+    }
+    for p in &c.fixed {
+        t.push(format!(
+            "{:<9}  0 (fixed: {} {pm} {} cannot be told from 0)",
+            p.name,
+            sig3(p.value),
+            sig3(p.se)
+        ));
+    }
+    if !c.full_model && !c.fixed.iter().any(|p| p.name == "s1") {
+        t.push("s1, s2     0 (thin prism not estimated; --model full)".into());
     }
     if c.centre_stated {
         t.push(format!("C (stated) {:.3} {:.3} px", c.model.cx, c.model.cy));
@@ -242,5 +310,20 @@ pub fn parameter_lines(c: &Calibration, pm: &str) -> Vec<String> {
         "stated"
     };
     t.push(format!("S ({how})  {} {} mm/px", c.model.sx, c.model.sy));
+    if !c.uncertainty.is_empty() {
+        let names = uncertainty_points(c.width, c.height);
+        let parts: Vec<String> = c
+            .uncertainty
+            .iter()
+            .map(|(q, u)| {
+                let name = names.iter().find(|(_, p)| p == q).map_or("", |(n, _)| n);
+                format!("{name} {}", sig3(*u))
+            })
+            .collect();
+        t.push(format!(
+            "projection uncertainty (px, 1 sigma): {}",
+            parts.join(", ")
+        ));
+    }
     t
 }

@@ -1,4 +1,5 @@
-//! Finding the plate's grid in a grey image with the LLV engine.
+//! Finding the plate's grid in a grey image: a checkerboard by its inner
+//! corners (`super::saddle`), a squares plate with the LLV engine as below.
 //!
 //! The squares' sides are long straight edges, which the pipeline's line
 //! extractor fits to subpixel accuracy (`llv::pipeline`, total least squares
@@ -53,6 +54,46 @@ pub enum DetectError {
         columns: usize,
         rows: usize,
     },
+    #[error(
+        "no checkerboard of {columns} × {rows} inner corners found ({saddles} corner-like points, none in a grid of alternating squares): hold the whole board in front of the camera, sharp and evenly lit"
+    )]
+    NoGrid {
+        saddles: usize,
+        columns: usize,
+        rows: usize,
+    },
+    #[error(
+        "a grid of {columns} × {rows} inner corners; the plate file says {want_columns} × {want_rows} (a checkerboard of {} × {} squares): check the plate file's `columns` and `rows` (squares, one more than inner corners), or whether part of the board is hidden",
+        want_columns + 1, want_rows + 1
+    )]
+    GridSize {
+        columns: usize,
+        rows: usize,
+        want_columns: usize,
+        want_rows: usize,
+    },
+    #[error(
+        "the board is partly out of the frame: a grid of {columns} × {rows} inner corners reaches the image's edge, the plate has {want_columns} × {want_rows}: move the board (or the camera) so that the whole board is in view"
+    )]
+    PartlyOut {
+        columns: usize,
+        rows: usize,
+        want_columns: usize,
+        want_rows: usize,
+    },
+    #[error(
+        "two boards in view (grids of {} × {} and {} × {} inner corners): show one board at a time",
+        first.0, first.1, second.0, second.1
+    )]
+    TwoBoards {
+        first: (usize, usize),
+        second: (usize, usize),
+    },
+    #[error(
+        "the board is in view ({corners} inner corners) but blurred: its edges are {width:.1} px wide (at most {} px gives sharp corners): focus, hold the board still, or give more light for a shorter exposure",
+        super::saddle::MAX_EDGE_WIDTH
+    )]
+    Blurred { width: f64, corners: usize },
     #[error("the image cannot be processed: {0}")]
     Image(#[from] crate::llv::LlvError),
 }
@@ -248,6 +289,10 @@ impl Detector {
 
     /// Finds `plate` in `img`.
     pub fn detect(&mut self, img: &GreyImage, plate: &Plate) -> Result<Detection, DetectError> {
+        if plate.kind == PlateKind::Checkerboard {
+            img.check_stage_size()?;
+            return super::saddle::detect(img, plate);
+        }
         let params = params_for(plate);
         let out = self.ws.run(&Input::single(img), &params)?;
         let segs: Vec<Segment> = out.lines_raw.to_vec();

@@ -14,9 +14,29 @@ use nalgebra::{Matrix2, Rotation3, SMatrix, Vector2, Vector3};
 
 use crate::llv::lens::CameraModel;
 
-/// Intrinsic parameters in the solver's order: `Cx, Cy, f, k1, g1, g2, g3,
-/// g4`, then `sy` when the scale is estimated.
-pub const INTRINSIC_NAMES: [&str; 9] = ["Cx", "Cy", "f", "k1", "g1", "g2", "g3", "g4", "sy"];
+/// Intrinsic parameters in the solver's order: `Cx, Cy, f`, the radial
+/// `k1`, Weng's decentering `p1, p2` and thin prism `s1, s2`, then `sy`
+/// when the scale is estimated.
+///
+/// The `.cdf` stores Weng's folded terms (lens.md): `g1 = p1 + s1`,
+/// `g2 = p2 + s2`, `g3 = 2 p1`, `g4 = 2 p2`. The solver works with the
+/// unfolded ones so that the thin prism can be left out (fixed at zero)
+/// without touching the decentering: see `docs/calibration.md`.
+pub const INTRINSIC_NAMES: [&str; 9] = ["Cx", "Cy", "f", "k1", "p1", "p2", "s1", "s2", "sy"];
+
+/// Index of the first thin-prism term in [`INTRINSIC_NAMES`].
+pub const THIN_PRISM: [usize; 2] = [6, 7];
+
+/// Weng's folded `D = (k1, g1, g2, g3, g4)` from `(k1, p1, p2, s1, s2)`.
+pub fn fold(k1: f64, p1: f64, p2: f64, s1: f64, s2: f64) -> [f64; 5] {
+    [k1, p1 + s1, p2 + s2, 2.0 * p1, 2.0 * p2]
+}
+
+/// `(k1, p1, p2, s1, s2)` from Weng's folded `D`.
+pub fn unfold(d: &[f64; 5]) -> [f64; 5] {
+    let (p1, p2) = (d[3] / 2.0, d[4] / 2.0);
+    [d[0], p1, p2, d[1] - p1, d[2] - p2]
+}
 
 /// A view's pose: plate → camera, as a rotation vector (axis × angle, rad)
 /// and a translation (mm).
@@ -64,7 +84,7 @@ pub struct Projection {
 
 /// The intrinsics as the solver's vector (`sy` last).
 pub fn intrinsics_vector(m: &CameraModel) -> [f64; 9] {
-    let d = m.distortion.unwrap_or([0.0; 5]);
+    let d = unfold(&m.distortion.unwrap_or([0.0; 5]));
     [m.cx, m.cy, m.f, d[0], d[1], d[2], d[3], d[4], m.sy]
 }
 
@@ -75,7 +95,7 @@ pub fn model_from(v: &[f64], base: &CameraModel, estimate_sy: bool) -> CameraMod
         cx: g(0),
         cy: g(1),
         f: g(2),
-        distortion: Some([g(3), g(4), g(5), g(6), g(7)]),
+        distortion: Some(fold(g(3), g(4), g(5), g(6), g(7))),
         sx: base.sx,
         sy: if estimate_sy { g(8) } else { base.sy },
     }
@@ -147,7 +167,14 @@ pub fn project(m: &CameraModel, pose: &Pose, x: &Vector3<f64>) -> Option<Project
     d_intrinsics
         .fixed_view_mut::<2, 1>(0, 2)
         .copy_from(&(ap * (p / m.f)));
-    let jd = SMatrix::<f64, 2, 5>::from_fn(|i, j| by_d[i][j]);
+    // By (k1, p1, p2, s1, s2) through the folding g = fold(k1, p1, p2, s1, s2).
+    let jd = SMatrix::<f64, 2, 5>::from_fn(|i, j| match j {
+        0 => by_d[i][0],
+        1 => by_d[i][1] + 2.0 * by_d[i][3],
+        2 => by_d[i][2] + 2.0 * by_d[i][4],
+        3 => by_d[i][1],
+        _ => by_d[i][2],
+    });
     d_intrinsics
         .fixed_view_mut::<2, 5>(0, 3)
         .copy_from(&(ap * jd));

@@ -29,6 +29,21 @@ use toml::Spanned;
 /// quadratic in its squares.
 pub const MAX_SQUARES: u32 = 64;
 
+/// Largest plate file read (bytes): a plate is a few lines.
+pub const MAX_PLATE_BYTES: u64 = 64 * 1024;
+
+/// The plates built into vss: name and text (`profiles/plates/`).
+pub const BUILT_IN: [(&str, &str); 2] = [
+    (
+        "squares",
+        include_str!("../../profiles/plates/squares.toml"),
+    ),
+    (
+        "checkerboard",
+        include_str!("../../profiles/plates/checkerboard.toml"),
+    ),
+];
+
 /// A plate that could not be read, or contradicts itself.
 #[derive(Debug, thiserror::Error)]
 pub enum PlateError {
@@ -37,7 +52,7 @@ pub enum PlateError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("plate `{name}` not found (looked for {tried})")]
+    #[error("plate `{name}` is not a built-in plate ({tried})")]
     NotFound { name: String, tried: String },
     #[error("{path}:{line}: {message}")]
     Invalid {
@@ -156,14 +171,37 @@ struct PlaceFile {
 }
 
 impl Plate {
-    /// Loads a plate by path, or by name from `profiles/plates/`.
+    /// Loads a plate: a bare name is one of the plates built into vss
+    /// ([`BUILT_IN`], the files of `profiles/plates/` as they were when vss
+    /// was built), anything with a `/` or ending in `.toml` a file, read
+    /// with the bounded, link-refusing reader ([`crate::fsutil::read_input_text`]).
+    /// No folder is searched: a file planted in the current folder's
+    /// `profiles/plates/` is never taken for a built-in plate.
     pub fn load(name_or_path: &str) -> Result<Plate, PlateError> {
-        let path = resolve(name_or_path)?;
-        let text = std::fs::read_to_string(&path).map_err(|source| PlateError::Io {
-            path: path.clone(),
-            source,
-        })?;
-        Plate::from_toml(&text, &path)
+        let p = Path::new(name_or_path);
+        if name_or_path.ends_with(".toml") || p.components().count() > 1 {
+            let text = crate::fsutil::read_input_text(p, MAX_PLATE_BYTES).map_err(|source| {
+                PlateError::Io {
+                    path: p.to_path_buf(),
+                    source,
+                }
+            })?;
+            return Plate::from_toml(&text, p);
+        }
+        match BUILT_IN.iter().find(|(n, _)| *n == name_or_path) {
+            Some((n, text)) => Plate::from_toml(text, Path::new(&format!("(built in) {n}.toml"))),
+            None => Err(PlateError::NotFound {
+                name: name_or_path.to_string(),
+                tried: format!(
+                    "the built-in plates {}; a plate file is named by its path, e.g. ./{name_or_path}.toml",
+                    BUILT_IN
+                        .iter()
+                        .map(|(n, _)| *n)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            }),
+        }
     }
 
     /// Parses and checks a plate file; `path` names it in errors.
@@ -332,8 +370,22 @@ impl Plate {
         })
     }
 
-    /// Every corner the detector finds on a whole view, by key.
+    /// Every corner the detector finds on a whole view, by key: on a
+    /// checkerboard its inner corners (where four squares meet), on a
+    /// squares plate the squares' corners.
     pub fn corners(&self) -> Vec<PlateCorner> {
+        if self.kind == PlateKind::Checkerboard {
+            let mut out = Vec::new();
+            for j in 1..self.rows {
+                for i in 1..self.columns {
+                    out.push(PlateCorner {
+                        key: (i, j),
+                        xy: [f64::from(i) * self.square, f64::from(j) * self.square],
+                    });
+                }
+            }
+            return out;
+        }
         let mut seen = BTreeSet::new();
         let mut out = Vec::new();
         for (i, j) in self.quad_cells() {
@@ -449,33 +501,6 @@ fn check_place(p: &PlaceFile) -> Result<Place, (Span, String)> {
     })
 }
 
-/// `profiles/plates/NAME.toml` for a bare name, the path itself otherwise.
-fn resolve(name_or_path: &str) -> Result<PathBuf, PlateError> {
-    let p = Path::new(name_or_path);
-    if name_or_path.ends_with(".toml") || p.components().count() > 1 {
-        return Ok(p.to_path_buf());
-    }
-    let candidates = [
-        PathBuf::from("profiles/plates").join(format!("{name_or_path}.toml")),
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("profiles/plates")
-            .join(format!("{name_or_path}.toml")),
-    ];
-    for c in &candidates {
-        if c.is_file() {
-            return Ok(c.clone());
-        }
-    }
-    Err(PlateError::NotFound {
-        name: name_or_path.to_string(),
-        tried: candidates
-            .iter()
-            .map(|c| c.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", "),
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -511,9 +536,8 @@ origin_mark = true
         let p = parse(t).unwrap();
         // Dark 10, inner light (3 × 2 inner cells, 3 of them light).
         assert_eq!(p.quad_cells().len(), 13);
-        // 6 × 5 lattice points less the two bottom corners, which only
-        // light border squares touch.
-        assert_eq!(p.corners().len(), 28);
+        // The inner corners: 4 × 3.
+        assert_eq!(p.corners().len(), 12);
         assert!(p.oriented());
         assert_eq!(p.origin.handedness(), -1.0);
     }

@@ -6,15 +6,15 @@
 //! (`s² (JᵀJ)⁻¹`, `s²` the residual variance), and the checks that say
 //! whether the set of views was good enough.
 //!
-//! One thing the views cannot settle: in Weng's model a shift `Δ` of the
-//! centre `C` is matched to second order by the decentering terms (`g3 += Δu
-//! / f²`, `g4 += Δv / f²`, in mm) and a turn of every view by `Δ / f`,
-//! because turning a pinhole camera moves its image by `f α` plus exactly
-//! `α (u², uv) / f`, which `g3` spans (and `g4` the other way). The fit is
-//! then decided by third-order terms, and `C` comes out to a few pixels
-//! (its standard error says how far). Such a `.cdf` corrects images and
-//! projects points nearly as well, but where the centre is known it can be
-//! stated ([`Options::centre`]) and the rest follows it.
+//! The model: `C`, `f`, radial `k1` and decentering `p1, p2` by default;
+//! Weng's thin prism `s1, s2` only when asked ([`Options::full_model`]). In
+//! Weng's model a shift `Δ` of the centre is matched to second order by
+//! thin-prism-like terms and a turn of every view, because turning a pinhole
+//! camera moves its image by `f α` plus exactly `α (u², uv) / f`; with the
+//! thin prism free the images fix `C` only to a few pixels, without it real
+//! lenses pin `C` down (docs/calibration.md). A distortion term whose
+//! standard error exceeds its value is fixed at zero and the rest solved
+//! again; only a weak `C`, `f` or `sy` refuses the views.
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
@@ -50,6 +50,10 @@ pub struct Options {
     pub estimate_scale: bool,
     /// `C` stated (px) instead of solved for.
     pub centre: Option<[f64; 2]>,
+    /// Estimate Weng's thin prism (`s1, s2`) too. Off by default: real
+    /// lenses have next to none, and with it a shift of `C` is nearly
+    /// matched by the other terms (docs/calibration.md).
+    pub full_model: bool,
 }
 
 /// A parameter with its standard error.
@@ -81,10 +85,19 @@ pub struct Calibration {
     pub scale_estimated: bool,
     /// `C` was stated, not solved for.
     pub centre_stated: bool,
+    /// The thin prism was estimated (`--model full`).
+    pub full_model: bool,
     pub views: Vec<ViewFit>,
     pub rms: f64,
     pub p95: f64,
+    /// The parameters solved for, with their standard errors.
     pub params: Vec<Estimate>,
+    /// Distortion terms the views could not tell from zero, fixed at zero
+    /// (with their value and standard error when they were let go).
+    pub fixed: Vec<Estimate>,
+    /// The projection's uncertainty (px, 1 σ) at the image's middle and
+    /// corners ([`uncertainty_points`]).
+    pub uncertainty: Vec<([f64; 2], f64)>,
     /// What makes the set of views weak, in words for the operator.
     pub warnings: Vec<String>,
     /// Residual evaluations the solver needed.
@@ -270,10 +283,10 @@ fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|e| e * e).sum::<f64>() / v.len().max(1) as f64).sqrt()
 }
 
-/// Standard errors of every parameter from `JᵀJ` over `m` residuals:
-/// `s · sqrt(diag((JᵀJ)⁻¹))`, scaled to a unit diagonal first so that mm,
-/// radians and 10⁻⁴ sit together.
-fn standard_errors(a: &DMatrix<f64>, ssr: f64, m: usize) -> Option<DVector<f64>> {
+/// The parameters' covariance from `JᵀJ` over `m` residuals: `s²
+/// (JᵀJ)⁻¹`, `s²` the residual variance, the inverse taken on `JᵀJ` scaled
+/// to a unit diagonal so that mm, radians and 10⁻⁴ sit together.
+fn covariance(a: &DMatrix<f64>, ssr: f64, m: usize) -> Option<DMatrix<f64>> {
     let n = a.nrows();
     if m <= n {
         return None;
@@ -282,7 +295,17 @@ fn standard_errors(a: &DMatrix<f64>, ssr: f64, m: usize) -> Option<DVector<f64>>
     let scaled = DMatrix::from_fn(n, n, |i, j| a[(i, j)] / (d[i] * d[j]));
     let inv = scaled.cholesky()?.inverse();
     let s2 = ssr / (m - n) as f64;
-    Some(DVector::from_fn(n, |i, _| (s2 * inv[(i, i)]).sqrt() / d[i]))
+    Some(DMatrix::from_fn(n, n, |i, j| {
+        s2 * inv[(i, j)] / (d[i] * d[j])
+    }))
+}
+
+/// Standard errors of every parameter (the covariance's diagonal).
+fn standard_errors(a: &DMatrix<f64>, ssr: f64, m: usize) -> Option<DVector<f64>> {
+    let c = covariance(a, ssr, m)?;
+    Some(DVector::from_fn(c.nrows(), |i, _| {
+        c[(i, i)].max(0.0).sqrt()
+    }))
 }
 
 /// Intrinsic calibration from three or more views.
@@ -327,7 +350,7 @@ pub fn calibrate(views: &[View], o: &Options) -> Result<Calibration, CalibError>
         ((a + b) / 2.0, o.sy)
     };
     let [cx0, cy0] = o.centre.unwrap_or([pin.cx, pin.cy]);
-    let start = CameraModel {
+    let mut start = CameraModel {
         cx: cx0,
         cy: cy0,
         sx: o.sx,
@@ -341,7 +364,7 @@ pub fn calibrate(views: &[View], o: &Options) -> Result<Calibration, CalibError>
         cx: cx0,
         cy: cy0,
     };
-    let poses: Vec<Pose> = hs
+    let mut poses: Vec<Pose> = hs
         .iter()
         .zip(views)
         .map(|(h, v)| {
@@ -350,34 +373,94 @@ pub fn calibrate(views: &[View], o: &Options) -> Result<Calibration, CalibError>
             })
         })
         .collect::<Result<_, _>>()?;
-    let free: Vec<usize> = (0..9)
+    let mut free: Vec<usize> = (0..9)
         .filter(|&i| match i {
             0 | 1 => o.centre.is_none(),
+            6 | 7 => o.full_model,
             8 => o.estimate_scale,
             _ => true,
         })
         .collect();
-    let mut fit = Fit::new(views, start, free.clone(), &poses);
-    let report = lm::minimize(&mut fit)?;
-    let model = fit.camera();
-    let out = || CalibError::NoConvergence {
-        why: "a corner left the camera's view".into(),
+    let mut fixed = Vec::new();
+    let mut evaluations = 0;
+    let (fit, params, r, a) = loop {
+        let mut fit = Fit::new(views, start, free.clone(), &poses);
+        evaluations += lm::minimize(&mut fit)?.evaluations;
+        let out = || CalibError::NoConvergence {
+            why: "a corner left the camera's view".into(),
+        };
+        let r = fit.residuals().ok_or_else(out)?;
+        let (a, _) = fit.normal().ok_or_else(out)?;
+        let cov = covariance(&a, r.norm_squared(), r.len()).ok_or(CalibError::Degenerate {
+            what: "the parameters cannot be told apart from these views".into(),
+        })?;
+        let iv = model::intrinsics_vector(&fit.camera());
+        let params: Vec<Estimate> = free
+            .iter()
+            .enumerate()
+            .map(|(k, &i)| Estimate {
+                name: INTRINSIC_NAMES[i],
+                value: iv[i],
+                se: cov[(k, k)].max(0.0).sqrt(),
+            })
+            .collect();
+        // Corners that fit no camera: said before any parameter is blamed.
+        let errs: Vec<f64> = (0..r.len() / 2)
+            .map(|i| r[2 * i].hypot(r[2 * i + 1]))
+            .collect();
+        let overall = rms(&errs);
+        if overall.is_nan() || overall >= 2.0 {
+            return Err(CalibError::NoConvergence {
+                why: format!(
+                    "the best fit leaves {overall:.2} px RMS: the corners do not fit one camera (a view whose grid was misread, or a plate file that does not match the plate)"
+                ),
+            });
+        }
+        // A distortion term the views cannot tell from zero is fixed at
+        // zero and the rest solved again, the weakest first; C, f and sy
+        // cannot be left out, so a weak one of them refuses the views.
+        let ratio = |p: &Estimate| {
+            if p.se.is_nan() {
+                f64::INFINITY
+            } else {
+                p.se / p.value.abs()
+            }
+        };
+        if let Some(p) = params
+            .iter()
+            .filter(|p| matches!(p.name, "Cx" | "Cy" | "f" | "sy"))
+            .find(|p| ratio(p) >= 1.0)
+        {
+            return Err(CalibError::WeakParameter {
+                name: p.name,
+                value: p.value,
+                se: p.se,
+            });
+        }
+        let weakest = params
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| !matches!(p.name, "Cx" | "Cy" | "f" | "sy"))
+            .max_by(|a, b| ratio(a.1).total_cmp(&ratio(b.1)));
+        match weakest {
+            Some((k, p)) if ratio(p) >= 1.0 => {
+                fixed.push(*p);
+                let i = free.remove(k);
+                let mut iv = model::intrinsics_vector(&fit.camera());
+                iv[i] = 0.0;
+                start = model::model_from(&iv, &start, true);
+                poses = (0..views.len()).map(|v| fit.pose(v)).collect();
+            }
+            _ => break (fit, params, r, a),
+        }
     };
-    let r = fit.residuals().ok_or_else(out)?;
-    let (a, _) = fit.normal().ok_or_else(out)?;
-    let se = standard_errors(&a, r.norm_squared(), r.len()).ok_or(CalibError::Degenerate {
-        what: "the parameters cannot be told apart from these views".into(),
-    })?;
-    let iv = model::intrinsics_vector(&model);
-    let params: Vec<Estimate> = free
-        .iter()
-        .enumerate()
-        .map(|(k, &i)| Estimate {
-            name: INTRINSIC_NAMES[i],
-            value: iv[i],
-            se: se[k],
-        })
-        .collect();
+    let model = fit.camera();
+    for p in &fixed {
+        warnings.push(format!(
+            "{} = {:.2e} had a standard error of {:.2e}, larger than itself: these views cannot tell it from zero, so it was fixed at 0 and the rest solved again",
+            p.name, p.value, p.se
+        ));
+    }
     let mut all = Vec::new();
     let mut fits = Vec::new();
     let mut row = 0;
@@ -410,16 +493,6 @@ pub fn calibrate(views: &[View], o: &Options) -> Result<Calibration, CalibError>
             ),
         });
     }
-    if let Some(p) = params
-        .iter()
-        .find(|p| p.se.is_nan() || p.se >= p.value.abs())
-    {
-        return Err(CalibError::WeakParameter {
-            name: p.name,
-            value: p.value,
-            se: p.se,
-        });
-    }
     let centre_se = params
         .iter()
         .filter(|p| p.name == "Cx" || p.name == "Cy")
@@ -427,22 +500,215 @@ pub fn calibrate(views: &[View], o: &Options) -> Result<Calibration, CalibError>
         .fold(0.0, f64::max);
     if centre_se > CENTRE_SE {
         warnings.push(format!(
-            "the centre C is known to ± {centre_se:.1} px only: in Weng's model a shift of C is matched, to second order, by g3 and g4 and a turn of each view, so the images hardly tell them apart. The .cdf corrects images and projects points as well either way, but its C (and the turn of a T found with it) is that uncertain; if the centre is known (the lens's data sheet, an optical bench), state it: --centre X,Y"
+            "the centre C is known to ± {centre_se:.1} px only{}; if the centre is known (the lens's data sheet, an optical bench), state it: vss calibrate --centre X,Y, or on the Calibrate screen S (X,Y) or s (the image's middle)",
+            if o.full_model {
+                ": with the thin prism (s1, s2) estimated, a shift of C is matched, to second order, by the distortion terms and a turn of each view, so the images hardly tell them apart; the .cdf corrects images as well either way, but its C (and the turn of a T found with it) is that uncertain. Without --model full the thin prism is left out and real lenses pin C down"
+            } else {
+                ": take more views, tilted more, with the plate near the image's edges and corners"
+            }
         ));
     }
     warnings.extend(weak_set(&fits, o));
+    let uncertainty = projection_uncertainty(&fit, &a, r.norm_squared(), r.len(), o);
     Ok(Calibration {
         model,
         scale_estimated: o.estimate_scale,
         centre_stated: o.centre.is_some(),
+        full_model: o.full_model,
         views: fits,
         rms: overall,
         p95: percentile(all, 0.95),
         params,
+        fixed,
+        uncertainty,
         warnings,
-        evaluations: report.evaluations,
+        evaluations,
         width: o.width,
         height: o.height,
+    })
+}
+
+/// The five places of the image where the projection's uncertainty is
+/// stated: the middle, then the corners (top-left, top-right, bottom-left,
+/// bottom-right), as `(name, pixel)`.
+pub fn uncertainty_points(width: usize, height: usize) -> [(&'static str, [f64; 2]); 5] {
+    let (w, h) = ((width.max(1) - 1) as f64, (height.max(1) - 1) as f64);
+    [
+        ("middle", [w / 2.0, h / 2.0]),
+        ("top-left", [0.0, 0.0]),
+        ("top-right", [w, 0.0]),
+        ("bottom-left", [0.0, h]),
+        ("bottom-right", [w, h]),
+    ]
+}
+
+/// Projects a direction (camera frame, at infinity) to the observed pixel.
+fn project_dir(m: &CameraModel, d: &Vector3<f64>) -> Option<[f64; 2]> {
+    if d.z <= 1e-9 {
+        return None;
+    }
+    let (ix, iy) = m.to_px(m.f * d.x / d.z, m.f * d.y / d.z);
+    let (ox, oy) = m.ideal_to_observed_converged(ix, iy);
+    (ox.is_finite() && oy.is_finite()).then_some([ox, oy])
+}
+
+/// The direction (camera frame) observed at pixel `q`.
+fn unproject(m: &CameraModel, q: [f64; 2]) -> Vector3<f64> {
+    let (ix, iy) = m.observed_to_ideal(q[0], q[1]);
+    let (u, v) = m.to_mm(ix, iy);
+    Vector3::new(u, v, m.f).normalize()
+}
+
+/// How far the projection of a far point seen at each of
+/// [`uncertainty_points`] could be off (px, 1 σ, the worst direction), from
+/// the corners' noise alone, as mrcal states it: the point is fixed in the
+/// frame of the plates (the mean of its directions in every view's plate
+/// frame), so that a change of the intrinsics the views' poses make up for
+/// does not count. Linearised: `J Σ Jᵀ` with `Σ = s² (JᵀJ)⁻¹` over every
+/// parameter and `J` by central differences. Empty when the covariance
+/// cannot be had.
+fn projection_uncertainty(
+    fit: &Fit,
+    a: &DMatrix<f64>,
+    ssr: f64,
+    m: usize,
+    o: &Options,
+) -> Vec<([f64; 2], f64)> {
+    let Some(cov) = covariance(a, ssr, m) else {
+        return Vec::new();
+    };
+    let cam = fit.camera();
+    let n = fit.x.len();
+    let mut out = Vec::new();
+    for (_, q) in uncertainty_points(o.width, o.height) {
+        let d = unproject(&cam, q);
+        // The direction in each view's plate frame.
+        let dk: Vec<Vector3<f64>> = (0..fit.views.len())
+            .map(|k| fit.pose(k).rotation_matrix().inverse() * d)
+            .collect();
+        let at = |x: &DVector<f64>| -> Option<[f64; 2]> {
+            let f = Fit {
+                views: fit.views,
+                plate: Vec::new(),
+                base: fit.base,
+                iv: fit.iv,
+                free: fit.free.clone(),
+                n_intr: fit.n_intr,
+                x: x.clone(),
+                rows: 0,
+            };
+            let cam = f.camera();
+            let mean = dk
+                .iter()
+                .enumerate()
+                .map(|(k, v)| f.pose(k).rotation_matrix() * v)
+                .fold(Vector3::zeros(), |s, v| s + v);
+            project_dir(&cam, &mean.normalize())
+        };
+        let mut j = DMatrix::zeros(2, n);
+        let mut ok = true;
+        for c in 0..n {
+            // Translations do not move a far point.
+            if c >= fit.n_intr && (c - fit.n_intr) % 6 >= 3 {
+                continue;
+            }
+            let h = 1e-6 * fit.x[c].abs().max(1e-3);
+            let mut xp = fit.x.clone();
+            xp[c] += h;
+            let mut xm = fit.x.clone();
+            xm[c] -= h;
+            match (at(&xp), at(&xm)) {
+                (Some(p), Some(q)) => {
+                    j[(0, c)] = (p[0] - q[0]) / (2.0 * h);
+                    j[(1, c)] = (p[1] - q[1]) / (2.0 * h);
+                }
+                _ => ok = false,
+            }
+        }
+        if !ok {
+            continue;
+        }
+        let v = &j * &cov * j.transpose();
+        let (a, b, c) = (v[(0, 0)], v[(0, 1)], v[(1, 1)]);
+        let worst = (a + c) / 2.0 + (((a - c) / 2.0).powi(2) + b * b).sqrt();
+        out.push((q, worst.max(0.0).sqrt()));
+    }
+    out
+}
+
+/// Two calibrations from halves of the views (alternate views), each
+/// judged on the other's views.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CrossCheck {
+    /// RMS reprojection error (px) of the views each half left out, their
+    /// poses solved with the other half's intrinsics.
+    pub held_out_rms: f64,
+    /// RMS and largest difference (px) between the two halves' projections
+    /// over a grid across the image, once the best turn between their
+    /// frames is allowed for.
+    pub difference_rms: f64,
+    pub difference_max: f64,
+}
+
+/// [`CrossCheck`] of a set of views, when each half has at least three.
+pub fn cross_validate(views: &[View], o: &Options) -> Option<CrossCheck> {
+    if views.len() < 6 {
+        return None;
+    }
+    let (a, b): (Vec<_>, Vec<_>) = views.iter().enumerate().partition(|(k, _)| k % 2 == 0);
+    let a: Vec<View> = a.into_iter().map(|(_, v)| v.clone()).collect();
+    let b: Vec<View> = b.into_iter().map(|(_, v)| v.clone()).collect();
+    let ca = calibrate(&a, o).ok()?;
+    let cb = calibrate(&b, o).ok()?;
+    let mut errs = Vec::new();
+    for (model, held) in [(&ca.model, &b), (&cb.model, &a)] {
+        for v in held.iter() {
+            let (pose, ..) = solve_pose(v, model).ok()?;
+            let cam = *model;
+            for c in &v.corners {
+                let p = model::project(
+                    &cam,
+                    &pose,
+                    &Vector3::new(c.corner.xy[0], c.corner.xy[1], 0.0),
+                )?;
+                errs.push((p.px.x - c.px[0]).hypot(p.px.y - c.px[1]));
+            }
+        }
+    }
+    // The grid: directions by A, turned onto B's frame (Kabsch), projected by B.
+    let g = 8;
+    let mut qs = Vec::new();
+    for j in 0..=g {
+        for i in 0..=g {
+            qs.push([
+                i as f64 / g as f64 * (o.width.max(1) - 1) as f64,
+                j as f64 / g as f64 * (o.height.max(1) - 1) as f64,
+            ]);
+        }
+    }
+    let da: Vec<Vector3<f64>> = qs.iter().map(|q| unproject(&ca.model, *q)).collect();
+    let db: Vec<Vector3<f64>> = qs.iter().map(|q| unproject(&cb.model, *q)).collect();
+    let h = da
+        .iter()
+        .zip(&db)
+        .fold(Matrix3::zeros(), |s, (x, y)| s + y * x.transpose());
+    let svd = h.svd(true, true);
+    let (u, vt) = (svd.u?, svd.v_t?);
+    let mut rot = u * vt;
+    if rot.determinant() < 0.0 {
+        let mut u2 = u;
+        u2.column_mut(2).neg_mut();
+        rot = u2 * vt;
+    }
+    let mut diffs = Vec::new();
+    for (q, d) in qs.iter().zip(&da) {
+        let p = project_dir(&cb.model, &(rot * d))?;
+        diffs.push((p[0] - q[0]).hypot(p[1] - q[1]));
+    }
+    Some(CrossCheck {
+        held_out_rms: rms(&errs),
+        difference_rms: rms(&diffs),
+        difference_max: diffs.iter().copied().fold(0.0, f64::max),
     })
 }
 
@@ -584,4 +850,125 @@ pub fn solve_pose(view: &View, m: &CameraModel) -> Result<(Pose, f64, f64, [f64;
         percentile(errs, 0.95),
         std::array::from_fn(|i| se[i]),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calib::plate::PlateCorner;
+
+    /// Views of a 9 × 7 grid of 20 mm through `cam`, tilted every way,
+    /// with the corners moved by seeded noise of `sigma` px.
+    fn views(cam: &CameraModel, sigma: f64, seed: u64) -> Vec<View> {
+        let mut state = seed;
+        let mut uniform = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        };
+        let mut gauss = move || {
+            let (a, b) = (uniform(), uniform());
+            (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+        };
+        let mut out = Vec::new();
+        for k in 0..12 {
+            let a = f64::from(k) * std::f64::consts::TAU / 12.0;
+            let pose = Pose {
+                rotation: Vector3::new(0.5 * a.cos(), 0.5 * a.sin(), 0.1 * f64::from(k % 3)),
+                translation: Vector3::new(
+                    -80.0 + 10.0 * a.sin(),
+                    -60.0,
+                    450.0 + 10.0 * f64::from(k),
+                ),
+            };
+            let mut corners = Vec::new();
+            for j in 0..7u32 {
+                for i in 0..9u32 {
+                    let xy = [f64::from(i) * 20.0, f64::from(j) * 20.0];
+                    let p = model::project(cam, &pose, &Vector3::new(xy[0], xy[1], 0.0)).unwrap();
+                    corners.push(Corner {
+                        corner: PlateCorner { key: (i, j), xy },
+                        px: [p.px.x + sigma * gauss(), p.px.y + sigma * gauss()],
+                    });
+                }
+            }
+            out.push(View {
+                name: format!("v{k}"),
+                corners,
+            });
+        }
+        out
+    }
+
+    fn options(cam: &CameraModel) -> Options {
+        Options {
+            width: 640,
+            height: 480,
+            sx: cam.sx,
+            sy: cam.sy,
+            estimate_scale: false,
+            centre: None,
+            full_model: false,
+        }
+    }
+
+    #[test]
+    fn a_term_the_views_cannot_tell_from_zero_is_fixed_not_refused() {
+        // A lens with radial distortion only: p1 and p2 are noise.
+        let cam = CameraModel {
+            cx: 322.0,
+            cy: 236.0,
+            sx: 0.006,
+            sy: 0.006,
+            f: 4.2,
+            distortion: Some([-0.004, 0.0, 0.0, 0.0, 0.0]),
+        };
+        let v = views(&cam, 0.2, 7);
+        let c = calibrate(&v, &options(&cam)).unwrap_or_else(|e| panic!("{e}"));
+        assert!(!c.fixed.is_empty(), "{:?}", c.params);
+        for f in &c.fixed {
+            assert!(["p1", "p2"].contains(&f.name), "{f:?}");
+            assert!(f.se >= f.value.abs());
+            assert!(
+                c.warnings
+                    .iter()
+                    .any(|w| w.starts_with(&format!("{} = ", f.name)))
+            );
+        }
+        // What is left is determined, and the camera is found.
+        for p in &c.params {
+            assert!(p.se < p.value.abs(), "{p:?}");
+        }
+        assert!((c.model.cx - cam.cx).hypot(c.model.cy - cam.cy) < 2.0);
+        assert!((c.model.f - cam.f).abs() / cam.f < 0.005);
+        let lines = crate::calib::parameter_lines(&c, "+-");
+        assert!(lines.iter().any(|l| l.contains("(fixed:")), "{lines:?}");
+    }
+
+    #[test]
+    fn the_projection_uncertainty_grows_towards_the_corners() {
+        let cam = CameraModel {
+            cx: 322.0,
+            cy: 236.0,
+            sx: 0.006,
+            sy: 0.006,
+            f: 4.2,
+            distortion: Some(model::fold(-0.004, 2e-4, -1e-4, 0.0, 0.0)),
+        };
+        let v = views(&cam, 0.1, 3);
+        let c = calibrate(&v, &options(&cam)).unwrap();
+        assert_eq!(c.uncertainty.len(), 5);
+        let mid = c.uncertainty[0].1;
+        assert!(mid > 0.0 && mid < 0.2, "{:?}", c.uncertainty);
+        assert!(
+            c.uncertainty[1..].iter().all(|u| u.1 > mid),
+            "{:?}",
+            c.uncertainty
+        );
+        // Twice the noise, twice the uncertainty.
+        let c2 = calibrate(&views(&cam, 0.2, 3), &options(&cam)).unwrap();
+        let ratio = c2.uncertainty[0].1 / mid;
+        assert!((1.6..2.4).contains(&ratio), "{ratio}");
+    }
 }

@@ -3,13 +3,18 @@
 //! `vss calibrate --camera N --plate PLATE IMAGES… [--out camN.cdf]` finds the
 //! plate in every image, solves the intrinsics (`crate::calib`), prints the
 //! reprojection error per view and overall, each parameter with its standard
-//! error and what makes the set of views weak, and writes `C`, `f`, `D`
-//! (calibrated) and `S` (stated, from the camera's `.cdf` in the profile or
-//! `--scale`) into the `.cdf`, keeping its other entries. `--extrinsic` with
-//! one image of the plate at its place in the cell (the plate file's
-//! `[place]`) solves `T` with the intrinsics of that `.cdf` and writes it
-//! there. Whatever goes wrong, nothing is written; a replaced file is kept as
-//! `camN.cdf.bak`.
+//! error, the terms fixed at zero, the projection's uncertainty across the
+//! image, a cross-validation (two halves of the views) and what makes the
+//! set of views weak, and writes `C`, `f`, `D` (calibrated) and `S` (stated,
+//! from `--scale`, the camera's `.cdf` in the profile, or the `--out` file)
+//! into the `.cdf`, keeping its other entries. `--camera` may be left out
+//! when `--out` names the file. `--extrinsic` with one image of the plate at
+//! its place in the cell (the plate file's `[place]`) solves `T` with the
+//! intrinsics of that `.cdf` and writes it there. Whatever goes wrong,
+//! nothing is written; `--report` is written before the `.cdf`, so a report
+//! that cannot be written leaves the `.cdf` as it was; a replaced file is
+//! kept as `camN.cdf.bak` (an older backup is never overwritten: the next
+//! is `.bak.1`, `.bak.2`, …).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -24,13 +29,13 @@ use crate::llv::GreyImage;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Camera number (1-based).
-    #[arg(long, required_unless_present = "check_plate")]
+    /// Camera number (1-based); may be left out when --out names the file.
+    #[arg(long)]
     pub camera: Option<u32>,
     /// Calibration plate: a name from profiles/plates/ or a .toml file.
     #[arg(long, value_name = "PLATE")]
     pub plate: String,
-    /// Images of the plate (.img .png .pgm .tif .bmp); one with --extrinsic.
+    /// Images of the plate (.img .png .pgm .tif .bmp .jpg); one with --extrinsic.
     pub images: Vec<PathBuf>,
     /// The .cdf to write (default camN.cdf in the current folder).
     #[arg(long, value_name = "FILE")]
@@ -38,16 +43,20 @@ pub struct Args {
     /// Solve the pose T from one image of the plate at its place in the cell.
     #[arg(long)]
     pub extrinsic: bool,
-    /// The scale S (mm per pixel), when the profile's .cdf has none.
-    #[arg(long, value_name = "SX,SY", value_delimiter = ',', num_args = 2)]
-    pub scale: Option<Vec<f64>>,
+    /// The scale S (mm per pixel), when the profile's .cdf has none: `SX,SY`.
+    #[arg(long, value_name = "SX,SY", allow_hyphen_values = true)]
+    pub scale: Option<String>,
     /// Estimate sy (sx kept): only S's ratio can be told from images.
     #[arg(long)]
     pub estimate_scale: bool,
-    /// State the centre C (px) instead of solving for it: `X,Y`, or `image`
-    /// for the image's middle.
-    #[arg(long, value_name = "X,Y|image")]
+    /// State the centre C (px) instead of solving for it: `X,Y` (negative
+    /// values allowed), or `image` for the image's middle.
+    #[arg(long, value_name = "X,Y|image", allow_hyphen_values = true)]
     pub centre: Option<String>,
+    /// The distortion model: `default` (radial k1, decentering p1 p2) or
+    /// `full` (also Weng's thin prism s1 s2, which trades off with C).
+    #[arg(long, value_enum, default_value_t = Model::Default)]
+    pub model: Model,
     /// Replace the intrinsics of an existing --out file.
     #[arg(long)]
     pub yes: bool,
@@ -58,6 +67,25 @@ pub struct Args {
     /// Only check the plate file and describe it.
     #[arg(long)]
     pub check_plate: bool,
+}
+
+/// Which distortion terms are estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Model {
+    /// Radial k1 and decentering p1, p2 (what real lenses pin down).
+    Default,
+    /// Also the thin prism s1, s2.
+    Full,
+}
+
+/// Two numbers `A,B` (spaces allowed round them).
+fn pair(opt: &str, s: &str, what: &str) -> anyhow::Result<[f64; 2]> {
+    let v: Vec<&str> = s.split(',').map(str::trim).collect();
+    let nums: Option<Vec<f64>> = v.iter().map(|t| t.parse().ok()).collect();
+    match nums.as_deref() {
+        Some([x, y]) if x.is_finite() && y.is_finite() => Ok([*x, *y]),
+        _ => bail!("{opt} {s}: {what}; nothing written"),
+    }
 }
 
 fn read_images(paths: &[PathBuf]) -> anyhow::Result<Vec<(String, GreyImage)>> {
@@ -85,30 +113,36 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         );
         return Ok(ExitCode::SUCCESS);
     }
-    let cam = a.camera.context("--camera N is needed")?;
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("cam{cam}.cdf")));
+    let out = match (&a.out, a.camera) {
+        (Some(o), _) => o.clone(),
+        (None, Some(cam)) => PathBuf::from(format!("cam{cam}.cdf")),
+        (None, None) => bail!("which camera: --camera N (writes camN.cdf) or --out FILE.cdf"),
+    };
+    let name = match a.camera {
+        Some(cam) => format!("camera {cam}"),
+        None => out.display().to_string(),
+    };
     if a.images.is_empty() {
         bail!("no images: give the images of the plate after the options");
     }
     if a.extrinsic {
         return extrinsic(&a, &plate, &out);
     }
-    let profile = g.load_profile()?;
     let (sx, sy) = match &a.scale {
-        Some(s) => match s[..] {
-            [x, y] if x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite() => (x, y),
-            _ => bail!("--scale {s:?}: two positive numbers, mm per pixel"),
+        Some(s) => match pair("--scale", s, "SX,SY, two positive numbers (mm per pixel)")? {
+            [x, y] if x > 0.0 && y > 0.0 => (x, y),
+            _ => bail!("--scale {s}: SX,SY, two positive numbers (mm per pixel); nothing written"),
         },
-        None => stated_scale(&profile, cam)?,
+        None => match a.camera {
+            Some(cam) => stated_scale(&g.load_profile()?, cam)?,
+            None => out_scale(&out)?,
+        },
     };
     let images = read_images(&a.images)?;
     let (w, h) = images.first().map(|i| i.1.size()).unwrap_or_default();
     if let Some((name, img)) = images.iter().find(|i| i.1.size() != (w, h)) {
         bail!(
-            "{name} is {} × {}, the first image {w} × {h}: one camera's views share a size",
+            "{name} is {} × {}, the first image {w} × {h}: one camera's views share a size (a photograph resized or from another camera?); nothing written",
             img.width(),
             img.height()
         );
@@ -116,19 +150,13 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     let centre = match a.centre.as_deref() {
         None => None,
         Some("image") => Some([w as f64 / 2.0, h as f64 / 2.0]),
-        Some(s) => {
-            let v: Vec<f64> = s.split(',').filter_map(|t| t.trim().parse().ok()).collect();
-            match v[..] {
-                [x, y] if x.is_finite() && y.is_finite() => Some([x, y]),
-                _ => bail!("--centre {s}: X,Y in pixels, or `image`"),
-            }
-        }
+        Some(s) => Some(pair("--centre", s, "X,Y in pixels, or `image`")?),
     };
     if out.exists() && !a.yes {
         bail!(
-            "{} exists: --yes replaces its S, C, f and D (its other entries are kept, the old file as {}.bak), or choose another --out",
+            "{} exists: --yes replaces its S, C, f and D (its other entries are kept, the old file as {}), or choose another --out",
             out.display(),
-            out.display()
+            calib::backup_name(&out).display()
         );
     }
     outln!("plate {}: {}", plate.name, plate.describe());
@@ -139,37 +167,56 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         eprintln!("vss: {name}: left out: {e}");
     }
     let views: Vec<View> = found.views.iter().map(|(v, _)| v.clone()).collect();
+    let options = calib::Options {
+        width: w,
+        height: h,
+        sx,
+        sy,
+        estimate_scale: a.estimate_scale,
+        centre,
+        full_model: a.model == Model::Full,
+    };
     let t1 = Instant::now();
-    let result = calib::calibrate(
-        &views,
-        &calib::Options {
-            width: w,
-            height: h,
-            sx,
-            sy,
-            estimate_scale: a.estimate_scale,
-            centre,
-        },
-    );
+    let result = calib::calibrate(&views, &options);
     let solve_ms = t1.elapsed().as_secs_f64() * 1e3;
-    let c = result.map_err(|e| anyhow::anyhow!("{e}; nothing written"))?;
+    let c = result.map_err(|e| {
+        let refused = if found.refused.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " ({} of {} images left out, each with its reason above)",
+                found.refused.len(),
+                images.len()
+            )
+        };
+        anyhow::anyhow!("{e}{refused}; nothing written")
+    })?;
     print_calibration(&c)?;
     outln!(
         "grid detection {:.1} ms a view, solution {solve_ms:.0} ms ({} evaluations)",
         detect_ms / images.len().max(1) as f64,
         c.evaluations
     );
+    match calib::cross_validate(&views, &options) {
+        Some(x) => outln!(
+            "cross-validation (two calibrations from alternate views): held-out views RMS {:.3} px; the two differ in projection by {:.3} px RMS, {:.3} px at most",
+            x.held_out_rms,
+            x.difference_rms,
+            x.difference_max
+        ),
+        None => outln!("cross-validation: needs 6 views (3 a half) that each calibrate"),
+    }
     for w in &c.warnings {
         outln!("warning: {w}");
     }
-    let existed = out.exists();
-    calib::write_intrinsics(&out, &c)?;
+    // The report first: if it cannot be written, the .cdf is left as it was.
     if let Some(r) = &a.report {
-        let ps = crate::report::calibration::document(cam, &c);
+        let ps = crate::report::calibration::document_named(&name, &c);
         crate::fsutil::write_atomic(r, ps.as_bytes())
-            .with_context(|| format!("cannot write {}", r.display()))?;
+            .with_context(|| format!("cannot write {}; nothing written", r.display()))?;
         outln!("wrote the calibration page {}", r.display());
     }
+    let bak = calib::write_intrinsics(&out, &c)?;
     outln!(
         "wrote {}: C{} f D calibrated, S {}{}",
         out.display(),
@@ -179,13 +226,25 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         } else {
             "stated"
         },
-        if existed {
-            format!("; the old file kept as {}.bak", out.display())
-        } else {
-            String::new()
+        match bak {
+            Some(b) => format!("; the old file kept as {}", b.display()),
+            None => String::new(),
         }
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// `S` of the `.cdf` at `out` (when no camera is named).
+fn out_scale(out: &Path) -> anyhow::Result<(f64, f64)> {
+    let hint = "give --scale SX,SY (mm per pixel, from the camera's data sheet)";
+    if !out.exists() {
+        bail!(
+            "{} does not exist yet, so no scale S: {hint}",
+            out.display()
+        );
+    }
+    let c = cdf::read_cdf(out).with_context(|| format!("the scale S: {hint}"))?;
+    calib::scale_of(&c).with_context(|| format!("{} has no scale S: {hint}", out.display()))
 }
 
 /// `S` of camera `cam`'s `.cdf` in the profile.
@@ -224,6 +283,9 @@ fn print_calibration(c: &Calibration) -> anyhow::Result<()> {
     );
     for l in calib::parameter_lines(c, "±") {
         outln!("{l}");
+    }
+    if c.centre_stated {
+        outln!("C stated, so the uncertainty of projection leaves out that of C");
     }
     Ok(())
 }
@@ -297,11 +359,11 @@ fn extrinsic(a: &Args, plate: &Plate, out: &Path) -> anyhow::Result<ExitCode> {
         e.se_translation[1],
         e.se_translation[2]
     );
-    calib::write_extrinsic(out, &old, &e.t)?;
+    let bak = calib::write_extrinsic(out, &old, &e.t)?.1;
     outln!(
-        "wrote T into {} (its other entries kept, the old file as {}.bak)",
+        "wrote T into {} (its other entries kept, the old file as {})",
         out.display(),
-        out.display()
+        bak.map_or("-".into(), |b| b.display().to_string())
     );
     Ok(ExitCode::SUCCESS)
 }

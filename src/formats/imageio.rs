@@ -26,6 +26,8 @@ pub enum ImageKind {
     Pgm,
     Tiff,
     Bmp,
+    /// Read for photographs (calibration); written lossy.
+    Jpeg,
 }
 
 /// Largest decoded image we accept from a foreign format (bytes).
@@ -41,6 +43,7 @@ impl ImageKind {
             "pgm" | "pnm" => ImageKind::Pgm,
             "tif" | "tiff" => ImageKind::Tiff,
             "bmp" => ImageKind::Bmp,
+            "jpg" | "jpeg" => ImageKind::Jpeg,
             _ => return None,
         })
     }
@@ -56,7 +59,7 @@ impl ImageKind {
                 path,
                 Location::None,
                 K::Unsupported,
-                "unknown image extension; expected .img, .imc, .png, .pgm, .tif, .tiff or .bmp",
+                "unknown image extension; expected .img, .imc, .png, .pgm, .tif, .tiff, .bmp or .jpg",
             )
         })
     }
@@ -103,6 +106,7 @@ fn foreign_size(bytes: &[u8], kind: ImageKind) -> Option<(usize, usize)> {
         ImageKind::Pgm => image::ImageFormat::Pnm,
         ImageKind::Tiff => image::ImageFormat::Tiff,
         ImageKind::Bmp => image::ImageFormat::Bmp,
+        ImageKind::Jpeg => image::ImageFormat::Jpeg,
     };
     let (w, h) = image::ImageReader::with_format(Cursor::new(bytes), fmt)
         .into_dimensions()
@@ -126,6 +130,7 @@ pub fn decode_any(
         ImageKind::Pgm => decode_foreign(bytes, image::ImageFormat::Pnm, path, limit),
         ImageKind::Tiff => decode_foreign(bytes, image::ImageFormat::Tiff, path, limit),
         ImageKind::Bmp => decode_foreign(bytes, image::ImageFormat::Bmp, path, limit),
+        ImageKind::Jpeg => decode_foreign(bytes, image::ImageFormat::Jpeg, path, limit),
     }
 }
 
@@ -148,6 +153,7 @@ pub fn encode_any(f: &ImgFile, kind: ImageKind) -> Result<Vec<u8>, FormatError> 
         ImageKind::Pgm => encode_foreign(f, image::ImageFormat::Pnm),
         ImageKind::Tiff => encode_foreign(f, image::ImageFormat::Tiff),
         ImageKind::Bmp => encode_foreign(f, image::ImageFormat::Bmp),
+        ImageKind::Jpeg => encode_foreign(f, image::ImageFormat::Jpeg),
     }
 }
 

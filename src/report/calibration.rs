@@ -73,8 +73,13 @@ pub fn magnification(c: &Calibration) -> f64 {
 
 /// Adds the calibration page of camera `camera` to `doc`.
 pub fn page(doc: &mut PsDoc, camera: u32, c: &Calibration) {
+    page_named(doc, &format!("camera {camera}"), c);
+}
+
+/// Adds the calibration page of the camera called `name` to `doc`.
+pub fn page_named(doc: &mut PsDoc, name: &str, c: &Calibration) {
     let (w, h) = (c.width.max(1) as f64, c.height.max(1) as f64);
-    let mut body = page_heading(&format!("camera {camera}: calibration"), 0, 1);
+    let mut body = page_heading(&format!("{name}: calibration"), 0, 1);
     let k = magnification(c);
     // Residuals: each corner a dot, its residual a line from it.
     let _ = writeln!(body, "gsave\n{w} {h} 0 0 2 2 place");
@@ -137,7 +142,12 @@ pub fn page(doc: &mut PsDoc, camera: u32, c: &Calibration) {
 
 /// A document of one calibration page.
 pub fn document(camera: u32, c: &Calibration) -> String {
-    let mut doc = PsDoc::new(&format!("camera {camera} calibration"));
-    page(&mut doc, camera, c);
+    document_named(&format!("camera {camera}"), c)
+}
+
+/// The calibration page of the camera called `name` as a PostScript file.
+pub fn document_named(name: &str, c: &Calibration) -> String {
+    let mut doc = PsDoc::new(&format!("{name} calibration"));
+    page_named(&mut doc, name, c);
     doc.finish()
 }

@@ -34,7 +34,7 @@ mod session;
 mod survey;
 mod tracker;
 
-pub use calibrate::{CalibrateScreen, PLATE};
+pub use calibrate::{CalibrateScreen, Centre, Field, PLATE, short_name};
 pub use capture::CaptureScreen;
 pub use cell::{CellState, DeviceState};
 pub use chrome::{Chrome, LogView, Overlay};

@@ -205,8 +205,16 @@ pub enum CalibrateAction {
     Drop,
     /// The centre `C` solved or stated at the image's middle.
     Centre,
+    /// The centre `C` stated at coordinates typed.
+    CentreAt,
     Solve,
     Accept,
+    /// Load images from files (a folder or a list, typed).
+    Open,
+    /// Show the next image loaded from files.
+    Next,
+    /// Choose the plate file (typed).
+    PlateFile,
 }
 
 /// Questions and text fields.

@@ -10,6 +10,7 @@ mod accuracy_cli;
 mod calib;
 mod calib_cli;
 mod calib_console;
+mod calib_real;
 mod cli_formats;
 mod cli_pipe;
 mod cli_standalone;

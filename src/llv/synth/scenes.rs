@@ -140,11 +140,14 @@ pub fn cell_scene() -> Scene {
 pub fn cell_cameras(width: usize, height: usize) -> Vec<Camera> {
     let scene = cell_scene();
     let fit: Vec<V3> = scene.objects.iter().flat_map(|o| o.vertices()).collect();
+    // Weng's folded D = (k1, g1, g2, g3, g4) of a lens with radial and
+    // decentering distortion and no thin prism, as real lenses have
+    // (g1 = g3 / 2, g2 = g4 / 2; docs/calibration.md).
     let dists: [[f64; 5]; 4] = [
-        [-0.000527, 0.000379, 0.001330, -0.000703, -0.001406],
-        [-0.000490, -0.000200, 0.000760, 0.000340, -0.000640],
-        [-0.000450, 0.000520, -0.001100, -0.000300, 0.001000],
-        [-0.000420, -0.000240, 0.000420, 0.000390, 0.000540],
+        [-0.000527, 0.0003515, -0.000703, 0.000703, -0.001406],
+        [-0.000490, 0.000170, -0.000320, 0.000340, -0.000640],
+        [-0.000450, -0.000150, 0.000500, -0.000300, 0.001000],
+        [-0.000420, 0.000156, 0.000216, 0.000312, 0.000432],
     ];
     let focal = [11.892729, 12.1, 11.95, 12.05];
     let centre = [(0.0, 0.0), (1.5, -1.0), (-1.0, 2.0), (2.0, 1.0)];

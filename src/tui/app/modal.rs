@@ -44,6 +44,8 @@ pub enum Pending {
 pub enum PromptPurpose {
     SessionName,
     ParamValue(&'static str),
+    /// The Calibrate screen's fields (images to load, plate, centre).
+    Calibrate(super::calibrate::Field),
 }
 
 /// A one-line text field.
@@ -345,6 +347,10 @@ impl App {
                     }
                     Err(e) => Err(e.to_string()),
                 }
+            }
+            PromptPurpose::Calibrate(field) => {
+                let (s, mut ctx) = self.parts();
+                s.calibrate.submitted(field, p.text.trim(), &mut ctx)
             }
         };
         match result {

@@ -127,10 +127,14 @@ pub const KEYMAP: &[Binding] = rows! {
     CB, ch('g'), Calibrate(Grab), "grab one frame", "grab";
     CB, ch('c'), Calibrate(Camera), "next camera", "camera";
     CB, ch(' '), Calibrate(Keep), "keep this view (its grid was found)", "keep";
-    CB, k(K::Backspace), Calibrate(Drop), "drop the last view kept", "";
+    CB, k(K::Backspace), Calibrate(Drop), "drop the photograph shown, or the last view kept", "";
     CB, ch('s'), Calibrate(Centre), "centre C: solved / stated at the image's middle", "centre";
     CB, k(K::Enter), Calibrate(Solve), "compute the calibration from the views kept", "compute";
     CB, ch('a'), Calibrate(Accept), "accept: write the camera's .cdf (asks first)", "accept";
+    CB, ch('o'), Calibrate(Open), "load photographs: a folder or files (typed); the grid found in each is kept", "open";
+    CB, ch('n'), Calibrate(Next), "show the next photograph loaded, with its corners", "next";
+    CB, ch('f'), Calibrate(PlateFile), "choose the plate: a built-in name or a plate file (typed)", "";
+    CB, ch('S'), Calibrate(CentreAt), "centre C stated at X,Y (typed)", "";
     // Capture.
     CA, ch('v'), Capture(ToggleLive), "live view on/off", "live";
     CA, ch('g'), Capture(Grab), "grab one frame", "grab";

@@ -1,8 +1,10 @@
-//! The Calibrate screen: the plate's grid drawn over the live view or a
-//! grab, the views kept with a map of where the plate's corners have been
-//! seen, and after `Enter` the parameters with their standard errors, the
-//! worst views and the residuals magnified in Braille. The state and keys
-//! are in `app/calibrate.rs`.
+//! The Calibrate screen: the plate's grid drawn over the live view, a grab
+//! or a photograph loaded from a file, the views kept with a map of where
+//! the plate's corners have been seen, and after `Enter` the parameters with
+//! their standard errors, the worst views and the residuals magnified: the
+//! mean residual of the corners in each cell of a grid sized to the pane, so
+//! that even at 80 × 24 the picture shows where the fit is off, not a blot
+//! of every corner's vector. The state and keys are in `app/calibrate.rs`.
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -12,7 +14,8 @@ use ratatui::widgets::{Paragraph, Widget, Wrap};
 use super::{Theme, block, split_panel};
 use crate::calib::{self, COVERAGE, Calibration, Detection, View};
 use crate::llv::{Point, Segment};
-use crate::tui::app::{App, CalibrateScreen, PLATE};
+use crate::tui::app::{App, CalibrateScreen};
+use crate::tui::app::{Centre, short_name};
 use crate::tui::widgets::preview::{Layer, Preview, PreviewMode};
 
 /// The cells found, as outlines to draw over the picture.
@@ -28,16 +31,33 @@ fn outlines(d: &Detection) -> Vec<Segment> {
         .collect()
 }
 
-/// The residual vectors, magnified, as segments from each corner.
-fn residuals(c: &Calibration) -> Vec<Segment> {
+/// The residuals, magnified: the mean residual of the corners in each cell
+/// of a `cols × rows` grid over the image, a segment from the cell's mean
+/// corner position.
+fn residuals(c: &Calibration, cols: usize, rows: usize) -> Vec<Segment> {
     let k = crate::report::calibration::magnification(c);
-    c.views
-        .iter()
-        .flat_map(|v| v.residuals.iter())
-        .map(|(p, r)| {
+    let (cols, rows) = (cols.max(1), rows.max(1));
+    let mut sums = vec![([0.0f64; 4], 0usize); cols * rows];
+    for (p, r) in c.views.iter().flat_map(|v| v.residuals.iter()) {
+        let i = ((p[0] / c.width.max(1) as f64 * cols as f64).floor() as isize)
+            .clamp(0, cols as isize - 1) as usize;
+        let j = ((p[1] / c.height.max(1) as f64 * rows as f64).floor() as isize)
+            .clamp(0, rows as isize - 1) as usize;
+        let e = &mut sums[j * cols + i];
+        e.0[0] += p[0];
+        e.0[1] += p[1];
+        e.0[2] += r[0];
+        e.0[3] += r[1];
+        e.1 += 1;
+    }
+    sums.iter()
+        .filter(|(_, n)| *n > 0)
+        .map(|(s, n)| {
+            let n = *n as f64;
+            let (x, y) = (s[0] / n, s[1] / n);
             Segment::new(
-                Point::new(p[0], p[1]),
-                Point::new(p[0] + k * r[0] + 0.5, p[1] + k * r[1] + 0.5),
+                Point::new(x, y),
+                Point::new(x + k * s[2] / n + 0.5, y + k * s[3] / n + 0.5),
             )
         })
         .collect()
@@ -45,6 +65,28 @@ fn residuals(c: &Calibration) -> Vec<Segment> {
 
 /// The panel's line on the grid in the latest frame.
 fn grid_line(s: &CalibrateScreen, cam: u32, t: Theme) -> Line<'static> {
+    if let Some(p) = s.shown_photo(cam) {
+        let i = s.shown.unwrap_or(0) + 1;
+        let n = s.photos.len();
+        return match &p.found {
+            Ok(d) => Line::styled(
+                format!(
+                    "photo {i}/{n}: {} corners, {} (n)",
+                    d.corners.len(),
+                    if s.is_kept(cam, &p.name) {
+                        "kept"
+                    } else {
+                        "dropped"
+                    }
+                ),
+                t.ok(),
+            ),
+            Err(e) => Line::styled(
+                format!("photo {i}/{n}: {}", e.split(": ").next().unwrap_or(e)),
+                t.warn(),
+            ),
+        };
+    }
     match &s.last {
         Some((c, Ok(d))) if *c == cam => {
             Line::styled(format!("grid: {} corners found", d.corners.len()), t.ok())
@@ -105,7 +147,10 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         super::panel_width(crate::tui::keymap::ScreenId::Calibrate),
     );
     let mut lines = vec![
-        Line::styled(format!("camera {cam} (c)  plate {PLATE}"), t.title()),
+        Line::styled(
+            format!("camera {cam} (c) plate {} (f)", short_name(&s.plate_name)),
+            t.title(),
+        ),
         Line::raw(format!(
             "live {} (v)  plate {} (p)",
             if app.cell.device.live { "ON" } else { "off" },
@@ -127,14 +172,11 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         let ascii = app.chrome.look.mode == PreviewMode::Ascii;
         lines.extend(coverage_lines(&views, s.size, ascii, t));
     }
-    lines.push(Line::raw(format!(
-        "centre C: {} (s)",
-        if s.centre_stated {
-            "stated, image middle"
-        } else {
-            "solved"
-        }
-    )));
+    lines.push(Line::raw(match s.centre {
+        Centre::Solved => "centre C: solved (s, S)".to_string(),
+        Centre::Middle => "centre C: stated, image middle (s)".to_string(),
+        Centre::At([x, y]) => format!("centre C: stated {x},{y} (S)"),
+    }));
     match solved {
         Some(c) => {
             lines.push(Line::styled(
@@ -143,8 +185,10 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
             ));
             for p in &c.params {
                 lines.push(Line::raw(format!(
-                    "{:<3}{:>13.6} ±{:.1e}",
-                    p.name, p.value, p.se
+                    "{:<3}{:>13.6} ±{}",
+                    p.name,
+                    p.value,
+                    calib::sig3(p.se)
                 )));
             }
             let mut worst: Vec<_> = c.views.iter().collect();
@@ -173,11 +217,18 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     if let Some((c_cam, c)) = &s.result
         && *c_cam == cam
     {
-        let segs = residuals(c);
+        let probe = block(app, "residuals");
+        let room = probe.inner(right);
+        // A cell of the grid for every four columns and two rows.
+        let (cols, rows) = (
+            (usize::from(room.width) / 4).clamp(2, 24),
+            (usize::from(room.height) / 2).clamp(2, 16),
+        );
+        let segs = residuals(c, cols, rows);
         let b = block(
             app,
             &format!(
-                "residuals ×{} over {} corners",
+                "mean residual ×{} in {} cells",
                 crate::report::calibration::magnification(c),
                 segs.len()
             ),
@@ -193,9 +244,31 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         p.render(inner, buf);
         return;
     }
+    if let Some(photo) = s.shown_photo(cam) {
+        let title = format!(
+            "{} {}/{}",
+            short_name(&photo.name),
+            s.shown.unwrap_or(0) + 1,
+            s.photos.len()
+        );
+        let b = block(app, &title);
+        let inner = b.inner(right);
+        b.render(right, buf);
+        let grid = match &photo.found {
+            Ok(d) => outlines(d),
+            Err(_) => Vec::new(),
+        };
+        Preview::new(
+            Layer::LinesOver(&photo.image, &grid),
+            app.chrome.look.mode,
+            app.chrome.look.colour,
+        )
+        .render(inner, buf);
+        return;
+    }
     let title = match &app.cell.live {
         Some((c, img)) => format!("camera {c} {}×{}", img.width(), img.height()),
-        None => "no picture: v live, g grab".into(),
+        None => "no picture: v live, g grab, o files".into(),
     };
     let b = block(app, &title);
     let inner = b.inner(right);
