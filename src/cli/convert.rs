@@ -25,12 +25,14 @@ pub struct Args {
 }
 
 pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
-    let out_kind = ImageKind::of(&a.output).with_context(|| {
-        format!(
-            "{}: unknown output format; use .img, .imc, .png, .pgm, .tif, .tiff or .bmp",
-            a.output.display()
-        )
-    })?;
+    let out_kind = ImageKind::of(&a.output)
+        .filter(|k| *k != ImageKind::Jpeg)
+        .with_context(|| {
+            format!(
+                "{}: unknown output format; use .img, .imc, .png, .pgm, .tif, .tiff or .bmp",
+                a.output.display()
+            )
+        })?;
     let (mut f, notes) = read_any_noted(&a.input)?;
     let in_kind = ImageKind::of(&a.input);
     for n in notes {

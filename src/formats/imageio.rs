@@ -26,7 +26,7 @@ pub enum ImageKind {
     Pgm,
     Tiff,
     Bmp,
-    /// Read for photographs (calibration); written lossy.
+    /// Read only: photographs (calibration).
     Jpeg,
 }
 
@@ -153,7 +153,12 @@ pub fn encode_any(f: &ImgFile, kind: ImageKind) -> Result<Vec<u8>, FormatError> 
         ImageKind::Pgm => encode_foreign(f, image::ImageFormat::Pnm),
         ImageKind::Tiff => encode_foreign(f, image::ImageFormat::Tiff),
         ImageKind::Bmp => encode_foreign(f, image::ImageFormat::Bmp),
-        ImageKind::Jpeg => encode_foreign(f, image::ImageFormat::Jpeg),
+        ImageKind::Jpeg => Err(FormatError::new(
+            Path::new("<image>"),
+            Location::None,
+            K::Unsupported,
+            "JPEG is read only (photographs for calibration); write .img, .png, .pgm, .tif or .bmp",
+        )),
     }
 }
 
