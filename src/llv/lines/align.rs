@@ -267,13 +267,14 @@ mod tests {
 
     #[test]
     fn a_line_running_on_past_its_edge_is_cut_there() {
-        // A vertical step on rows 0..32 only; below it, texture.
+        // A vertical step on rows 0..16 only; below it, texture: the line
+        // as a whole is not beyond chance, and its edge part is kept.
         let (w, h) = (64, 64);
         let mut r = crate::llv::synth::rng::SplitMix64::new(5);
         let px: Vec<u8> = (0..w * h)
             .map(|i| {
                 let (x, y) = (i % w, i / w);
-                if y < 32 {
+                if y < 16 {
                     if x < 32 { 50 } else { 150 }
                 } else {
                     (r.uniform() * 255.0) as u8
@@ -281,11 +282,13 @@ mod tests {
             })
             .collect();
         let img = GreyImage::new(w, h, px).unwrap();
+        // (0.9: the photographs profile's; at 0.6 a stretch of this
+        // texture, 11 of 17 aligned, would pass too.)
         let mut lines = vec![line(31.5, 2.0, 31.5, 60.0)];
-        keep_aligned(&[img], &mut lines, 0.6, 8.0, &mut AlignScratch::default());
+        keep_aligned(&[img], &mut lines, 0.9, 8.0, &mut AlignScratch::default());
         assert_eq!(lines.len(), 1, "{lines:?}");
         let l = lines[0];
         assert_eq!(l.a, Point::new(31.5, 2.0));
-        assert!((l.b.y - 32.0).abs() < 3.0, "{l:?}");
+        assert!((l.b.y - 16.0).abs() < 3.0, "{l:?}");
     }
 }

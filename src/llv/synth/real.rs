@@ -460,13 +460,14 @@ mod tests {
     #[test]
     fn rule_by_hand() {
         // A true edge of 10 px; a detection along its first 5 px, 1.5 px
-        // off and 3° turned: all of it true, half the edge found.
+        // off and 3° turned: all of it true, and the edge found up to
+        // about x = 6 (within 2 px of the detection's end, ends included).
         let truth = [seg(0.0, 0.0, 10.0, 0.0)];
         let t = 3f64.to_radians();
         let det = [seg(0.0, 1.5, 5.0 * t.cos(), 1.5 + 5.0 * t.sin())];
         let m = score_real(&det, &truth);
         assert!((m.precision - 1.0).abs() < 1e-9, "{m:?}");
-        assert!((m.recall - 0.5).abs() < 0.06, "{m:?}");
+        assert!((m.recall - 0.6).abs() < 0.011, "{m:?}");
         // 6° off: nothing matches; 2.5 px off: nothing.
         let t = 6f64.to_radians();
         let det = [seg(0.0, 0.0, 5.0 * t.cos(), 5.0 * t.sin())];
