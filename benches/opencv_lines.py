@@ -44,6 +44,11 @@ import time
 
 import cv2
 
+try:
+    import pytlsd
+except ImportError:  # pytlsd is optional: `pip install pytlsd`
+    pytlsd = None
+
 
 def detectors():
     """The OpenCV detectors, each a function from image to an (N, 4) list."""
@@ -55,11 +60,25 @@ def detectors():
         ed.detectEdges(img)
         return ed.detectLines()
 
-    return [
+    dets = [
         ("FLD", fld.detect),
         ("EDLines", edlines),
         ("LSD", lambda img: lsd.detect(img)[0]),
     ]
+    if pytlsd is not None:
+        # pytlsd is the authors' LSD in C: the image's pixel (0, 0) over
+        # [0, 1]^2 (checked on the photographs: scored with vss's convention
+        # its segments lie 0.5 px off). Shifted to pixel centres at whole
+        # coordinates, as every other file here.
+        dets.append(("pytlsd", lambda img: tlsd(img)))
+    return dets
+
+
+def tlsd(img):
+    found = pytlsd.lsd(img.astype("float64"))
+    if found is None or len(found) == 0:
+        return []
+    return [tuple(float(v) - 0.5 for v in s[:4]) for s in found]
 
 
 def timed(detect, img, runs):
@@ -78,6 +97,8 @@ def timed(detect, img, runs):
 def rows(found):
     if found is None:
         return []
+    if isinstance(found, list):
+        return found
     return [tuple(float(v) for v in s.reshape(-1)[:4]) for s in found]
 
 
@@ -195,6 +216,84 @@ def compare(argv):
         f.write(scores)
 
 
+def real(argv):
+    """Every detector on a folder of photographs with `NAME_gt.txt` files,
+    scored by vss's real-photograph scorer (`vss selftest --score-real`)."""
+    p = argparse.ArgumentParser(prog="opencv_lines.py real")
+    p.add_argument("--photos", default="../shared/data/yud-tune")
+    p.add_argument("--vss", default="target/release/vss")
+    p.add_argument("--dir", default="/tmp/vss-real")
+    p.add_argument("--runs", type=int, default=5)
+    p.add_argument("--elsed", default=None, help="the ELSED driver (benches/elsed_bench.cpp)")
+    p.add_argument("--rounds", type=int, default=1,
+                   help="time everything this many times, alternating, and keep each image's fastest")
+    p.add_argument("--skip-vss", action="store_true", help="reuse DIR's vss segments and times")
+    p.add_argument("--profile", default=None,
+                   help="vss's profile (e.g. profiles/photographs.toml; default: the built-in one)")
+    a = p.parse_args(argv)
+    cv2.setNumThreads(1)
+    os.makedirs(a.dir, exist_ok=True)
+    photos = sorted(
+        f for f in os.listdir(a.photos)
+        if f.lower().endswith((".jpg", ".jpeg", ".png", ".pgm"))
+        and os.path.exists(os.path.join(a.photos, os.path.splitext(f)[0] + "_gt.txt"))
+    )
+    if not photos:
+        sys.exit(f"{a.photos}: no photographs with NAME_gt.txt beside them")
+    print(f"OpenCV {cv2.__version__}, one thread; vss {a.vss}; {len(photos)} photographs",
+          file=sys.stderr)
+    best = {}
+    for r in range(max(a.rounds, 1)):
+        if not a.skip_vss:
+            prof = ["--profile", a.profile] if a.profile else []
+            subprocess.run([a.vss, *prof, "selftest", "--export-real", a.photos, "--dir", a.dir,
+                            "--runs", str(a.runs)], check=True)
+        dets = detectors()
+        times = {name: [] for name, _ in dets}
+        for f in photos:
+            stem = os.path.splitext(f)[0]
+            img = cv2.imread(os.path.join(a.photos, f), cv2.IMREAD_GRAYSCALE)
+            if img is None:
+                sys.exit(f"{f}: not an image OpenCV can read")
+            for name, detect in dets:
+                found, fastest, median = timed(detect, img, a.runs)
+                write_segments(os.path.join(a.dir, f"{stem}.{name}.seg"), name, rows(found))
+                times[name].append((stem, fastest, median))
+        for name, t in times.items():
+            with open(os.path.join(a.dir, f"{name}.times"), "w") as out:
+                out.write(f"# photo fastest_ms median_ms runs ({name}, in-process, one thread)\n")
+                for stem, fastest, median in t:
+                    out.write(f"{stem} {fastest:.4f} {median:.4f} {a.runs}\n")
+        if a.elsed:
+            # The driver writes IMAGE.ELSED.seg beside the image (less a
+            # .pgm): links in DIR/img keep the photographs' folder untouched.
+            img_dir = os.path.join(a.dir, "img")
+            os.makedirs(img_dir, exist_ok=True)
+            links = []
+            for f in photos:
+                link = os.path.join(img_dir, f)
+                if not os.path.lexists(link):
+                    os.symlink(os.path.abspath(os.path.join(a.photos, f)), link)
+                links.append(link)
+            out = subprocess.run([a.elsed, str(a.runs), "ELSED", *links], check=True,
+                                 capture_output=True, text=True).stdout
+            with open(os.path.join(a.dir, "ELSED.times"), "w") as t:
+                t.write("# photo fastest_ms median_ms runs (ELSED, C++, in-process, one thread)\n")
+                for line in out.splitlines():
+                    path, fastest, median, n = line.split()
+                    stem = os.path.splitext(os.path.basename(path))[0]
+                    os.replace(path + ".ELSED.seg", os.path.join(a.dir, f"{stem}.ELSED.seg"))
+                    t.write(f"{stem} {fastest} {median} {n}\n")
+        keep_fastest(a.dir, best)
+        if a.rounds > 1:
+            print(f"round {r + 1} of {a.rounds} done", file=sys.stderr)
+    cmd = [a.vss, "selftest", "--score-real", a.photos, "--dir", a.dir]
+    print(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout, end="")
+    scores = subprocess.run(cmd + ["--json"], check=True, capture_output=True, text=True).stdout
+    with open(os.path.join(a.dir, "scores.json"), "w") as f:
+        f.write(scores)
+
+
 def bench(name, detect, runs):
     found, fastest, median = timed(detect, bench.img, runs)
     n = 0 if found is None else len(found)
@@ -215,9 +314,11 @@ def one_image(argv):
 
 def main():
     if len(sys.argv) < 2:
-        sys.exit("usage: opencv_lines.py compare [OPTIONS] | opencv_lines.py SCENE.pgm [RUNS]")
+        sys.exit("usage: opencv_lines.py compare|real [OPTIONS] | opencv_lines.py SCENE.pgm [RUNS]")
     if sys.argv[1] == "compare":
         compare(sys.argv[2:])
+    elif sys.argv[1] == "real":
+        real(sys.argv[2:])
     else:
         one_image(sys.argv[1:])
 

@@ -1,5 +1,6 @@
 //! `vss convert IN OUT`: grey images between the grabber's `.img`/`.imc` and
-//! PNG, PGM, TIFF, BMP (formats chosen by extension). PNG keeps an `.img`'s
+//! PNG, PGM, TIFF, BMP, and from JPEG photographs (formats chosen by
+//! extension; JPEG is read, not written). PNG keeps an `.img`'s
 //! comment and upper-left corner, so `.img → .png → .img` is exact. Notes
 //! (colour reduced to grey, comment dropped) go to stderr; on any error
 //! nothing is written.
@@ -14,7 +15,7 @@ use crate::formats::imageio::{ImageKind, read_any_noted, write_any};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Input image: .img, .imc, .png, .pgm, .tif, .tiff or .bmp.
+    /// Input image: .img, .imc, .png, .pgm, .tif, .tiff, .bmp, .jpg or .jpeg.
     pub input: PathBuf,
     /// Output image; the extension picks the format.
     pub output: PathBuf,
@@ -25,14 +26,18 @@ pub struct Args {
 }
 
 pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
-    let out_kind = ImageKind::of(&a.output)
-        .filter(|k| *k != ImageKind::Jpeg)
-        .with_context(|| {
-            format!(
-                "{}: unknown output format; use .img, .imc, .png, .pgm, .tif, .tiff or .bmp",
-                a.output.display()
-            )
-        })?;
+    let out_kind = ImageKind::of(&a.output).with_context(|| {
+        format!(
+            "{}: unknown output format; use .img, .imc, .png, .pgm, .tif, .tiff or .bmp",
+            a.output.display()
+        )
+    })?;
+    if !out_kind.writable() {
+        anyhow::bail!(
+            "{}: vss reads JPEG but does not write it (lossy); use .png, .pgm, .tif or .bmp",
+            a.output.display()
+        );
+    }
     let (mut f, notes) = read_any_noted(&a.input)?;
     let in_kind = ImageKind::of(&a.input);
     for n in notes {

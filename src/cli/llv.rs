@@ -36,7 +36,7 @@ use crate::session::{FrameRule, Runner};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Grey images (.img .imc .png .pgm .tif .bmp); lightings of one view
+    /// Grey images (.img .imc .png .pgm .tif .bmp .jpg); lightings of one view
     /// (cube1a.img cube1b.img) are combined.
     #[arg(required_unless_present = "from_edges", conflicts_with = "from_edges")]
     pub images: Vec<PathBuf>,
@@ -230,7 +230,11 @@ fn run_group(
         .iter()
         .map(|f| {
             // The size from the header, before the pixels are read.
-            imageio::read_any_sized(f, crate::llv::image::check_stage_size).map(|(f, _)| f)
+            let (img, notes) = imageio::read_any_sized(f, crate::llv::image::check_stage_size)?;
+            for n in notes {
+                errln!("vss: note: {}: {n}", f.display());
+            }
+            Ok::<_, crate::formats::FormatError>(img)
         })
         .collect::<Result<_, _>>()?;
     // Sizes first: a lens map is made for the size before the stages run.

@@ -8,6 +8,13 @@
 //! `--export DIR` writes the same images, their truth and vss's segments
 //! and times for other detectors to run on; `--score DIR` scores every
 //! detector found there with the same scorer (`llv::synth::compare`).
+//!
+//! Real photographs (`llv::synth::real`): `--score-real PHOTOS` runs vss
+//! on every photograph with a `NAME_gt.txt` and scores it by the
+//! length-based rule of the photographs' README; with `--dir DIR` it scores
+//! instead every detector's `NAME.DET.seg` in DIR. `--export-real PHOTOS
+//! --dir DIR` writes vss's segments and times there (for
+//! `benches/opencv_lines.py real`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -18,6 +25,7 @@ use super::Global;
 use crate::llv::synth::compare::{self, ExportConfig};
 use crate::llv::synth::eval::yard::{Level, YardConfig, YardReport, evaluate_yard};
 use crate::llv::synth::eval::{EvalConfig, EvalReport, evaluate};
+use crate::llv::synth::real;
 
 mod tables;
 
@@ -61,6 +69,20 @@ pub struct Args {
     /// running the pipeline.
     #[arg(long, value_name = "DIR")]
     pub score: Option<PathBuf>,
+    /// Score real photographs with NAME_gt.txt files in PHOTOS: vss run on
+    /// them, or with --dir, every detector's NAME.DET.seg in DIR.
+    #[arg(long, value_name = "PHOTOS", conflicts_with_all = ["score", "export", "export_real"])]
+    pub score_real: Option<PathBuf>,
+    /// Run vss on the photographs with NAME_gt.txt files in PHOTOS and write
+    /// its segments and times to --dir (for benches/opencv_lines.py real).
+    #[arg(long, value_name = "PHOTOS", conflicts_with_all = ["score", "export"], requires = "dir")]
+    pub export_real: Option<PathBuf>,
+    /// The folder of segment files for --score-real and --export-real.
+    #[arg(long, value_name = "DIR")]
+    pub dir: Option<PathBuf>,
+    /// Change a parameter for this run: --set edges.half_width=3 (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -100,7 +122,52 @@ fn configs(a: &Args) -> (Option<EvalConfig>, Option<YardConfig>) {
     (cubes.filter(|c| !c.noise.is_empty()), yard)
 }
 
+/// The profile's parameters with the `--set` changes.
+fn params(g: &Global, a: &Args) -> anyhow::Result<crate::llv::Params> {
+    let mut p = g.load_profile()?.llv;
+    for s in &a.set {
+        p.set_str(s).with_context(|| format!("--set {s}"))?;
+    }
+    p.validate()?;
+    Ok(p)
+}
+
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
+    if let Some(photos) = &a.export_real {
+        let p = params(g, &a)?;
+        let dir = a.dir.as_deref().context("--export-real needs --dir DIR")?;
+        let n = real::export_real(photos, dir, &p, a.runs)
+            .with_context(|| format!("running vss on the photographs of {}", photos.display()))?;
+        outln!(
+            "vss on {n} photographs: segments and times written to {}",
+            dir.display()
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    if let Some(photos) = &a.score_real {
+        let scores = match &a.dir {
+            Some(dir) => real::score_dir(photos, dir)?,
+            None => {
+                let p = params(g, &a)?;
+                let (m, _) = real::evaluate_real(photos, &p).with_context(|| {
+                    format!("running vss on the photographs of {}", photos.display())
+                })?;
+                vec![real::RealScore {
+                    detector: compare::VSS.into(),
+                    metrics: m,
+                    fastest_ms: None,
+                    median_ms: None,
+                }]
+            }
+        };
+        if a.json {
+            outln!("{}", serde_json::to_string(&scores)?);
+        } else {
+            let n = scores.first().map_or(0, |s| s.metrics.images);
+            out!("{}", real::table(&scores, n));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
     if let Some(dir) = &a.score {
         let scores = compare::score_dir(dir)?;
         if a.json {
@@ -119,7 +186,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     if a.scenes == 0 {
         anyhow::bail!("--scenes must be at least 1");
     }
-    let profile = g.load_profile()?;
+    let llv = params(g, &a)?;
     let (cubes, yard) = configs(&a);
     let name = g.profile.as_deref().unwrap_or("default");
     if let Some(dir) = &a.export {
@@ -128,7 +195,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             yard,
             runs: a.runs,
         };
-        let m = compare::export(dir, &cfg, &profile.llv)
+        let m = compare::export(dir, &cfg, &llv)
             .with_context(|| format!("exporting the scenes to {}", dir.display()))?;
         for f in &m.families {
             outln!(
@@ -144,11 +211,11 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let cube_report: Option<EvalReport> = cubes
-        .map(|c| evaluate(&c, &profile.llv))
+        .map(|c| evaluate(&c, &llv))
         .transpose()
         .context("running the pipeline on the cube scenes")?;
     let yard_report: Option<YardReport> = yard
-        .map(|y| evaluate_yard(&y, &profile.llv))
+        .map(|y| evaluate_yard(&y, &llv))
         .transpose()
         .context("running the pipeline on the yard scenes")?;
     if a.json {

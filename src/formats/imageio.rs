@@ -1,6 +1,17 @@
 //! Grey images in any format the console meets: the cell's `.img`/`.imc`,
-//! and PNG, PGM, TIFF, BMP for everything else. The format follows the file
-//! extension.
+//! and PNG, PGM, TIFF, BMP for everything else, and JPEG photographs (read
+//! only: a lossy copy of a survey image is not one). The format follows the
+//! file extension.
+//!
+//! JPEG: a colour photograph becomes its luma by the JPEG's own weights
+//! (BT.601, what the file's Y channel holds and what OpenCV's and libjpeg's
+//! grey readers give), not Rec. 709 as the other formats; an EXIF
+//! orientation is applied, so the lines come in the picture as every viewer
+//! shows it, and a note says so; CMYK is converted through RGB; progressive
+//! files decode as baseline ones; a file without its end-of-image marker
+//! (truncated) is refused, and so are 12-bit, lossless and damaged files,
+//! with the decoder's reason. The size is checked
+//! from the header before any pixel is decoded.
 //!
 //! PNG is read and written with the `png` crate directly so that an `.img`'s
 //! comment and upper-left corner travel in tEXt chunks (`vss.comment` — or
@@ -26,7 +37,7 @@ pub enum ImageKind {
     Pgm,
     Tiff,
     Bmp,
-    /// Read only: photographs (calibration).
+    /// `.jpg`, `.jpeg`: read only.
     Jpeg,
 }
 
@@ -53,13 +64,18 @@ impl ImageKind {
         matches!(self, ImageKind::Img | ImageKind::Png)
     }
 
+    /// Whether vss writes the format (JPEG it only reads).
+    pub fn writable(self) -> bool {
+        self != ImageKind::Jpeg
+    }
+
     fn of_or_err(path: &Path) -> Result<ImageKind, FormatError> {
         ImageKind::of(path).ok_or_else(|| {
             FormatError::new(
                 path,
                 Location::None,
                 K::Unsupported,
-                "unknown image extension; expected .img, .imc, .png, .pgm, .tif, .tiff, .bmp or .jpg",
+                "unknown image extension; expected .img, .imc, .png, .pgm, .tif, .tiff, .bmp, .jpg or .jpeg",
             )
         })
     }
@@ -130,7 +146,7 @@ pub fn decode_any(
         ImageKind::Pgm => decode_foreign(bytes, image::ImageFormat::Pnm, path, limit),
         ImageKind::Tiff => decode_foreign(bytes, image::ImageFormat::Tiff, path, limit),
         ImageKind::Bmp => decode_foreign(bytes, image::ImageFormat::Bmp, path, limit),
-        ImageKind::Jpeg => decode_foreign(bytes, image::ImageFormat::Jpeg, path, limit),
+        ImageKind::Jpeg => decode_jpeg(bytes, path, limit),
     }
 }
 
@@ -157,7 +173,7 @@ pub fn encode_any(f: &ImgFile, kind: ImageKind) -> Result<Vec<u8>, FormatError> 
             Path::new("<image>"),
             Location::None,
             K::Unsupported,
-            "JPEG is read only (photographs for calibration); write .img, .png, .pgm, .tif or .bmp",
+            "vss reads JPEG but does not write it (lossy); write .png, .pgm, .tif or .bmp",
         )),
     }
 }
@@ -386,6 +402,88 @@ fn decode_foreign(
     let l = img.into_luma8();
     let (w, h) = (l.width() as usize, l.height() as usize);
     let image = GreyImage::new(w, h, l.into_raw())
+        .map_err(|e| FormatError::new(path, Location::None, K::Syntax, e.to_string()))?;
+    Ok((ImgFile::new(image), notes))
+}
+
+/// The JPEG's luma from its RGB, by the JPEG's own (BT.601) weights in
+/// libjpeg's 16-bit fixed point.
+fn jpeg_luma(r: u8, g: u8, b: u8) -> u8 {
+    let l = 19_595 * u32::from(r) + 38_470 * u32::from(g) + 7_471 * u32::from(b);
+    ((l + 32_768) >> 16).min(255) as u8
+}
+
+fn decode_jpeg(
+    bytes: &[u8],
+    path: &Path,
+    limit: u64,
+) -> Result<(ImgFile, Vec<String>), FormatError> {
+    use image::ImageDecoder;
+    use image::metadata::Orientation;
+    let bad = |e: image::ImageError| {
+        let kind = match e {
+            image::ImageError::Limits(_) => K::Range,
+            image::ImageError::Unsupported(_) => K::Unsupported,
+            image::ImageError::IoError(_) => K::Truncated,
+            _ => K::Syntax,
+        };
+        FormatError::new(
+            path,
+            Location::None,
+            kind,
+            format!("not a readable JPEG: {e}"),
+        )
+    };
+    let mut dec = image::codecs::jpeg::JpegDecoder::new(Cursor::new(bytes)).map_err(bad)?;
+    // The decoder fills a cut-off scan with grey; a photograph without its
+    // end-of-image marker is refused instead of half read.
+    if !bytes.windows(2).any(|m| m == [0xFF, 0xD9]) {
+        return Err(FormatError::new(
+            path,
+            Location::None,
+            K::Truncated,
+            "truncated JPEG: the file ends before its end-of-image marker",
+        ));
+    }
+    let (w, h) = dec.dimensions();
+    let need = dec.total_bytes();
+    if need > limit {
+        return Err(FormatError::new(
+            path,
+            Location::None,
+            K::Range,
+            format!(
+                "JPEG of {w} × {h} pixels ({need} bytes decoded) is larger than this file can hold or than {MAX_DECODED} bytes; refused from its header"
+            ),
+        ));
+    }
+    let orientation = dec.orientation().unwrap_or(Orientation::NoTransforms);
+    let colour = dec.color_type();
+    let mut img = image::DynamicImage::from_decoder(dec).map_err(bad)?;
+    let mut notes = Vec::new();
+    if orientation != Orientation::NoTransforms {
+        img.apply_orientation(orientation);
+        notes.push(format!(
+            "EXIF orientation applied ({orientation:?}): lines are in the picture as it is shown, {} × {} px",
+            img.width(),
+            img.height()
+        ));
+    }
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let grey = match img {
+        image::DynamicImage::ImageLuma8(l) => l.into_raw(),
+        other => {
+            let rgb = other.into_rgb8();
+            if rgb.pixels().any(|p| p[0] != p[1] || p[1] != p[2]) {
+                notes.push("colour JPEG converted to grey (its luma, BT.601)".into());
+            }
+            rgb.pixels().map(|p| jpeg_luma(p[0], p[1], p[2])).collect()
+        }
+    };
+    if colour.has_alpha() {
+        notes.push("alpha channel dropped".into());
+    }
+    let image = GreyImage::new(w, h, grey)
         .map_err(|e| FormatError::new(path, Location::None, K::Syntax, e.to_string()))?;
     Ok((ImgFile::new(image), notes))
 }

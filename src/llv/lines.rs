@@ -52,6 +52,7 @@
 //!   mean signed response of its points, `residual` their RMS distance from
 //!   the line.
 
+pub mod align;
 pub mod nfa;
 pub mod source;
 mod split;

@@ -222,6 +222,28 @@ params! {
         noise_sigmas: f64 = 3.5,
             "σ", 0.0..=20.0, step 0.25,
             "edge points must beat this many noise sigmas of their tile";
+        /// The sensor's noise, from the image's least textured tiles: every
+        /// tile's noise scale is raised to this percentile of the tiles'
+        /// scales (a flat sky or a JPEG's smooth gradient does not set a
+        /// threshold below the camera's noise) and capped at `noise_cap`
+        /// times it (gravel does not hide the edges in it;
+        /// `edges/noise.rs`). 0 keeps each tile's own scale.
+        noise_percentile: f64 = 0.0,
+            "%", 0.0..=100.0, step 5.0,
+            "tiles' noise raised to this percentile of the image's; 0 is off";
+        /// Images whose noise (Immerkær's estimate, `pipeline::noise_level`)
+        /// is at least this many grey levels take `half_width + 1`, and
+        /// those twice as noisy no orientation test (`lines.min_aligned`): a narrow
+        /// kernel keeps close parallel edges apart in a clean photograph, a
+        /// wider one averages more noise. 0 is off.
+        noisy_sigma: f64 = 0.0,
+            "grey levels", 0.0..=255.0, step 0.5,
+            "images at least this noisy take half_width + 1; 0 is off";
+        /// With `noise_percentile`: no tile's noise scale above this many
+        /// times that percentile. 0: no cap.
+        noise_cap: f64 = 0.0,
+            "×", 0.0..=100.0, step 0.25,
+            "tiles' noise capped at this multiple of the percentile; 0 is off";
         /// Threads for the two scan directions (edges and lines; 1 or 2).
         /// The results are the same.
         threads: u32 = 1,
@@ -271,6 +293,12 @@ params! {
         log_nfa: f64 = 0.0,
             "log10", -20.0..=20.0, step 1.0,
             "keep segments whose log10 number of false alarms is below this";
+        /// Gradient-orientation agreement: a line is kept when the image's
+        /// gradient is within 22.5° of its normal at this fraction of its
+        /// pixels (`lines/align.rs`: texture is not noise). 0 is off.
+        min_aligned: f64 = 0.0,
+            "fraction", 0.0..=1.0, step 0.1,
+            "lines need the gradient across them at this fraction of their pixels; 0 is off";
     }
 
     /// CONNECT, the automatic post-processing (llv.md §4), and the corner closing

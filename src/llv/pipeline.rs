@@ -107,6 +107,7 @@ pub struct Workspace {
     tmp: Vec<Segment>,
     corners: CornerScratch,
     refine: RefineScratch,
+    align: super::lines::align::AlignScratch,
     /// Whether `out` holds the results of a complete run.
     valid: bool,
 }
@@ -180,6 +181,37 @@ impl Workspace {
             self.lens(input, p)?;
             self.out.timings.lens_us = micros(t);
         }
+        // The kernel's half-width for this image: one more where the image
+        // is noisy (`edges.noisy_sigma`, `noise_level`), and no orientation
+        // test of the lines where it is twice as noisy (`lines/align.rs`).
+        let widened;
+        let p = {
+            let first = if self.out.corrected.is_empty() {
+                input.images.first()
+            } else {
+                self.out.corrected.first()
+            };
+            let sigma = match first {
+                Some(img) if p.edges.noisy_sigma > 0.0 => noise_level(img),
+                _ => 0.0,
+            };
+            if p.edges.noisy_sigma > 0.0 && sigma >= p.edges.noisy_sigma {
+                widened = {
+                    let mut q = p.clone();
+                    q.edges.half_width = (q.edges.half_width + 1).min(7);
+                    // At twice that noise the Sobel direction of a faint
+                    // edge is unreliable (docs/accuracy.md): the measured
+                    // noise alone guards there.
+                    if sigma >= 2.0 * p.edges.noisy_sigma {
+                        q.lines.min_aligned = 0.0;
+                    }
+                    q
+                };
+                &widened
+            } else {
+                p
+            }
+        };
         if from <= Stage::Lines {
             let same_response = from >= Stage::Edges
                 && prev_params.edges.half_width == p.edges.half_width
@@ -342,6 +374,13 @@ impl Workspace {
         if p.connect.refine {
             refine_into(images, &mut self.out.lines, &mut self.refine);
         }
+        super::lines::align::keep_aligned(
+            images,
+            &mut self.out.lines,
+            p.lines.min_aligned,
+            p.connect.min_line_length,
+            &mut self.align,
+        );
         if p.connect.corner_radius > 0.0 {
             close_corners_with(
                 &mut self.out.lines,
@@ -468,6 +507,48 @@ fn micros(t: Instant) -> u64 {
 
 /// Checks the images (at least one, ≥ 16 × 16, one size), the ambient image
 /// and the lens map; returns the size.
+/// The image's noise σ (grey levels) by Immerkær's method ("Fast noise
+/// variance estimation", CVIU 64, 1996): the mean magnitude of the
+/// difference of two Laplacians, `σ = √(π/2) / 6 · mean |I ∗ N|`, which
+/// cancels straight edges and smooth shading and keeps what changes from
+/// pixel to pixel. Texture raises it too, which is what a wider kernel is
+/// also for; pixels whose 3 × 3 window is not all valid are left out.
+pub fn noise_level(img: &GreyImage) -> f64 {
+    let (w, h) = img.size();
+    if w < 3 || h < 3 {
+        return 0.0;
+    }
+    let d = img.data();
+    let mask = img.valid_mask();
+    let (mut sum, mut n) = (0u64, 0u64);
+    for y in 1..h - 1 {
+        let (r0, r1, r2) = (
+            &d[(y - 1) * w..y * w],
+            &d[y * w..(y + 1) * w],
+            &d[(y + 1) * w..(y + 2) * w],
+        );
+        for x in 1..w - 1 {
+            if let Some(m) = mask
+                && !(y - 1..=y + 1).all(|v| m[v * w + x - 1] && m[v * w + x] && m[v * w + x + 1])
+            {
+                continue;
+            }
+            let c = |r: &[u8], i: usize| i32::from(r[i]);
+            let v = c(r0, x - 1) - 2 * c(r0, x) + c(r0, x + 1) - 2 * c(r1, x - 1) + 4 * c(r1, x)
+                - 2 * c(r1, x + 1)
+                + c(r2, x - 1)
+                - 2 * c(r2, x)
+                + c(r2, x + 1);
+            sum += u64::from(v.unsigned_abs());
+            n += 1;
+        }
+    }
+    if n == 0 {
+        return 0.0;
+    }
+    (std::f64::consts::PI / 2.0).sqrt() / 6.0 * sum as f64 / n as f64
+}
+
 fn check_input(input: &Input) -> Result<(usize, usize), LlvError> {
     let first = input.images.first().ok_or(LlvError::BufferSize {
         width: 0,

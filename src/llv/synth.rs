@@ -17,6 +17,7 @@ pub mod compare;
 pub mod eval;
 mod geom;
 mod raster;
+pub mod real;
 mod render;
 pub mod rng;
 mod scenes;

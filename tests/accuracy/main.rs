@@ -1,9 +1,11 @@
 //! The accuracy floors, apart from the other integration tests so that
 //! `cargo test --test accuracy` runs them alone: `cubes::` on the family the
-//! engine is tuned on, `yard::` on the one it is not. Each floor is within
+//! engine is tuned on, `yard::` on the one it is not, `real::` on the real
+//! photographs it is tuned on (`../shared/data/yud-tune`). Each floor is within
 //! 0.01 of what the engine measures, so that a regression fails.
 
 mod cubes;
+mod real;
 mod yard;
 
 /// The default profile's LLV parameters (the built-in profile, or

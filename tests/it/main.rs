@@ -23,6 +23,7 @@ mod llv_auto_cli;
 mod llv_cli;
 mod llv_corners;
 mod llv_engine;
+mod llv_jpeg;
 mod llv_lines;
 mod llv_shadow;
 mod photometric;

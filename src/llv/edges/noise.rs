@@ -232,6 +232,31 @@ impl NoiseMap {
     }
 }
 
+impl NoiseMap {
+    /// Bounds every tile's σ to `[lo, cap · lo]`, `lo` the `pct`-th
+    /// percentile of the tiles' estimates: the image's least textured
+    /// tiles measure its sensor noise, so a flat tile (sky, a JPEG's
+    /// quantised gradients) does not set a threshold below the camera's
+    /// noise, and a textured one (gravel) not one far above it.
+    /// `pct` ≤ 0 leaves the map as it is.
+    pub fn bound(&mut self, pct: f64, cap: f64, s: &mut NoiseScratch) {
+        if pct.is_nan() || pct <= 0.0 || self.sigma.is_empty() || self.offset != 0.0 {
+            return;
+        }
+        let v = &mut s.known;
+        v.clear();
+        v.extend_from_slice(&self.sigma);
+        let k = ((pct / 100.0 * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1;
+        let (_, lo, _) = v.select_nth_unstable_by(k, f32::total_cmp);
+        let lo = *lo;
+        let hi = if cap > 0.0 { lo * cap as f32 } else { f32::MAX };
+        for s in &mut self.sigma {
+            *s = s.clamp(lo, hi.max(lo));
+        }
+        self.global = self.global.clamp(lo, hi.max(lo));
+    }
+}
+
 /// Each sum's histogram bin: its magnitude, at most `BINS - 1`, and `BINS`
 /// for [`NONE`] (whose key, `i16::MAX`, no real sum has). Plain code the
 /// compiler puts in lanes (AVX2 where the processor has it).

@@ -307,6 +307,7 @@ pub fn detect_into(
 ) {
     let mut ns = std::mem::take(&mut s.noise);
     noise.estimate_into(resp, &mut ns);
+    noise.bound(p.noise_percentile, p.noise_cap, &mut ns);
     s.noise = ns;
     map.reset(resp, p.floor, track_sigmas);
     points_into(resp, noise, p, Some(map), out, starts, s);

@@ -36,7 +36,7 @@ use crate::llv::{GreyImage, LlvError, Params, Point, Segment};
 
 mod files;
 
-pub use files::{read_segments, read_times, read_truth};
+pub use files::{read_segments, read_times, read_truth, write_segments};
 
 /// The name vss's own files carry.
 pub const VSS: &str = "vss";
@@ -88,15 +88,22 @@ fn write_pgm(path: &Path, img: &GreyImage) -> Result<(), FormatError> {
     write_any(path, &ImgFile::new(img.clone()))
 }
 
-/// Runs vss `runs` times (at least once) on `img` with a warm workspace:
-/// the last run's lines and the fastest and median times (ms).
-fn timed(
+/// Runs vss `runs` times on `img` with a warm workspace (one warm-up run
+/// first): the last run's lines and the fastest and median times (ms).
+/// `runs` = 0: one run, timed, and no warm-up.
+pub(crate) fn timed_run(
     ws: &mut Workspace,
     img: &GreyImage,
     params: &Params,
     runs: usize,
 ) -> Result<(Vec<Segment>, f64, f64), LlvError> {
     let input = Input::single(img);
+    if runs == 0 {
+        let t = Instant::now();
+        ws.run(&input, params)?;
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        return Ok((ws.outputs().lines.clone(), ms, ms));
+    }
     ws.run(&input, params)?; // warm-up
     let mut times = Vec::with_capacity(runs.max(1));
     for _ in 0..runs.max(1) {
@@ -131,9 +138,11 @@ fn export_level(
         write_pgm(&pgm, &s.image)?;
         files::write_truth(&base.with_extension("truth"), &s.truth, &s.dont_care)?;
         let (lines, fastest, median) =
-            timed(&mut ws, &s.image, params, runs).map_err(|source| CompareError::Llv {
-                path: pgm.clone(),
-                source,
+            timed_run(&mut ws, &s.image, params, runs.max(1)).map_err(|source| {
+                CompareError::Llv {
+                    path: pgm.clone(),
+                    source,
+                }
             })?;
         files::write_segments(&dir.join(format!("{}.{VSS}.seg", stem(i))), &lines)?;
         times.push_str(&format!(
@@ -269,7 +278,7 @@ pub fn read_manifest(dir: &Path) -> Result<Manifest, FormatError> {
 
 /// The detectors with segment files in a level folder: vss first, then the
 /// others by name.
-fn detectors(dir: &Path) -> Result<Vec<String>, FormatError> {
+pub(crate) fn detectors(dir: &Path) -> Result<Vec<String>, FormatError> {
     let rd = std::fs::read_dir(dir).map_err(|e| FormatError::io(dir, "list the folder", &e))?;
     let mut names: Vec<String> = Vec::new();
     for entry in rd.flatten() {

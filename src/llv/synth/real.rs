@@ -1,0 +1,522 @@
+//! Real photographs with human-labelled line segments: a folder of
+//! `NAME.jpg` (or `.png`, `.pgm`, …) with `NAME_gt.txt` beside each (one
+//! segment a line, `x1 y1 x2 y2`), as the York Urban database with Cho et
+//! al.'s ground truth comes. Reading them, running vss on them, and scoring
+//! any detector's segments by the rule the project is judged by
+//! (`../shared/data/README.md`):
+//!
+//! - every segment is sampled at steps of at most 1 px (the midpoints of
+//!   `⌈length⌉` equal intervals, each weighing `length / ⌈length⌉`);
+//! - a detected sample is true where some ground-truth segment within
+//!   [`ANGLE_DEG`] of the detected segment's direction lies within [`DIST`]
+//!   px of it (distance to the segment, ends included);
+//! - a ground-truth sample is found where some detected segment within
+//!   [`ANGLE_DEG`] lies within [`DIST`] px of it;
+//! - recall and precision are lengths summed over all images, F their
+//!   harmonic mean.
+//!
+//! The ground truth puts pixel (0, 0) over `[0, 1]²`; vss puts pixel
+//! centres at whole coordinates, so [`read_truth`] subtracts
+//! [`TRUTH_SHIFT`] from every coordinate. Detector files (`NAME.DET.seg`)
+//! are in vss's convention, as `vss selftest --export` writes them.
+//!
+//! This rule differs from the synthetic scorer (`score.rs`: 3°, exact
+//! intervals, don't-care edges) on purpose: it is the published one, and
+//! the figures of other detectors on these photographs are given by it.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use super::compare::{CompareError, VSS, read_segments, read_times, timed_run};
+use crate::formats::imageio::{ImageKind, read_any_sized};
+use crate::formats::{FormatError, FormatErrorKind as K, Location, write_bytes};
+use crate::llv::pipeline::Workspace;
+use crate::llv::{GreyImage, Params, Point, Segment};
+
+/// Largest distance (px) of a sample from a matching segment.
+pub const DIST: f64 = 2.0;
+/// Largest direction difference (degrees) of matching segments.
+pub const ANGLE_DEG: f64 = 5.0;
+/// Subtracted from every ground-truth coordinate (pixel (0, 0) over
+/// `[0, 1]²` → pixel centres at whole coordinates).
+pub const TRUTH_SHIFT: f64 = 0.5;
+
+/// Sums of lengths over images; [`RealTally::metrics`] pools them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct RealTally {
+    /// Detected length (px) and the part of it that is true.
+    pub detected: f64,
+    pub true_detected: f64,
+    /// Ground-truth length (px) and the part of it that is found.
+    pub truth: f64,
+    pub found: f64,
+    /// Detected segments in all.
+    pub segments: usize,
+    pub images: usize,
+}
+
+/// Pooled scores.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct RealMetrics {
+    pub precision: f64,
+    pub recall: f64,
+    pub f: f64,
+    pub detected_length: f64,
+    pub truth_length: f64,
+    pub segments: usize,
+    pub images: usize,
+}
+
+impl RealTally {
+    /// Adds one image's detected segments and ground truth (both with pixel
+    /// centres at whole coordinates).
+    pub fn add(&mut self, detected: &[Segment], truth: &[Segment]) {
+        let (t, d) = covered(detected, truth);
+        self.true_detected += t;
+        self.detected += d;
+        let (f, g) = covered(truth, detected);
+        self.found += f;
+        self.truth += g;
+        self.segments += detected.len();
+        self.images += 1;
+    }
+
+    pub fn metrics(&self) -> RealMetrics {
+        let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { 0.0 };
+        let precision = ratio(self.true_detected, self.detected);
+        let recall = ratio(self.found, self.truth);
+        let f = if precision + recall > 0.0 {
+            2.0 * precision * recall / (precision + recall)
+        } else {
+            0.0
+        };
+        RealMetrics {
+            precision,
+            recall,
+            f,
+            detected_length: self.detected,
+            truth_length: self.truth,
+            segments: self.segments,
+            images: self.images,
+        }
+    }
+}
+
+/// Scores one image.
+pub fn score_real(detected: &[Segment], truth: &[Segment]) -> RealMetrics {
+    let mut t = RealTally::default();
+    t.add(detected, truth);
+    t.metrics()
+}
+
+/// A segment's usable form: ends, direction (radians, mod π) and length.
+#[derive(Clone, Copy)]
+struct Seg {
+    a: Point,
+    b: Point,
+    theta: f64,
+    len: f64,
+}
+
+fn usable(s: &Segment) -> Option<Seg> {
+    let len = s.length();
+    let finite = [s.a.x, s.a.y, s.b.x, s.b.y].iter().all(|v| v.is_finite());
+    (finite && len > 0.0 && len.is_finite()).then(|| Seg {
+        a: s.a,
+        b: s.b,
+        theta: (s.b.y - s.a.y).atan2(s.b.x - s.a.x),
+        len,
+    })
+}
+
+fn angle_ok(t0: f64, t1: f64) -> bool {
+    let d = (t0 - t1).rem_euclid(std::f64::consts::PI);
+    d.min(std::f64::consts::PI - d).to_degrees() <= ANGLE_DEG
+}
+
+/// Distance from `p` to the segment `a b` (ends included).
+fn seg_distance(p: Point, s: &Seg) -> f64 {
+    let (ux, uy) = (s.b.x - s.a.x, s.b.y - s.a.y);
+    let l2 = ux * ux + uy * uy;
+    let t = if l2 > 0.0 {
+        (((p.x - s.a.x) * ux + (p.y - s.a.y) * uy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p.x - s.a.x - t * ux).hypot(p.y - s.a.y - t * uy)
+}
+
+/// The matching length of `samples`' segments against `against`, and their
+/// whole length: `(matched, total)`.
+fn covered(samples: &[Segment], against: &[Segment]) -> (f64, f64) {
+    let src: Vec<Seg> = samples.iter().filter_map(usable).collect();
+    let tgt: Vec<Seg> = against.iter().filter_map(usable).collect();
+    let total: f64 = src.iter().map(|s| s.len).sum();
+    if tgt.is_empty() {
+        return (0.0, total);
+    }
+    let grid = Grid::new(&tgt);
+    let mut matched = 0.0;
+    for s in &src {
+        let n = s.len.ceil().max(1.0);
+        let w = s.len / n;
+        for k in 0..n as usize {
+            let t = (k as f64 + 0.5) / n;
+            let p = Point::new(s.a.x + (s.b.x - s.a.x) * t, s.a.y + (s.b.y - s.a.y) * t);
+            let hit = grid.near(p).iter().any(|&j| {
+                let o = &tgt[j as usize];
+                angle_ok(s.theta, o.theta) && seg_distance(p, o) <= DIST
+            });
+            if hit {
+                matched += w;
+            }
+        }
+    }
+    (matched, total)
+}
+
+/// Square cells, each listing the segments that come within [`DIST`] of
+/// some point of it: a sample asks only its own cell.
+struct Grid {
+    x0: f64,
+    y0: f64,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    lists: Vec<Vec<u32>>,
+}
+
+impl Grid {
+    fn new(segs: &[Seg]) -> Grid {
+        let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+        for s in segs {
+            for p in [s.a, s.b] {
+                x0 = x0.min(p.x);
+                y0 = y0.min(p.y);
+                x1 = x1.max(p.x);
+                y1 = y1.max(p.y);
+            }
+        }
+        let (x0, y0) = (x0 - DIST - 1.0, y0 - DIST - 1.0);
+        let extent = (x1 - x0 + DIST + 1.0).max(y1 - y0 + DIST + 1.0);
+        // At most 512 cells a side, whatever the coordinates.
+        let cell = (extent / 512.0).max(4.0);
+        let nx = ((x1 + DIST + 1.0 - x0) / cell).ceil() as usize + 1;
+        let ny = ((y1 + DIST + 1.0 - y0) / cell).ceil() as usize + 1;
+        let mut lists = vec![Vec::new(); nx * ny];
+        let reach = DIST + cell * std::f64::consts::FRAC_1_SQRT_2;
+        for (j, s) in segs.iter().enumerate() {
+            let cx = |x: f64| (((x - x0) / cell).floor().max(0.0) as usize).min(nx - 1);
+            let cy = |y: f64| (((y - y0) / cell).floor().max(0.0) as usize).min(ny - 1);
+            let (lx, hx) = (cx(s.a.x.min(s.b.x) - DIST), cx(s.a.x.max(s.b.x) + DIST));
+            let (ly, hy) = (cy(s.a.y.min(s.b.y) - DIST), cy(s.a.y.max(s.b.y) + DIST));
+            for gy in ly..=hy {
+                for gx in lx..=hx {
+                    let c =
+                        Point::new(x0 + (gx as f64 + 0.5) * cell, y0 + (gy as f64 + 0.5) * cell);
+                    if seg_distance(c, s) <= reach {
+                        lists[gy * nx + gx].push(j as u32);
+                    }
+                }
+            }
+        }
+        Grid {
+            x0,
+            y0,
+            cell,
+            nx,
+            ny,
+            lists,
+        }
+    }
+
+    fn near(&self, p: Point) -> &[u32] {
+        let gx = (p.x - self.x0) / self.cell;
+        let gy = (p.y - self.y0) / self.cell;
+        if !(gx >= 0.0 && gy >= 0.0) {
+            return &[];
+        }
+        let (gx, gy) = (gx as usize, gy as usize);
+        if gx >= self.nx || gy >= self.ny {
+            return &[];
+        }
+        &self.lists[gy * self.nx + gx]
+    }
+}
+
+/// One photograph of a folder: its name (the file stem), image and truth.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Photo {
+    pub name: String,
+    pub image: PathBuf,
+    pub truth: PathBuf,
+}
+
+/// The photographs of `dir` that have a `NAME_gt.txt` beside them, by
+/// name. A folder without any is an error (a test must not pass on none).
+pub fn photographs(dir: &Path) -> Result<Vec<Photo>, FormatError> {
+    let rd = std::fs::read_dir(dir).map_err(|e| FormatError::io(dir, "list the folder", &e))?;
+    let mut out = Vec::new();
+    for entry in rd.flatten() {
+        let path = entry.path();
+        let Some(kind) = ImageKind::of(&path) else {
+            continue;
+        };
+        if kind == ImageKind::Img {
+            continue;
+        }
+        let Some(name) = path.file_stem().and_then(|s| s.to_str()) else {
+            continue;
+        };
+        let truth = dir.join(format!("{name}_gt.txt"));
+        if truth.is_file() {
+            out.push(Photo {
+                name: name.to_string(),
+                image: path.clone(),
+                truth,
+            });
+        }
+    }
+    out.sort_by(|a, b| a.name.cmp(&b.name));
+    if out.is_empty() {
+        return Err(FormatError::new(
+            dir,
+            Location::None,
+            K::Missing,
+            "no photographs with a NAME_gt.txt beside them",
+        ));
+    }
+    Ok(out)
+}
+
+/// A ground-truth file, shifted to pixel centres at whole coordinates.
+pub fn read_truth(path: &Path) -> Result<Vec<Segment>, FormatError> {
+    let mut v = read_segments(path)?;
+    for s in &mut v {
+        for p in [&mut s.a, &mut s.b] {
+            p.x -= TRUTH_SHIFT;
+            p.y -= TRUTH_SHIFT;
+        }
+    }
+    Ok(v)
+}
+
+/// A photograph as a grey image, refused from its header when the LLV
+/// stage could not take it.
+pub fn read_photo(path: &Path) -> Result<GreyImage, FormatError> {
+    read_any_sized(path, crate::llv::image::check_stage_size).map(|(f, _)| f.image)
+}
+
+/// Runs vss on every photograph of `dir` and scores it: the pooled
+/// metrics and each photograph's own, by name.
+pub fn evaluate_real(
+    dir: &Path,
+    params: &Params,
+) -> Result<(RealMetrics, Vec<(String, RealMetrics)>), CompareError> {
+    let mut ws = Workspace::new();
+    let mut tally = RealTally::default();
+    let mut each = Vec::new();
+    for p in photographs(dir)? {
+        let img = read_photo(&p.image)?;
+        let truth = read_truth(&p.truth)?;
+        let (lines, _, _) =
+            timed_run(&mut ws, &img, params, 0).map_err(|source| CompareError::Llv {
+                path: p.image.clone(),
+                source,
+            })?;
+        let mut one = RealTally::default();
+        one.add(&lines, &truth);
+        tally.add(&lines, &truth);
+        each.push((p.name, one.metrics()));
+    }
+    Ok((tally.metrics(), each))
+}
+
+/// Runs vss on every photograph of `photos` (timed in-process, `runs`
+/// runs after a warm-up) and writes `NAME.vss.seg` and `vss.times` in
+/// `out` for [`score_dir`] (and `benches/opencv_lines.py real`).
+pub fn export_real(
+    photos: &Path,
+    out: &Path,
+    params: &Params,
+    runs: usize,
+) -> Result<usize, CompareError> {
+    std::fs::create_dir_all(out).map_err(|e| FormatError::io(out, "create the folder", &e))?;
+    let mut ws = Workspace::new();
+    let mut times =
+        String::from("# photo fastest_ms median_ms runs (vss, in-process, one thread)\n");
+    let list = photographs(photos)?;
+    for p in &list {
+        let img = read_photo(&p.image)?;
+        let (lines, fastest, median) =
+            timed_run(&mut ws, &img, params, runs.max(1)).map_err(|source| CompareError::Llv {
+                path: p.image.clone(),
+                source,
+            })?;
+        super::compare::write_segments(&out.join(format!("{}.{VSS}.seg", p.name)), &lines)?;
+        times.push_str(&format!(
+            "{} {fastest:.4} {median:.4} {}\n",
+            p.name,
+            runs.max(1)
+        ));
+    }
+    write_bytes(&out.join(format!("{VSS}.times")), times.as_bytes())?;
+    Ok(list.len())
+}
+
+/// One detector's scores on a folder of photographs.
+#[derive(Clone, Debug, Serialize)]
+pub struct RealScore {
+    pub detector: String,
+    pub metrics: RealMetrics,
+    /// Mean over the photographs of each one's fastest and median time
+    /// (ms), when the detector wrote its times.
+    pub fastest_ms: Option<f64>,
+    pub median_ms: Option<f64>,
+}
+
+/// Scores every detector with segment files `NAME.DET.seg` in `segs` for
+/// the photographs of `photos` (vss first, then by name). A detector
+/// missing some photograph is an error.
+pub fn score_dir(photos: &Path, segs: &Path) -> Result<Vec<RealScore>, FormatError> {
+    let list = photographs(photos)?;
+    let truths: Vec<Vec<Segment>> = list
+        .iter()
+        .map(|p| read_truth(&p.truth))
+        .collect::<Result<_, _>>()?;
+    let mut out = Vec::new();
+    for det in super::compare::detectors(segs)? {
+        let mut tally = RealTally::default();
+        for (p, t) in list.iter().zip(&truths) {
+            let path = segs.join(format!("{}.{det}.seg", p.name));
+            if !path.exists() {
+                return Err(FormatError::new(
+                    &path,
+                    Location::None,
+                    K::Missing,
+                    format!(
+                        "{det} has segments for some photographs but not for {}; run it on every one again",
+                        p.name
+                    ),
+                ));
+            }
+            tally.add(&read_segments(&path)?, t);
+        }
+        let times_path = segs.join(format!("{det}.times"));
+        let (fastest_ms, median_ms) = if times_path.exists() {
+            let t = read_times(&times_path)?;
+            let n = t.len().max(1) as f64;
+            (
+                Some(t.iter().map(|x| x.0).sum::<f64>() / n),
+                Some(t.iter().map(|x| x.1).sum::<f64>() / n),
+            )
+        } else {
+            (None, None)
+        };
+        out.push(RealScore {
+            detector: det,
+            metrics: tally.metrics(),
+            fastest_ms,
+            median_ms,
+        });
+    }
+    Ok(out)
+}
+
+/// The scores as a table.
+pub fn table(scores: &[RealScore], images: usize) -> String {
+    use std::fmt::Write as _;
+    let mut s = format!(
+        "real photographs ({images}; 2 px, {ANGLE_DEG}°, length-based)\n{:<10} {:>9} {:>7} {:>7} {:>9} {:>11} {:>10}\n",
+        "detector", "precision", "recall", "F", "segments", "fastest ms", "median ms"
+    );
+    let ms = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.2}"));
+    for d in scores {
+        let m = &d.metrics;
+        let _ = writeln!(
+            s,
+            "{:<10} {:>9.3} {:>7.3} {:>7.3} {:>9} {:>11} {:>10}",
+            d.detector,
+            m.precision,
+            m.recall,
+            m.f,
+            m.segments,
+            ms(d.fastest_ms),
+            ms(d.median_ms)
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn seg(x0: f64, y0: f64, x1: f64, y1: f64) -> Segment {
+        Segment::new(Point::new(x0, y0), Point::new(x1, y1))
+    }
+
+    #[test]
+    fn rule_by_hand() {
+        // A true edge of 10 px; a detection along its first 5 px, 1.5 px
+        // off and 3° turned: all of it true, and the edge found up to
+        // about x = 6 (within 2 px of the detection's end, ends included).
+        let truth = [seg(0.0, 0.0, 10.0, 0.0)];
+        let t = 3f64.to_radians();
+        let det = [seg(0.0, 1.5, 5.0 * t.cos(), 1.5 + 5.0 * t.sin())];
+        let m = score_real(&det, &truth);
+        assert!((m.precision - 1.0).abs() < 1e-9, "{m:?}");
+        assert!((m.recall - 0.6).abs() < 0.011, "{m:?}");
+        // 6° off: nothing matches; 2.5 px off: nothing.
+        let t = 6f64.to_radians();
+        let det = [seg(0.0, 0.0, 5.0 * t.cos(), 5.0 * t.sin())];
+        assert_eq!(score_real(&det, &truth).precision, 0.0);
+        let det = [seg(0.0, 2.5, 10.0, 2.5)];
+        assert_eq!(score_real(&det, &truth).recall, 0.0);
+        // Beyond the end, within 2 px of it (ends included): true.
+        let det = [seg(11.0, 0.0, 11.9, 0.0)];
+        assert!((score_real(&det, &truth).precision - 1.0).abs() < 1e-9);
+        let det = [seg(12.5, 0.0, 13.5, 0.0)];
+        assert_eq!(score_real(&det, &truth).precision, 0.0);
+    }
+
+    #[test]
+    fn grid_agrees_with_every_pair() {
+        // Random segments: the grid's answer is the brute-force one.
+        let mut r = crate::llv::synth::rng::SplitMix64::new(7);
+        let mut mk = |n: usize| -> Vec<Segment> {
+            (0..n)
+                .map(|_| {
+                    let (x, y) = (r.uniform() * 200.0, r.uniform() * 150.0);
+                    let a = r.uniform() * std::f64::consts::PI;
+                    let l = 1.0 + r.uniform() * 80.0;
+                    seg(x, y, x + l * a.cos(), y + l * a.sin())
+                })
+                .collect()
+        };
+        let (d, t) = (mk(150), mk(150));
+        let (m, total) = covered(&d, &t);
+        let tgt: Vec<Seg> = t.iter().filter_map(usable).collect();
+        let (mut bm, mut bt) = (0.0, 0.0);
+        for s in d.iter().filter_map(usable) {
+            let n = s.len.ceil();
+            for k in 0..n as usize {
+                let u = (k as f64 + 0.5) / n;
+                let p = Point::new(s.a.x + (s.b.x - s.a.x) * u, s.a.y + (s.b.y - s.a.y) * u);
+                if tgt
+                    .iter()
+                    .any(|o| angle_ok(s.theta, o.theta) && seg_distance(p, o) <= DIST)
+                {
+                    bm += s.len / n;
+                }
+                bt += s.len / n;
+            }
+        }
+        assert!(m > 0.0);
+        assert!(
+            (m - bm).abs() < 1e-9 && (total - bt).abs() < 1e-9,
+            "{m} {bm}"
+        );
+    }
+}
