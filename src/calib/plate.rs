@@ -329,7 +329,7 @@ impl Plate {
     pub fn is_dark(&self, i: u32, j: u32) -> bool {
         match self.kind {
             PlateKind::Squares => !(self.origin_mark && i == 0 && j == 0),
-            PlateKind::Checkerboard => (i + j) % 2 == 0,
+            PlateKind::Checkerboard => (i + j).is_multiple_of(2),
         }
     }
 

@@ -304,10 +304,10 @@ fn run_group(
     }
     write_outputs(a, &grp.dir, &grp.stem, out, true, &mut set)?;
     let written = commit(set)?;
-    if let (Some(t), Some(r)) = (&a.auto, &proposal) {
-        if !a.json {
-            print_auto(&grp.stem, t, r)?;
-        }
+    if let (Some(t), Some(r)) = (&a.auto, &proposal)
+        && !a.json
+    {
+        print_auto(&grp.stem, t, r)?;
     }
     report(
         a,

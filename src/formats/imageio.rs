@@ -310,7 +310,7 @@ fn decode_png(
 
 fn unhex(s: &str) -> Option<String> {
     let b = s.as_bytes();
-    if b.len() % 2 != 0 {
+    if !b.len().is_multiple_of(2) {
         return None;
     }
     b.chunks(2)

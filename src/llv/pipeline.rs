@@ -575,13 +575,13 @@ fn check_input(input: &Input) -> Result<(usize, usize), LlvError> {
             });
         }
     }
-    if let Some(m) = input.lens {
-        if m.size() != size {
-            return Err(LlvError::SizeMismatch {
-                a: size,
-                b: m.size(),
-            });
-        }
+    if let Some(m) = input.lens
+        && m.size() != size
+    {
+        return Err(LlvError::SizeMismatch {
+            a: size,
+            b: m.size(),
+        });
     }
     Ok(size)
 }

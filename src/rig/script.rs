@@ -73,10 +73,8 @@ impl Write for Script {
             if b == self.eol {
                 let line = std::mem::take(&mut self.pending_line);
                 let blank = line.iter().all(|c| c.is_ascii_whitespace());
-                if !blank {
-                    if let Some(a) = self.answers.pop_front() {
-                        self.readable.extend(a);
-                    }
+                if !blank && let Some(a) = self.answers.pop_front() {
+                    self.readable.extend(a);
                 }
             } else {
                 self.pending_line.push(b);

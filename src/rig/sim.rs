@@ -301,10 +301,10 @@ impl SimCell {
             // Unplugged: the device name goes away, as /dev/ttyUSB0 does.
             if !stop.load(Ordering::SeqCst) {
                 let l = link.lock().unwrap_or_else(PoisonError::into_inner).clone();
-                if let Some(l) = l {
-                    if std::fs::read_link(&l).is_ok_and(|t| t == Path::new(&path)) {
-                        let _ = std::fs::remove_file(&l);
-                    }
+                if let Some(l) = l
+                    && std::fs::read_link(&l).is_ok_and(|t| t == Path::new(&path))
+                {
+                    let _ = std::fs::remove_file(&l);
                 }
             }
         })

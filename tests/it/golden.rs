@@ -118,7 +118,10 @@ fn five_lightings_of_the_simulated_cell_give_the_golden_outputs() {
             .fold(0u32, |m, light| m | 1 << light.relay);
         let name = format!("five1{}.img", l.letter);
         let frame = scene.frame(1, mask, u64::from(l.letter as u32));
-        save(&dir.path().join(&name), GreyImage::new(w, h, frame).unwrap());
+        save(
+            &dir.path().join(&name),
+            GreyImage::new(w, h, frame).unwrap(),
+        );
         args.push(name);
     }
     assert_eq!(args.len(), 5, "the built-in cell has five lightings");

@@ -117,7 +117,7 @@ fn run(a: &[u8], b: &[u8], fx: &[u8], fy: &[u8], out: &mut [u8]) {
     }
     // ... then one step aligned to the end of the run for the remainder (it
     // recomputes a few pixels with the same result).
-    if n % LANES != 0 {
+    if !n.is_multiple_of(LANES) {
         let k = n - LANES;
         let chunks = (
             lanes(a0, k),

@@ -38,7 +38,7 @@ pub(super) fn row_masks(
 ) {
     let n = sign.len();
     let words = n / 64;
-    let ok = n % 64 == 0
+    let ok = n.is_multiple_of(64)
         && [lo.len(), mid.len(), hi.len(), thr.len(), trk.len()]
             .iter()
             .all(|&l| l >= n)
