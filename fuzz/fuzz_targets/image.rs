@@ -1,7 +1,8 @@
-//! PNG, PGM, TIFF and BMP through `imageio` (the first byte picks the
+//! PNG, PGM, TIFF, BMP and JPEG through `imageio` (the first byte picks the
 //! format): a decoded image stays within the decoder's limit (at most
-//! ~1100 pixels a byte of input plus 1 MiB), encodes in its format, and
-//! decodes back to the same pixels (PNG: comment and corner too).
+//! ~1100 pixels a byte of input plus 1 MiB); but for JPEG, which vss reads
+//! and never writes, it encodes in its format and decodes back to the same
+//! pixels (PNG: comment and corner too).
 #![no_main]
 
 use std::path::Path;
@@ -18,12 +19,16 @@ fuzz_target!(|data: &[u8]| {
         ImageKind::Pgm,
         ImageKind::Tiff,
         ImageKind::Bmp,
+        ImageKind::Jpeg,
     ];
     let kind = kinds[usize::from(pick) % kinds.len()];
     let p = Path::new("fuzz.png");
     if let Ok((f, _notes)) = decode_any(bytes, kind, p) {
         let px = f.image.data().len() as u64;
         assert!(px <= bytes.len() as u64 * 1100 + (1 << 20), "{px} pixels");
+        if kind == ImageKind::Jpeg {
+            return;
+        }
         let enc = encode_any(&f, kind).expect("a decoded image encodes");
         let (back, notes) = decode_any(&enc, kind, p).expect("its encoding decodes");
         assert!(notes.is_empty(), "{notes:?}");
