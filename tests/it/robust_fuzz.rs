@@ -29,12 +29,14 @@ use vss::rig::replay::{Replay, SEPARATOR, Tap, recording};
 use vss::rig::sim::{Faults, SimCell, SimOptions, cell_profile};
 use vss::session::manifest::Manifest;
 
-/// The image kinds of the `image` target, picked by a seed's first byte.
-const KINDS: [ImageKind; 4] = [
+/// The image kinds of the `image` target, picked by a seed's first byte
+/// (as `fuzz/fuzz_targets/image.rs` lists them).
+const KINDS: [ImageKind; 5] = [
     ImageKind::Png,
     ImageKind::Pgm,
     ImageKind::Tiff,
     ImageKind::Bmp,
+    ImageKind::Jpeg,
 ];
 
 /// The commands whose answers the `relay` target looks for.
