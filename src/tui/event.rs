@@ -241,6 +241,9 @@ pub enum StoreEvent {
     /// (no `.cdf` named, unreadable, or lacking S, C or f).
     Cameras(Vec<Result<CameraModel, String>>),
     Saved(String),
+    /// Image `k`'s outputs are saved: it is accepted (said only now, when
+    /// its files are on disk, not when the save was asked for).
+    OutputsSaved(u32),
     /// A note worth a log line (a stale lock taken over).
     Note(String),
     Reports(Vec<PathBuf>),

@@ -113,7 +113,7 @@ fn keys_that_write_ask_or_stay_apart_from_moving_keys() {
     );
     // The save key does.
     c.press(PIPELINE, Action::Pipeline(PipelineAction::Save));
-    c.wait_text("saved outputs of image 1", 10);
+    c.wait_text("image 1 accepted: outputs saved", 10);
     // The plan of one image done: the end is announced.
     c.send("1");
     c.press(SURVEY, Action::Survey(SurveyAction::Accept));

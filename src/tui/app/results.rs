@@ -213,6 +213,12 @@ impl App {
                 self.ctx().info(format!("saved {}", clean(&what)));
                 Vec::new()
             }
+            StoreEvent::OutputsSaved(k) => {
+                self.ctx().info(format!(
+                    "image {k} accepted: outputs saved (.hpo .vpo .lex .ldr)"
+                ));
+                Vec::new()
+            }
             StoreEvent::Note(what) => {
                 self.ctx().info(clean(&what));
                 Vec::new()

@@ -594,7 +594,9 @@ impl Ctx<'_> {
             c.in_session && c.outputs_params.as_ref() == Some(&self.tracker.params)
         });
         let mut cmds = Vec::new();
-        if !unchanged {
+        if unchanged {
+            self.info(format!("image {k} accepted"));
+        } else {
             if cur.is_some_and(|c| c.accepted) && !confirmed {
                 self.ask(
                     format!(
@@ -609,8 +611,9 @@ impl Ctx<'_> {
                 Some(c) => cmds = c,
                 None => return Vec::new(),
             }
+            // "accepted" is said when the store has the files.
+            self.info(format!("image {k}: saving its outputs"));
         }
-        self.info(format!("image {k} accepted"));
         self.next_image(k);
         if let Some(n) = self.session.image(self.session.work.k)
             && !n.captured.is_empty()

@@ -256,8 +256,7 @@ impl Store {
                     .map(|e| s.file_name(k, None, e))
                     .collect();
                 self.forget_problems(&files);
-                let what = format!("outputs of image {k} (.hpo .vpo .lex .ldr)");
-                self.reply(StoreEvent::Saved(what));
+                self.reply(StoreEvent::OutputsSaved(k));
                 self.updated();
             }
             StoreCmd::RecordEdit { k, what, lines } => {
