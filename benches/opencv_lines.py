@@ -229,7 +229,7 @@ def real(argv):
                    help="time everything this many times, alternating, and keep each image's fastest")
     p.add_argument("--skip-vss", action="store_true", help="reuse DIR's vss segments and times")
     p.add_argument("--profile", default=None,
-                   help="vss's profile (e.g. profiles/photographs.toml; default: the built-in one)")
+                   help="vss's profile (a .toml file; default: the built-in one)")
     a = p.parse_args(argv)
     cv2.setNumThreads(1)
     os.makedirs(a.dir, exist_ok=True)

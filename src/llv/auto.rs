@@ -8,10 +8,12 @@
 //! The search is a fixed grid (deterministic, no randomness), nested by
 //! stage so that the expensive stages run least often:
 //! `edges.per_region × edges.noise_sigmas` (edge stage: how many starts,
-//! and how far above the noise) → `lines.min_length × lines.log_nfa` (line
-//! stage: how significant a segment must be) → `connect.min_line_length`
+//! and how far above the noise) → `lines.min_aligned × lines.log_nfa` (line
+//! stage: how significant a segment must be, and whether the orientation
+//! test applies; `lines.min_length` is not searched, as CONNECT's
+//! `min_line_length` decides the shortest lines kept) → `connect.min_line_length`
 //! (CONNECT only). Each axis holds the base value and a ladder around it:
-//! with the default base, 40 edge runs, 480 line runs and 3360 CONNECT runs
+//! with the default base, 45 edge runs, 540 line runs and 5940 CONNECT runs
 //! (CONNECT runs are cheap). With several lightings `edges.noise_factor`
 //! is a third edge-stage axis (three times the runs).
 //!
@@ -169,7 +171,7 @@ pub fn search(input: &Input, base: &Params, target: &Target) -> Result<AutoResul
             p.edges.noise_sigmas = noise_sigmas;
             ws.rerun(Stage::Edges, input, &p)?;
             runs += 1;
-            for (min_len, log_nfa) in ladder(base.lines.min_length, MIN_LENGTH)
+            for (aligned, log_nfa) in ladder(base.lines.min_aligned, MIN_ALIGNED)
                 .into_iter()
                 .flat_map(|l| {
                     ladder(base.lines.log_nfa, LOG_NFA)
@@ -178,7 +180,7 @@ pub fn search(input: &Input, base: &Params, target: &Target) -> Result<AutoResul
                 })
             {
                 let mut q = p.clone();
-                q.lines.min_length = min_len;
+                q.lines.min_aligned = aligned;
                 q.lines.log_nfa = log_nfa;
                 ws.rerun(Stage::Lines, input, &q)?;
                 runs += 1;
@@ -211,9 +213,11 @@ pub fn search(input: &Input, base: &Params, target: &Target) -> Result<AutoResul
 const PER_REGION: &[f64] = &[3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0, 32.0];
 const NOISE_SIGMAS: &[f64] = &[2.0, 2.5, 3.5, 5.0, 7.0];
 const NOISE_FACTOR: &[f64] = &[2.0, 3.0, 5.0];
-const MIN_LENGTH: &[f64] = &[8.0, 12.0];
+const MIN_ALIGNED: &[f64] = &[0.0];
 const LOG_NFA: &[f64] = &[-10.0, -5.0, 0.0, 5.0, 10.0, 15.0];
-const MIN_LINE_LENGTH: &[f64] = &[12.0, 16.0, 20.0, 30.0, 40.0, 60.0, 80.0];
+const MIN_LINE_LENGTH: &[f64] = &[
+    12.0, 16.0, 20.0, 30.0, 40.0, 60.0, 80.0, 100.0, 120.0, 140.0, 160.0,
+];
 
 struct Candidate {
     /// (target cost, parameters changed, distance in steps): smaller wins.
@@ -338,7 +342,11 @@ mod tests {
         assert_eq!(
             changes(&base, &p),
             vec![
-                ("edges.per_region".to_string(), 16.0, 12.0),
+                (
+                    "edges.per_region".to_string(),
+                    f64::from(base.edges.per_region),
+                    12.0
+                ),
                 ("connect.min_line_length".to_string(), 12.0, 20.0)
             ]
         );

@@ -199,7 +199,7 @@ params! {
     /// Lee's edge detector and the adaptive threshold (llv.md §2).
     edges: EdgeParams, Edges {
         /// Kernel half-width `A` (pixels), 3–7.
-        half_width: u32 = 4,
+        half_width: u32 = 3,
             "px", 3.0..=7.0, step 1.0,
             "Lee kernel half-width A; wider smooths more";
         /// Floor threshold `T` (grey levels): no peak at or below it is kept.
@@ -207,7 +207,7 @@ params! {
             "grey levels", 0.0..=255.0, step 0.5,
             "floor threshold T: weaker peaks are never edges";
         /// `M`: edge pixels kept per region by the adaptive threshold.
-        per_region: u32 = 16,
+        per_region: u32 = 4096,
             "points", 1.0..=4096.0, step 1.0,
             "adaptive threshold M: strongest edge points kept per region";
         /// Scan lines per region of the adaptive threshold (1 = one scan line).
@@ -219,7 +219,7 @@ params! {
         /// from the image; `edges/noise.rs`). 0 switches the test off.
         /// Several lightings: sigmas of the noise model of their combined
         /// response (`photometric.rs`), which means the same.
-        noise_sigmas: f64 = 3.5,
+        noise_sigmas: f64 = 2.5,
             "σ", 0.0..=20.0, step 0.25,
             "edge points must beat this many noise sigmas of their tile";
         /// The sensor's noise, from the image's least textured tiles: every
@@ -228,7 +228,7 @@ params! {
         /// threshold below the camera's noise) and capped at `noise_cap`
         /// times it (gravel does not hide the edges in it;
         /// `edges/noise.rs`). 0 keeps each tile's own scale.
-        noise_percentile: f64 = 0.0,
+        noise_percentile: f64 = 25.0,
             "%", 0.0..=100.0, step 5.0,
             "tiles' noise raised to this percentile of the image's; 0 is off";
         /// Images whose noise (Immerkær's estimate, `pipeline::noise_level`)
@@ -236,12 +236,12 @@ params! {
         /// those twice as noisy no orientation test (`lines.min_aligned`): a narrow
         /// kernel keeps close parallel edges apart in a clean photograph, a
         /// wider one averages more noise. 0 is off.
-        noisy_sigma: f64 = 0.0,
+        noisy_sigma: f64 = 4.5,
             "grey levels", 0.0..=255.0, step 0.5,
             "images at least this noisy take half_width + 1; 0 is off";
         /// With `noise_percentile`: no tile's noise scale above this many
         /// times that percentile. 0: no cap.
-        noise_cap: f64 = 0.0,
+        noise_cap: f64 = 2.0,
             "×", 0.0..=100.0, step 0.25,
             "tiles' noise capped at this multiple of the percentile; 0 is off";
         /// Threads for the two scan directions (edges and lines; 1 or 2).
@@ -296,7 +296,7 @@ params! {
         /// Gradient-orientation agreement: a line is kept when the image's
         /// gradient is within 22.5° of its normal at this fraction of its
         /// pixels (`lines/align.rs`: texture is not noise). 0 is off.
-        min_aligned: f64 = 0.0,
+        min_aligned: f64 = 0.9,
             "fraction", 0.0..=1.0, step 0.1,
             "lines need the gradient across them at this fraction of their pixels; 0 is off";
     }

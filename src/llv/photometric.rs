@@ -420,7 +420,11 @@ mod tests {
         .unwrap();
         let mut s = PhotoScratch::default();
         let mut out = Response::default();
-        let p = EdgeParams::default();
+        // A = 4, whose kernel's sum over a one-pixel line is 18 / 64.
+        let p = EdgeParams {
+            half_width: 4,
+            ..EdgeParams::default()
+        };
         combined_response_into(
             &[img.clone(), img],
             None,
@@ -618,7 +622,11 @@ mod tests {
 
     #[test]
     fn invalid_pixels_give_no_response_around_them() {
-        let p = EdgeParams::default();
+        // A = 4: the kernel's reach is 4 px either side of the invalid pixel.
+        let p = EdgeParams {
+            half_width: 4,
+            ..EdgeParams::default()
+        };
         let mut lit = step(50, 150, 40);
         let mut mask = vec![true; W * 32];
         mask[10 * W + 20] = false;

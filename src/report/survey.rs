@@ -292,7 +292,7 @@ mod tests {
     fn params_are_listed_by_dotted_key() {
         let lines = params_lines(&crate::llv::Params::default());
         assert!(
-            lines.iter().any(|l| l == "  edges.half_width = 4"),
+            lines.iter().any(|l| l == "  edges.half_width = 3"),
             "{lines:?}"
         );
         assert!(lines.iter().any(|l| l.starts_with("  connect.wl = ")));

@@ -128,6 +128,9 @@ fn too_few_views_and_no_plate_are_refused_at_80_by_24() {
     let dir = c.dir.path().to_path_buf();
     let before = std::fs::read(dir.join("cam1.cdf")).unwrap();
     c.wait_text("Survey", 10);
+    // The cell connected first: its message would hide the answer to a key
+    // pressed before it (seen on a loaded machine).
+    c.wait_text("grabber VSS-SIM", 30);
     c.press(
         Scope::Global,
         Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),

@@ -231,7 +231,7 @@ fn info_reports_a_bad_profile_with_line_and_key() {
     let d = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(profile())
         .unwrap()
-        .replace("half_width = 4 ", "half_width = 11 ");
+        .replace("half_width = 3 ", "half_width = 11 ");
     std::fs::write(d.path().join("cell.toml"), &text).unwrap();
     let line = text[..text.find("half_width = 11").unwrap()]
         .matches('\n')
@@ -275,7 +275,7 @@ fn params_export_then_import_into_a_profile() {
     let o = run(&["params", "export", "cell.toml", "--set", "edges"], p);
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(
-        o.stdout.starts_with("10 \"vss edges\"\n0 4\n"),
+        o.stdout.starts_with("10 \"vss edges\"\n0 3\n"),
         "{}",
         o.stdout
     );
@@ -294,7 +294,7 @@ fn params_export_then_import_into_a_profile() {
     assert_eq!(o.code, 0, "{}", o.stderr);
     let par = std::fs::read_to_string(p.join("e.par"))
         .unwrap()
-        .replacen("\n0 4\n", "\n0 6\n", 1);
+        .replacen("\n0 3\n", "\n0 6\n", 1);
     std::fs::write(p.join("e.par"), par).unwrap();
     // Without --out: the [llv] tables on stdout.
     let o = run(&["--profile", "cell.toml", "params", "import", "e.par"], p);

@@ -109,7 +109,7 @@ fn assert_names(from: &str, to: &str, key: &str, also: &[&str]) {
 #[test]
 fn out_of_range_parameters_name_line_key_and_range() {
     assert_names(
-        "half_width = 4 ",
+        "half_width = 3 ",
         "half_width = 9 ",
         "llv.edges.half_width",
         &["3 to 7"],
@@ -132,13 +132,13 @@ fn out_of_range_parameters_name_line_key_and_range() {
 #[test]
 fn wrong_types_name_line_key_and_range() {
     assert_names(
-        "half_width = 4 ",
+        "half_width = 3 ",
         "half_width = \"four\" ",
         "llv.edges.half_width",
         &["3 to 7"],
     );
     assert_names(
-        "half_width = 4 ",
+        "half_width = 3 ",
         "half_width = 4.5 ",
         "llv.edges.half_width",
         &["3 to 7"],
@@ -172,7 +172,7 @@ fn wrong_types_name_line_key_and_range() {
 #[test]
 fn unknown_keys_name_line_and_key() {
     assert_names(
-        "per_region = 16 ",
+        "per_region = 4096 ",
         "per_regoin = 16 ",
         "per_regoin",
         &["llv.edges"],

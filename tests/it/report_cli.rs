@@ -179,7 +179,7 @@ fn session_report_has_every_image() {
         .find_map(|l| l.strip_prefix("%%Pages: "))
         .unwrap_or("none");
     assert_eq!(pages, "6", "three pages per image");
-    assert!(text.contains("edges.half_width = 4"), "parameters printed");
+    assert!(text.contains("edges.half_width = 3"), "parameters printed");
     gs::require_gs();
     assert_eq!(gs::render(&dir.path().join("all.ps"), "a4", 36).len(), 6);
     let cube = std::fs::read_to_string(dir.path().join("cube.ps")).unwrap();

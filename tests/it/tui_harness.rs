@@ -379,6 +379,8 @@ impl Console {
             self.capture_current(k);
             self.press(SURVEY, Action::Survey(SurveyAction::Accept));
             self.wait_text(&format!("Image {}: camera", k + 1), 20);
+            // Accepted once the store has its files (said then, not before).
+            self.wait_text(&format!("image {k} accepted"), 20);
         }
     }
 

@@ -123,7 +123,7 @@ fn values_changes_and_grabs_are_confirmed_and_the_log_keeps_the_run() {
     assert!(s.contains("more"), "a longer list says so:\n{s}");
     c.choose_param("edges.half_width");
     c.press(PIPELINE, Action::Pipeline(PipelineAction::Type));
-    c.wait_text("edges.half_width = 4", 5);
+    c.wait_text("edges.half_width = 3", 5);
     // The field holds the value now: clear it, type a bad one.
     c.send("\x15wide\r");
     let s = c.wait_text("is not a number", 5);

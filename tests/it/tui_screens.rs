@@ -306,7 +306,7 @@ fn a_parameter_change_reruns_and_older_results_never_win() {
             .last()
             .unwrap()
             .text
-            .contains("edges.half_width 4 → 5"),
+            .contains("edges.half_width 3 → 4"),
         "the change is logged"
     );
     let req = req.clone();
@@ -333,7 +333,7 @@ fn a_parameter_change_reruns_and_older_results_never_win() {
     let (s, _) = draw(&app, 80, 24);
     assert!(
         s.lines()
-            .any(|l| l.contains("edges.half_width") && l.contains(" 5*")),
+            .any(|l| l.contains("edges.half_width") && l.contains(" 4*")),
         "changed values are marked:\n{s}"
     );
 }

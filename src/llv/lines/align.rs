@@ -282,7 +282,7 @@ mod tests {
             })
             .collect();
         let img = GreyImage::new(w, h, px).unwrap();
-        // (0.9: the photographs profile's; at 0.6 a stretch of this
+        // (0.9: the default; at 0.6 a stretch of this
         // texture, 11 of 17 aligned, would pass too.)
         let mut lines = vec![line(31.5, 2.0, 31.5, 60.0)];
         keep_aligned(&[img], &mut lines, 0.9, 8.0, &mut AlignScratch::default());

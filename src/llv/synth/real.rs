@@ -344,8 +344,9 @@ pub fn export_real(
 ) -> Result<usize, CompareError> {
     std::fs::create_dir_all(out).map_err(|e| FormatError::io(out, "create the folder", &e))?;
     let mut ws = Workspace::new();
-    let mut times =
-        String::from("# photo fastest_ms median_ms runs (vss, in-process, one thread)\n");
+    let mut times = String::from(
+        "# photo fastest_ms median_ms runs (vss, in-process, one thread); lens edges lines connect ms of the last run\n",
+    );
     let list = photographs(photos)?;
     for p in &list {
         let img = read_photo(&p.image)?;
@@ -355,10 +356,16 @@ pub fn export_real(
                 source,
             })?;
         super::compare::write_segments(&out.join(format!("{}.{VSS}.seg", p.name)), &lines)?;
+        let t = &ws.outputs().timings;
+        let ms = |us: u64| us as f64 / 1e3;
         times.push_str(&format!(
-            "{} {fastest:.4} {median:.4} {}\n",
+            "{} {fastest:.4} {median:.4} {} {:.3} {:.3} {:.3} {:.3}\n",
             p.name,
-            runs.max(1)
+            runs.max(1),
+            ms(t.lens_us),
+            ms(t.edges_us),
+            ms(t.lines_us),
+            ms(t.connect_us)
         ));
     }
     write_bytes(&out.join(format!("{VSS}.times")), times.as_bytes())?;
