@@ -236,7 +236,7 @@ params! {
         /// those twice as noisy no orientation test (`lines.min_aligned`): a narrow
         /// kernel keeps close parallel edges apart in a clean photograph, a
         /// wider one averages more noise. 0 is off.
-        noisy_sigma: f64 = 4.5,
+        noisy_sigma: f64 = 4.0,
             "grey levels", 0.0..=255.0, step 0.5,
             "images at least this noisy take half_width + 1; 0 is off";
         /// With `noise_percentile`: no tile's noise scale above this many

@@ -93,7 +93,7 @@ fn endpoints_and_angles() {
     geometry(Level::Sigma(2.0), 0.141, 0.246);
     geometry(Level::Sigma(5.0), 0.131, 0.207);
     geometry(Level::Sigma(10.0), 0.253, 0.349);
-    geometry(Level::Signal, 0.142, 0.264);
+    geometry(Level::Signal, 0.137, 0.205);
 }
 
 #[test]
@@ -119,7 +119,7 @@ fn noise_10() {
 
 #[test]
 fn signal_dependent_noise() {
-    floors(Level::Signal, 0.904, 0.980, 0.940);
+    floors(Level::Signal, 0.910, 0.975, 0.942);
 }
 
 #[test]
