@@ -149,7 +149,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             Some(dir) => real::score_dir(photos, dir)?,
             None => {
                 let p = params(g, &a)?;
-                let (m, _) = real::evaluate_real(photos, &p).with_context(|| {
+                let (m, _, by_contrast) = real::evaluate_real(photos, &p).with_context(|| {
                     format!("running vss on the photographs of {}", photos.display())
                 })?;
                 vec![real::RealScore {
@@ -157,6 +157,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                     metrics: m,
                     fastest_ms: None,
                     median_ms: None,
+                    by_contrast,
                 }]
             }
         };

@@ -11,13 +11,13 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use super::default_params;
-use vss::llv::synth::real::{RealMetrics, evaluate_real, photographs};
+use vss::llv::synth::real::{RealEvaluation, evaluate_real, photographs};
 
 fn folder() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/yud-tune")
 }
 
-type Scores = (RealMetrics, Vec<(String, RealMetrics)>);
+type Scores = RealEvaluation;
 
 fn scores() -> &'static Scores {
     static SCORES: OnceLock<Scores> = OnceLock::new();
@@ -44,7 +44,7 @@ fn the_tune_set_is_all_there() {
 
 #[test]
 fn york_urban_tune_f_recall_precision() {
-    let (m, each) = scores();
+    let (m, each, _) = scores();
     let s = format!(
         "{} photographs: precision {:.4}, recall {:.4}, F {:.4} ({} segments)",
         m.images, m.precision, m.recall, m.f, m.segments
@@ -64,3 +64,19 @@ fn york_urban_tune_f_recall_precision() {
 const F: f64 = 0.726;
 const RECALL: f64 = 0.722;
 const PRECISION: f64 = 0.730;
+
+/// Recall by the true lines' contrast (the breakdown): floors
+/// within 0.01 of what the engine measures, printed by `cargo test --test
+/// accuracy real:: -- --nocapture`.
+#[test]
+fn york_urban_tune_recall_by_contrast() {
+    let (_, _, c) = scores();
+    let r = c.recall();
+    eprintln!("recall by contrast (< 10, 10-20, 20-40, >= 40 grey levels): {r:?}");
+    for (i, floor) in BY_CONTRAST.iter().enumerate() {
+        let got = r[i].unwrap_or(0.0);
+        assert!(got >= *floor, "class {i}: recall {got:.4} (floor {floor})");
+    }
+}
+
+const BY_CONTRAST: [f64; 4] = [0.540, 0.638, 0.753, 0.836];

@@ -150,30 +150,108 @@ fn seg_distance(p: Point, s: &Seg) -> f64 {
 /// The matching length of `samples`' segments against `against`, and their
 /// whole length: `(matched, total)`.
 fn covered(samples: &[Segment], against: &[Segment]) -> (f64, f64) {
-    let src: Vec<Seg> = samples.iter().filter_map(usable).collect();
+    covered_each(samples, against)
+        .into_iter()
+        .fold((0.0, 0.0), |(m, t), (a, b)| (m + a, t + b))
+}
+
+/// [`covered`] per segment of `samples` (unusable ones: `(0, 0)`).
+fn covered_each(samples: &[Segment], against: &[Segment]) -> Vec<(f64, f64)> {
     let tgt: Vec<Seg> = against.iter().filter_map(usable).collect();
-    let total: f64 = src.iter().map(|s| s.len).sum();
-    if tgt.is_empty() {
-        return (0.0, total);
-    }
-    let grid = Grid::new(&tgt);
-    let mut matched = 0.0;
-    for s in &src {
-        let n = s.len.ceil().max(1.0);
-        let w = s.len / n;
-        for k in 0..n as usize {
+    let grid = (!tgt.is_empty()).then(|| Grid::new(&tgt));
+    samples
+        .iter()
+        .map(|s| {
+            let Some(s) = usable(s) else {
+                return (0.0, 0.0);
+            };
+            let Some(grid) = &grid else {
+                return (0.0, s.len);
+            };
+            let n = s.len.ceil().max(1.0);
+            let w = s.len / n;
+            let mut matched = 0.0;
+            for k in 0..n as usize {
+                let t = (k as f64 + 0.5) / n;
+                let p = Point::new(s.a.x + (s.b.x - s.a.x) * t, s.a.y + (s.b.y - s.a.y) * t);
+                let hit = grid.near(p).iter().any(|&j| {
+                    let o = &tgt[j as usize];
+                    angle_ok(s.theta, o.theta) && seg_distance(p, o) <= DIST
+                });
+                if hit {
+                    matched += w;
+                }
+            }
+            (matched, s.len)
+        })
+        .collect()
+}
+
+/// Upper bounds (grey levels) of the contrast classes of
+/// [`ContrastRecall`]: below 10, 10–20, 20–40, 40 and more.
+pub const CONTRAST_BOUNDS: [f64; 3] = [10.0, 20.0, 40.0];
+
+/// How far to either side of a true line its contrast is read (px).
+const CONTRAST_REACH: f64 = 2.0;
+
+/// A true line's contrast in `img`: the median over its samples (1 px
+/// apart) of the difference of the grey levels [`CONTRAST_REACH`] px to
+/// either side (nearest pixel). `None` when no sample has both sides inside.
+pub fn contrast(img: &GreyImage, s: &Segment) -> Option<f64> {
+    let s = usable(s)?;
+    let (nx, ny) = (-(s.b.y - s.a.y) / s.len, (s.b.x - s.a.x) / s.len);
+    let at = |x: f64, y: f64| -> Option<f64> {
+        let (x, y) = (x.round(), y.round());
+        (x >= 0.0 && y >= 0.0)
+            .then(|| img.get(x as usize, y as usize))
+            .flatten()
+            .map(f64::from)
+    };
+    let n = s.len.ceil().max(1.0);
+    let mut d: Vec<f64> = (0..n as usize)
+        .filter_map(|k| {
             let t = (k as f64 + 0.5) / n;
-            let p = Point::new(s.a.x + (s.b.x - s.a.x) * t, s.a.y + (s.b.y - s.a.y) * t);
-            let hit = grid.near(p).iter().any(|&j| {
-                let o = &tgt[j as usize];
-                angle_ok(s.theta, o.theta) && seg_distance(p, o) <= DIST
-            });
-            if hit {
-                matched += w;
+            let (x, y) = (s.a.x + (s.b.x - s.a.x) * t, s.a.y + (s.b.y - s.a.y) * t);
+            let r = CONTRAST_REACH;
+            Some((at(x + r * nx, y + r * ny)? - at(x - r * nx, y - r * ny)?).abs())
+        })
+        .collect();
+    if d.is_empty() {
+        return None;
+    }
+    let mid = d.len() / 2;
+    Some(*d.select_nth_unstable_by(mid, f64::total_cmp).1)
+}
+
+/// The class of a contrast: the index of the first bound above it.
+fn contrast_class(c: f64) -> usize {
+    CONTRAST_BOUNDS.iter().take_while(|&&b| c >= b).count()
+}
+
+/// Recall by the true lines' contrast (lengths pooled over photographs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ContrastRecall {
+    /// True length per class, and the part of it found.
+    pub truth: [f64; 4],
+    pub found: [f64; 4],
+}
+
+impl ContrastRecall {
+    /// Adds one photograph: its true lines with their classes (`None`: no
+    /// contrast could be read) and a detector's segments.
+    pub fn add(&mut self, truth: &[Segment], classes: &[Option<usize>], detected: &[Segment]) {
+        for ((f, t), c) in covered_each(truth, detected).into_iter().zip(classes) {
+            if let Some(c) = *c {
+                self.found[c] += f;
+                self.truth[c] += t;
             }
         }
     }
-    (matched, total)
+
+    /// Recall per class (`None` for a class without true lines).
+    pub fn recall(&self) -> [Option<f64>; 4] {
+        std::array::from_fn(|i| (self.truth[i] > 0.0).then(|| self.found[i] / self.truth[i]))
+    }
 }
 
 /// Square cells, each listing the segments that come within [`DIST`] of
@@ -308,14 +386,15 @@ pub fn read_photo(path: &Path) -> Result<GreyImage, FormatError> {
     read_any_sized(path, crate::llv::image::check_stage_size).map(|(f, _)| f.image)
 }
 
-/// Runs vss on every photograph of `dir` and scores it: the pooled
-/// metrics and each photograph's own, by name.
-pub fn evaluate_real(
-    dir: &Path,
-    params: &Params,
-) -> Result<(RealMetrics, Vec<(String, RealMetrics)>), CompareError> {
+/// What [`evaluate_real`] measures: the pooled metrics, each
+/// photograph's own (by name), and recall by contrast.
+pub type RealEvaluation = (RealMetrics, Vec<(String, RealMetrics)>, ContrastRecall);
+
+/// Runs vss on every photograph of `dir` and scores it.
+pub fn evaluate_real(dir: &Path, params: &Params) -> Result<RealEvaluation, CompareError> {
     let mut ws = Workspace::new();
     let mut tally = RealTally::default();
+    let mut by_contrast = ContrastRecall::default();
     let mut each = Vec::new();
     for p in photographs(dir)? {
         let img = read_photo(&p.image)?;
@@ -328,9 +407,14 @@ pub fn evaluate_real(
         let mut one = RealTally::default();
         one.add(&lines, &truth);
         tally.add(&lines, &truth);
+        let classes: Vec<Option<usize>> = truth
+            .iter()
+            .map(|s| contrast(&img, s).map(contrast_class))
+            .collect();
+        by_contrast.add(&truth, &classes, &lines);
         each.push((p.name, one.metrics()));
     }
-    Ok((tally.metrics(), each))
+    Ok((tally.metrics(), each, by_contrast))
 }
 
 /// Runs vss on every photograph of `photos` (timed in-process, `runs`
@@ -381,6 +465,8 @@ pub struct RealScore {
     /// (ms), when the detector wrote its times.
     pub fastest_ms: Option<f64>,
     pub median_ms: Option<f64>,
+    /// Recall by the true lines' contrast in the photograph.
+    pub by_contrast: ContrastRecall,
 }
 
 /// Scores every detector with segment files `NAME.DET.seg` in `segs` for
@@ -392,10 +478,22 @@ pub fn score_dir(photos: &Path, segs: &Path) -> Result<Vec<RealScore>, FormatErr
         .iter()
         .map(|p| read_truth(&p.truth))
         .collect::<Result<_, _>>()?;
+    // Each true line's contrast class, read from its photograph once.
+    let classes: Vec<Vec<Option<usize>>> = list
+        .iter()
+        .zip(&truths)
+        .map(|(p, t)| {
+            let img = read_photo(&p.image)?;
+            Ok(t.iter()
+                .map(|s| contrast(&img, s).map(contrast_class))
+                .collect())
+        })
+        .collect::<Result<_, FormatError>>()?;
     let mut out = Vec::new();
     for det in super::compare::detectors(segs)? {
         let mut tally = RealTally::default();
-        for (p, t) in list.iter().zip(&truths) {
+        let mut by_contrast = ContrastRecall::default();
+        for ((p, t), c) in list.iter().zip(&truths).zip(&classes) {
             let path = segs.join(format!("{}.{det}.seg", p.name));
             if !path.exists() {
                 return Err(FormatError::new(
@@ -408,7 +506,9 @@ pub fn score_dir(photos: &Path, segs: &Path) -> Result<Vec<RealScore>, FormatErr
                     ),
                 ));
             }
-            tally.add(&read_segments(&path)?, t);
+            let detected = read_segments(&path)?;
+            tally.add(&detected, t);
+            by_contrast.add(t, c, &detected);
         }
         let times_path = segs.join(format!("{det}.times"));
         let (fastest_ms, median_ms) = if times_path.exists() {
@@ -426,6 +526,7 @@ pub fn score_dir(photos: &Path, segs: &Path) -> Result<Vec<RealScore>, FormatErr
             metrics: tally.metrics(),
             fastest_ms,
             median_ms,
+            by_contrast,
         });
     }
     Ok(out)
@@ -453,6 +554,42 @@ pub fn table(scores: &[RealScore], images: usize) -> String {
             ms(d.median_ms)
         );
     }
+    let _ = writeln!(
+        s,
+        "recall by the true line's contrast (grey levels 2 px to either side; share of true length)"
+    );
+    if let Some(d) = scores.first() {
+        let all: f64 = d.by_contrast.truth.iter().sum();
+        let share = d
+            .by_contrast
+            .truth
+            .map(|t| if all > 0.0 { t / all } else { 0.0 });
+        let _ = writeln!(
+            s,
+            "{:<10} {:>9} {:>9} {:>9} {:>9}\n{:<10} {:>9.2} {:>9.2} {:>9.2} {:>9.2}",
+            "contrast",
+            "< 10",
+            "10-20",
+            "20-40",
+            ">= 40",
+            "share",
+            share[0],
+            share[1],
+            share[2],
+            share[3]
+        );
+    }
+    for d in scores {
+        let r = d
+            .by_contrast
+            .recall()
+            .map(|r| r.map_or("-".to_string(), |r| format!("{r:.3}")));
+        let _ = writeln!(
+            s,
+            "{:<10} {:>9} {:>9} {:>9} {:>9}",
+            d.detector, r[0], r[1], r[2], r[3]
+        );
+    }
     s
 }
 
@@ -462,6 +599,25 @@ mod tests {
 
     fn seg(x0: f64, y0: f64, x1: f64, y1: f64) -> Segment {
         Segment::new(Point::new(x0, y0), Point::new(x1, y1))
+    }
+
+    #[test]
+    fn contrast_is_the_step_across_the_line() {
+        // Columns below 20 are 50, from 20 on 80: a vertical step of 30 at
+        // x = 19.5, and a line along it.
+        let px = (0..40 * 30)
+            .map(|i| if i % 40 < 20 { 50 } else { 80 })
+            .collect();
+        let img = GreyImage::new(40, 30, px).unwrap();
+        let c = contrast(&img, &seg(19.5, 2.0, 19.5, 27.0)).unwrap();
+        assert_eq!(c, 30.0);
+        assert_eq!(contrast_class(c), 2);
+        // Along a flat area: none.
+        assert_eq!(contrast(&img, &seg(5.0, 2.0, 5.0, 27.0)), Some(0.0));
+        assert_eq!(contrast_class(9.9), 0);
+        assert_eq!(contrast_class(40.0), 3);
+        // Off the image: no contrast to read.
+        assert_eq!(contrast(&img, &seg(100.0, 2.0, 100.0, 27.0)), None);
     }
 
     #[test]
