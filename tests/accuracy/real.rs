@@ -88,9 +88,8 @@ const BY_CONTRAST: [f64; 4] = [0.540, 0.638, 0.753, 0.836];
 /// scorer. Printed by `cargo test --test accuracy real:: -- --nocapture`.
 ///
 /// The goal (the combination at least as good as the best single
-/// image) is not met here: the combination's noise model (τ = 5 × each
-/// image's median |response|) is not the sensor-noise threshold one image
-/// gets, and on textured photographs it takes away recall (docs/accuracy.md).
+/// image) is not met here: the combination subtracts τ per image, which on
+/// textured photographs takes away recall (docs/accuracy.md).
 /// The floor keeps what it measures from getting worse.
 #[test]
 fn three_lightings_of_each_photograph_against_the_best_one() {
