@@ -370,7 +370,7 @@ fn noise_median(samples: &mut [i32], strips: &mut Vec<i32>, percentile: f64) -> 
         samples
             .chunks_mut(STRIP)
             .filter(|c| c.len() * 2 >= STRIP)
-            .map(|c| median(c)),
+            .map(median),
     );
     let last = strips.len() - 1;
     let k = ((percentile.min(100.0) / 100.0) * last as f64).round() as usize;
