@@ -137,6 +137,29 @@ fn parameter_keys_keep_the_picture_still(cols: u16, rows: u16, ceiling: usize) {
     c.send("q");
 }
 
+/// The Pipeline screen's hints on one row, in columns (as the hint row
+/// lays them out: key, space, label, two spaces).
+fn pipeline_hints_width() -> u16 {
+    use vss::tui::keymap::hints;
+    [
+        Scope::Screen(ScreenId::Pipeline),
+        Scope::Picture,
+        Scope::Global,
+    ]
+    .into_iter()
+    .flat_map(hints)
+    .map(|(k, d)| (k.chars().count() + 1 + d.chars().count() + 2) as u16)
+    .sum()
+}
+
+/// Where the hints just fit one row, "running…" made them two and took a
+/// row from the picture: it moved a column and was sent again whole (at
+/// 120 × 40 before the Pipeline screen's hints grew past one row).
+#[test]
+fn a_parameter_key_where_the_hints_just_fit_one_row_keeps_the_picture_still() {
+    parameter_keys_keep_the_picture_still(pipeline_hints_width() + 1, 40, 4096);
+}
+
 #[test]
 fn a_parameter_key_at_120_by_40_keeps_the_picture_still_within_4_kib() {
     parameter_keys_keep_the_picture_still(120, 40, 4096);

@@ -76,7 +76,9 @@ fn the_device_lost_banner_is_whole_on_the_hint_rows() {
 
 #[test]
 fn the_zoom_readout_fits_at_80_columns() {
-    let mut c = Console::start(80, 24, &[]);
+    // 512 × 512, as the cell's cameras: three-digit places.
+    let profile = PROFILE.replace("width = 128\nheight = 128", "width = 512\nheight = 512");
+    let mut c = Console::start_with(&profile, 80, 24, &[], |_| {});
     c.create_session("cube");
     c.capture_current(1);
     c.press(
