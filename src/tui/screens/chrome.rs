@@ -226,9 +226,14 @@ fn hint_spans(app: &App) -> Vec<Span<'static>> {
 
 /// The keys of the screen in front, then the picture's and the global ones.
 fn key_hints(app: &App) -> Vec<Span<'static>> {
+    key_hints_of(app, app.scope())
+}
+
+/// The hints of `scope` (with the picture's and the global ones on a
+/// screen).
+fn key_hints_of(app: &App, scope: Scope) -> Vec<Span<'static>> {
     let t = app.theme();
     let mut spans = Vec::new();
-    let scope = app.scope();
     let searching = app.search_in_front() && !matches!(scope, Scope::Prompt | Scope::Confirm);
     let mut hints = if searching {
         keymap::hints(Scope::Search)
@@ -271,11 +276,13 @@ fn key_hints(app: &App) -> Vec<Span<'static>> {
 }
 
 /// The room kept on the hint rows for what comes and goes while the
-/// operator works ("running…", a transfer's gauge), so that their coming
-/// does not take a row from the screen above: a picture that lost a row
-/// would be drawn one column narrower and sent again whole (issue 33).
-/// That is `transfer [#########] 100% running… `, in columns.
-const STATUS_ROOM: usize = 36;
+/// operator tunes ("running…"), so that its coming does not take a row
+/// from the screen above: a picture that lost a row would be drawn one
+/// column narrower and sent again whole (issue 33). A transfer's gauge is
+/// not kept room for: it comes with a capture, when the picture changes
+/// anyway, and its room would cost a row at 80 × 24 for good.
+/// `running… ` is 9 columns.
+const STATUS_ROOM: usize = 9;
 
 /// The hints laid out in rows of `width`: a key and its label stay
 /// together.
@@ -310,18 +317,15 @@ fn layout_spans(spans: Vec<Span<'static>>, width: usize, used: usize) -> Vec<Vec
 }
 
 /// Rows the hints need at `width` (at most three), with room kept for the
-/// passing status ([`STATUS_ROOM`]): the same while a run or a capture
-/// comes and goes.
+/// passing status ([`STATUS_ROOM`]) and for the screen's own hints while a
+/// question or a field shows shorter ones: the same while a run comes and
+/// goes, or a value is typed.
 pub fn hint_rows(app: &App, width: u16) -> u16 {
     let now = hint_layout(app, width as usize).len();
-    // Kept once there is a picture a key can re-run, or a capture runs.
-    let kept = if app.tracker.current.is_some() || app.cell.device.transfer.is_some() {
-        layout_spans(
-            key_hints(app),
-            width as usize,
-            STATUS_ROOM.min(width as usize),
-        )
-        .len()
+    // Kept once there is a picture a key can re-run.
+    let kept = if app.tracker.current.is_some() {
+        let screen = key_hints_of(app, Scope::Screen(app.chrome.screen));
+        layout_spans(screen, width as usize, STATUS_ROOM.min(width as usize)).len()
     } else {
         0
     };
