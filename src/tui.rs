@@ -10,7 +10,7 @@
 use std::io::{self, Write};
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError, Sender};
 use std::time::{Duration, Instant};
 
@@ -52,17 +52,21 @@ pub fn run(profile: crate::profile::Profile, look: mode::Look) -> anyhow::Result
 
     // Signals first: a hang-up during start-up must still restore the terminal.
     let stop = Arc::new(AtomicBool::new(false));
+    // Which signal stopped the console, for the log's last line.
+    let signal = Arc::new(AtomicUsize::new(0));
     for sig in [
         signal_hook::consts::SIGTERM,
         signal_hook::consts::SIGHUP,
         signal_hook::consts::SIGINT,
         signal_hook::consts::SIGQUIT,
     ] {
+        signal_hook::flag::register_usize(sig, signal.clone(), sig as usize)
+            .context("installing signal handlers")?;
         signal_hook::flag::register(sig, stop.clone()).context("installing signal handlers")?;
     }
     install_panic_hook();
     let mut terminal = enter().context("setting up the terminal")?;
-    let result = run_loop(&mut terminal, profile, look, &stop);
+    let result = run_loop(&mut terminal, profile, look, &stop, &signal);
     // Drop the terminal first: its own clean-up writes to the screen, and
     // leaving the alternate screen must be the last thing written.
     drop(terminal);
@@ -147,6 +151,7 @@ fn run_loop(
     profile: crate::profile::Profile,
     look: mode::Look,
     stop: &Arc<AtomicBool>,
+    signal: &Arc<AtomicUsize>,
 ) -> anyhow::Result<()> {
     let (tx, rx) = mpsc::channel::<Msg>();
     let mut app = App::new(&profile, look);
@@ -202,6 +207,19 @@ fn run_loop(
             Err(RecvTimeoutError::Disconnected) => break,
         }
     }
+    // The log says why the console ended: the operator, a signal, or the
+    // terminal gone.
+    let why = match signal.load(Ordering::SeqCst) as i32 {
+        0 if app.quit() => "quit by the operator".to_string(),
+        0 if stop.load(Ordering::SeqCst) => "the terminal's input ended (hang-up)".to_string(),
+        0 => "its workers stopped".to_string(),
+        signal_hook::consts::SIGHUP => "SIGHUP: the terminal hung up".to_string(),
+        signal_hook::consts::SIGTERM => "SIGTERM: asked to stop".to_string(),
+        signal_hook::consts::SIGINT => "SIGINT".to_string(),
+        signal_hook::consts::SIGQUIT => "SIGQUIT".to_string(),
+        n => format!("signal {n}"),
+    };
+    app.ctx().info(format!("console ended: {why}"));
     workers.dispatch(app.take_log_lines().into_iter().collect());
     workers.finish();
     Ok(())

@@ -30,6 +30,7 @@ mod mouse;
 mod nav;
 mod pipeline;
 mod results;
+mod search;
 mod session;
 mod survey;
 mod tracker;
@@ -37,7 +38,7 @@ mod tracker;
 pub use calibrate::{CalibrateScreen, Centre, Field, PLATE, short_name};
 pub use capture::CaptureScreen;
 pub use cell::{CellState, DeviceState};
-pub use chrome::{Chrome, LogView, Overlay};
+pub use chrome::{Chrome, LogView, Overlay, Search, SearchTarget};
 pub use edit::{EditScreen, describe_op};
 pub use files::FilesScreen;
 pub use log::{Level, Log, LogEntry};
@@ -219,6 +220,15 @@ impl App {
             return Vec::new();
         }
         let scope = self.scope();
+        // A search on takes n, N and Esc while what it searches is in
+        // front; once that is gone, so is the search.
+        if self.chrome.search.is_some() && !matches!(scope, Scope::Prompt | Scope::Confirm) {
+            if !self.search_in_front() {
+                self.chrome.search = None;
+            } else if let Some(a) = keymap::lookup(Scope::Search, &key) {
+                return self.act(a);
+            }
+        }
         match keymap::lookup(scope, &key) {
             Some(a) => self.act(a),
             None if scope == Scope::Prompt => {
@@ -244,6 +254,10 @@ impl App {
             Action::Modal(m) => self.modal_action(m),
             Action::Viewer(v) => {
                 self.chrome.viewer(v);
+                Vec::new()
+            }
+            Action::Search(a) => {
+                self.search(a);
                 Vec::new()
             }
             Action::Survey(a) => {
@@ -306,9 +320,10 @@ impl App {
                     .filter(|c| !c.unsaved.is_empty())
                 {
                     let (letters, k) = (c.unsaved_letters(), c.k);
+                    let letters = format!("L{}", &letters[1..]);
                     self.ctx().ask(
                         format!(
-                            "Lighting {letters} of image {k} is not saved (! on the checklist): \
+                            "{letters} of image {k} is not saved (! on the checklist): \
                              quitting loses it. Quit anyway?"
                         ),
                         Pending::Quit,
@@ -359,6 +374,7 @@ impl App {
     /// Stops a transfer (and the live view) under way.
     pub fn cancel_transfer(ctx: &mut Ctx) -> Vec<Cmd> {
         ctx.cell.device.live = false;
+        ctx.cell.device.cancelled = ctx.cell.device.transfer.is_some();
         vec![Cmd::Device(DeviceCmd::Cancel)]
     }
 }

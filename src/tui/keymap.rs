@@ -70,6 +70,9 @@ pub enum Scope {
     Prompt,
     /// The help overlay or the message viewer is open.
     Viewer,
+    /// A search is on (after `/` and Enter): tried before the scope in
+    /// front, so `n` goes to the next match rather than to the screen.
+    Search,
 }
 
 /// Everything a key can ask for, grouped by its owner.
@@ -85,6 +88,7 @@ pub enum Action {
     Calibrate(CalibrateAction),
     Modal(ModalAction),
     Viewer(ViewerAction),
+    Search(SearchAction),
 }
 
 /// Keys of the frame around every screen.
@@ -245,7 +249,20 @@ pub enum ViewerAction {
     Down,
     PageUp,
     PageDown,
+    Top,
+    Bottom,
     Close,
+}
+
+/// `/`: search the help window, the message log or the Session screen's
+/// file list for a text; then the next and previous match, and the end of
+/// the search.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SearchAction {
+    Start,
+    Next,
+    Prev,
+    Clear,
 }
 
 impl Action {
@@ -272,7 +289,11 @@ impl Action {
             Action::Files(a) => a == FilesAction::Export,
             Action::Calibrate(a) => matches!(a, CalibrateAction::Drop | CalibrateAction::Accept),
             Action::Global(a) => a == GlobalAction::Quit,
-            Action::Capture(_) | Action::Nav(_) | Action::Modal(_) | Action::Viewer(_) => false,
+            Action::Capture(_)
+            | Action::Nav(_)
+            | Action::Modal(_)
+            | Action::Viewer(_)
+            | Action::Search(_) => false,
         }
     }
 
@@ -299,6 +320,7 @@ impl Action {
             Action::Edit(a) => matches!(a, EditAction::LineNext | EditAction::LinePrev),
             Action::Files(a) => matches!(a, FilesAction::Up | FilesAction::Down),
             Action::Capture(a) => matches!(a, CaptureAction::LightPrev | CaptureAction::LightNext),
+            Action::Search(a) => matches!(a, SearchAction::Next | SearchAction::Prev),
             Action::Calibrate(_) | Action::Modal(_) | Action::Viewer(_) => false,
         }
     }
@@ -417,10 +439,16 @@ pub fn describe(scope: Scope) -> Vec<(String, &'static str)> {
 /// The status-bar hints of a scope: (keys, short label) pairs, the keys of
 /// one hint joined (`zZ zoom`, `PgUp/PgDn scroll`).
 pub fn hints(scope: Scope) -> Vec<(String, &'static str)> {
+    hints_where(scope, |_| true)
+}
+
+/// The hints of a scope for the bindings `keep` keeps (what does nothing
+/// now, or what another scope takes, is not offered).
+pub fn hints_where(scope: Scope, keep: impl Fn(&Binding) -> bool) -> Vec<(String, &'static str)> {
     let mut out: Vec<(Vec<String>, &'static str)> = Vec::new();
     for b in KEYMAP
         .iter()
-        .filter(|b| !b.hint.is_empty() && b.scope == scope)
+        .filter(|b| !b.hint.is_empty() && b.scope == scope && keep(b))
     {
         match out.iter_mut().find(|(_, h)| *h == b.hint) {
             Some((keys, _)) => keys.push(b.key.label()),
@@ -453,6 +481,10 @@ pub fn scopes() -> Vec<(String, Scope)> {
     out.push(("Questions".into(), Scope::Confirm));
     out.push(("Typing".into(), Scope::Prompt));
     out.push(("Help and message windows".into(), Scope::Viewer));
+    out.push((
+        "While a search is on (after / and Enter)".into(),
+        Scope::Search,
+    ));
     out
 }
 

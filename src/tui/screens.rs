@@ -19,8 +19,8 @@ mod capture;
 pub mod chrome;
 mod edit;
 mod pipeline;
-mod session;
-mod survey;
+pub mod session;
+pub mod survey;
 
 /// The smallest terminal the screens are drawn in.
 pub const MIN_SIZE: (u16, u16) = (64, 18);
@@ -311,11 +311,18 @@ impl Widget for &App {
             LogView::Line | LogView::Hidden => chrome::message(self, f.message, buf),
         }
         chrome::hints(self, f.hints, buf);
+        // A question or field opened over the help (`/` there) is drawn
+        // over it.
+        if let Some(o) = self.chrome.overlay {
+            // Over all but the hint rows, which say its keys.
+            let over = Rect {
+                height: area.height.saturating_sub(f.hints.height),
+                ..area
+            };
+            chrome::overlay(self, o, over, buf);
+        }
         if let Some(m) = &self.chrome.modal {
             chrome::modal_box(self, m, area, buf);
-        }
-        if let Some(o) = self.chrome.overlay {
-            chrome::overlay(self, o, area, buf);
         }
         if self.ascii() {
             chrome::asciify(area, buf);
@@ -375,11 +382,12 @@ pub fn pointer(
         let r = row.checked_sub(p.y)? as usize;
         return match screen {
             ScreenId::Survey if app.session.view.is_none() || app.screens.survey.picking => {
-                let n = app.session.list.len();
+                let rows = survey::session_rows(app, p.width as usize);
+                let focus = survey::selected_row(&rows, app.screens.survey.selected);
                 let room = (p.height as usize).saturating_sub(4);
-                let (start, _, above) = window_span(n, app.screens.survey.selected, room);
-                let i = (r.checked_sub(1 + usize::from(above))? + start).min(n);
-                (i < n).then_some(Pointer::SessionRow(i))
+                let (start, shown, above) = window_span(rows.len(), focus, room);
+                let i = r.checked_sub(1 + usize::from(above))?;
+                (i < shown).then(|| rows.get(start + i).map(|row| Pointer::SessionRow(row.0)))?
             }
             ScreenId::Survey => {
                 let ks = app.session.numbers();

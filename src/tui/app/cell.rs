@@ -23,6 +23,9 @@ pub struct DeviceState {
     /// The lights are settling before a freeze (nothing transferred yet).
     pub settling: bool,
     pub live: bool,
+    /// The operator stopped the transfer under way (Esc): its failure is
+    /// that stop, not a fault.
+    pub cancelled: bool,
 }
 
 #[derive(Debug)]

@@ -24,6 +24,43 @@ pub enum Overlay {
     Message { scroll: usize },
 }
 
+/// What a search looks through.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SearchTarget {
+    Help,
+    Log,
+    Files,
+}
+
+impl SearchTarget {
+    pub fn name(self) -> &'static str {
+        match self {
+            SearchTarget::Help => "the help",
+            SearchTarget::Log => "the log",
+            SearchTarget::Files => "the file list",
+        }
+    }
+}
+
+/// A search on: its text (case ignored) and which of its matches is shown.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Search {
+    pub target: SearchTarget,
+    pub query: String,
+    /// The match shown, counted in the order `n` goes (help and files top
+    /// down, the log newest first).
+    pub current: usize,
+    /// How many rows match, when last looked.
+    pub count: usize,
+}
+
+impl Search {
+    /// Whether a row of text matches.
+    pub fn matches(&self, row: &str) -> bool {
+        row.to_lowercase().contains(&self.query.to_lowercase())
+    }
+}
+
 #[derive(Debug)]
 pub struct Chrome {
     pub look: Look,
@@ -34,6 +71,8 @@ pub struct Chrome {
     pub log_scroll: usize,
     pub overlay: Option<Overlay>,
     pub modal: Option<Modal>,
+    /// The search on, if any (`/`).
+    pub search: Option<Search>,
     /// The terminal's size (columns, rows), from the last resize.
     pub size: (u16, u16),
     pub quit: bool,
@@ -49,6 +88,7 @@ impl Chrome {
             log_scroll: 0,
             overlay: None,
             modal: None,
+            search: None,
             size: (80, 24),
             quit: false,
         }
@@ -90,6 +130,9 @@ impl Chrome {
             ViewerAction::Down => *scroll += 1,
             ViewerAction::PageUp => *scroll = scroll.saturating_sub(page),
             ViewerAction::PageDown => *scroll += page,
+            ViewerAction::Top => *scroll = 0,
+            // The drawing clamps to the last page.
+            ViewerAction::Bottom => *scroll = usize::MAX / 2,
             ViewerAction::Close => self.overlay = None,
         }
     }

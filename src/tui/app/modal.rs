@@ -34,6 +34,8 @@ pub enum Pending {
     ExtraImage(u32),
     /// Go on with the edit of an accepted image's lines.
     Edit,
+    /// Go on with an edit whose result looks like nonsense.
+    EditDoubtful,
     /// Create a session whose name ends in a digit.
     CreateSession(String),
     /// Write the calibration shown into its camera's `.cdf`.
@@ -46,6 +48,8 @@ pub enum PromptPurpose {
     ParamValue(&'static str),
     /// The Calibrate screen's fields (images to load, plate, centre).
     Calibrate(super::calibrate::Field),
+    /// The text `/` searches for.
+    Search(super::SearchTarget),
 }
 
 /// A one-line text field.
@@ -299,6 +303,10 @@ impl App {
                 let (s, mut ctx) = self.parts();
                 s.edit.confirmed(&mut ctx)
             }
+            Pending::EditDoubtful => {
+                let (s, mut ctx) = self.parts();
+                s.edit.doubt_confirmed(&mut ctx)
+            }
             Pending::CalibWrite => self.screens.calibrate.confirmed(),
         }
     }
@@ -308,6 +316,15 @@ impl App {
             return Vec::new();
         };
         let result = match p.purpose {
+            PromptPurpose::Search(target) => {
+                // Not logged: a search is no event of the survey (and its
+                // text in the log would be a match of the next search).
+                if let Err(e) = self.search_submitted(target, &p.text) {
+                    p.error = Some(e);
+                    self.chrome.modal = Some(Modal::Prompt(p));
+                }
+                return Vec::new();
+            }
             PromptPurpose::SessionName => {
                 match crate::formats::names::SessionName::new(p.text.trim()) {
                     Ok(n) => {
@@ -336,16 +353,30 @@ impl App {
             }
             PromptPurpose::ParamValue(key) => {
                 let mut params = self.tracker.params.clone();
-                match params.set_str(&format!("{key}={}", p.text.trim())) {
-                    Ok(()) => {
-                        let v = params.get(key).unwrap_or_default();
-                        self.chrome.log.push(
-                            Level::Info,
-                            format!("{key} = {}", crate::llv::params::fmt_value(v)),
-                        );
-                        Ok(self.ctx().set_params(params))
+                let spec = crate::llv::params::PARAMS.iter().find(|sp| sp.key == key);
+                let typed = p.text.trim();
+                // A fraction for a whole-number parameter is the wrong kind
+                // of value, whatever its size ("6.7 is out of range: 1 to
+                // 4096" sent the operator looking at the range).
+                let fraction = spec.is_some_and(|sp| sp.kind == crate::llv::params::Kind::Int)
+                    && typed.parse::<f64>().is_ok_and(|v| v.fract() != 0.0);
+                if fraction {
+                    Err(format!(
+                        "{key} takes a whole number ({}): {typed} is not one",
+                        spec.map(|sp| sp.range_text()).unwrap_or_default()
+                    ))
+                } else {
+                    match params.set_str(&format!("{key}={typed}")) {
+                        Ok(()) => {
+                            let v = params.get(key).unwrap_or_default();
+                            self.chrome.log.push(
+                                Level::Info,
+                                format!("{key} = {}", crate::llv::params::fmt_value(v)),
+                            );
+                            Ok(self.ctx().set_params(params))
+                        }
+                        Err(e) => Err(e.to_string()),
                     }
-                    Err(e) => Err(e.to_string()),
                 }
             }
             PromptPurpose::Calibrate(field) => {

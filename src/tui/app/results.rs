@@ -126,8 +126,20 @@ impl App {
             DeviceEvent::CaptureFailed { purpose, error } => {
                 dev.transfer = None;
                 dev.settling = false;
+                let stopped = std::mem::take(&mut dev.cancelled);
                 let mut ctx = self.ctx();
-                ctx.error(format!("capture failed: {}", clean(&error)));
+                if stopped {
+                    // The operator's own Esc, not a fault of the cell.
+                    let what = match purpose {
+                        FramePurpose::Survey { letter, .. } => {
+                            format!("image {} lighting {letter}", ctx.session.work.k)
+                        }
+                        _ => "the frame".to_string(),
+                    };
+                    ctx.info(format!("capture stopped (Esc): {what} not taken"));
+                } else {
+                    ctx.error(format!("capture failed: {}", clean(&error)));
+                }
                 if let FramePurpose::Survey { .. } = purpose {
                     ctx.survey_capture_failed();
                 }
@@ -214,6 +226,8 @@ impl App {
                 Vec::new()
             }
             StoreEvent::OutputsSaved(k) => {
+                self.session.saving.retain(|&s| s != k);
+                self.session.refused.retain(|r| r.0 != k);
                 self.ctx().info(format!(
                     "image {k} accepted: outputs saved (.hpo .vpo .lex .ldr)"
                 ));
@@ -295,6 +309,13 @@ impl App {
                 Vec::new()
             }
             StoreEvent::OutputsNotSaved { k, error } => {
+                self.session.saving.retain(|&s| s != k);
+                let why = match &error {
+                    StoreError::Session { source, .. } => clean(&source.to_string()),
+                    e => clean(&e.to_string()),
+                };
+                self.session.refused.retain(|r| r.0 != k);
+                self.session.refused.push((k, why));
                 let mut ctx = self.ctx();
                 ctx.error(format!(
                     "{} — image {k} is not accepted; a tries again once that is put right",

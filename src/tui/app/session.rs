@@ -11,6 +11,13 @@ pub struct SessionState {
     pub view: Option<SessionView>,
     pub list: Vec<SessionEntry>,
     pub work: Work,
+    /// Images accepted whose outputs the store is saving: done for the
+    /// survey's next step (the view says so only once they are saved).
+    pub saving: Vec<u32>,
+    /// Images whose acceptance failed (their outputs not saved), with why:
+    /// said in the next-step box until they are accepted, so that no later
+    /// message hides it.
+    pub refused: Vec<(u32, String)>,
 }
 
 impl SessionState {

@@ -79,6 +79,11 @@ impl SurveyScreen {
                     ctx.warn("no session in the survey folder yet: n creates one");
                     return Vec::new();
                 }
+                if ctx.session.view.is_none() {
+                    // The list on screen already is the picker.
+                    ctx.info("the sessions are listed here: ↑↓ chooses, Enter opens");
+                    return Vec::new();
+                }
                 self.picking = !self.picking || ctx.session.view.is_none();
                 if let Some(v) = &ctx.session.view
                     && let Some(i) = ctx.session.list.iter().position(|e| e.dir == v.dir)
@@ -157,7 +162,10 @@ impl SurveyScreen {
             SurveyAction::Camera | SurveyAction::Location => {
                 let w = &mut ctx.session.work;
                 if w.phase != Phase::Setup {
-                    ctx.warn("camera and location are chosen before capturing (Setup)");
+                    ctx.warn(
+                        "camera (c) and location (p) are chosen before an image's capture \
+                         starts, not while it runs or after it",
+                    );
                     return Vec::new();
                 }
                 if a == SurveyAction::Camera {
@@ -419,6 +427,8 @@ impl Ctx<'_> {
     }
 
     pub fn session_opened(&mut self, v: SessionView) -> Vec<Cmd> {
+        self.session.saving.clear();
+        self.session.refused.clear();
         self.info(format!("session {} open in {}", v.name, v.dir.display()));
         let last = v
             .images
@@ -611,6 +621,7 @@ impl Ctx<'_> {
                 Some(c) => cmds = c,
                 None => return Vec::new(),
             }
+            self.session.saving.push(k);
             // "accepted" is said when the store has the files.
             self.info(format!("image {k}: saving its outputs"));
         }
@@ -627,10 +638,12 @@ impl Ctx<'_> {
     /// Moves the survey on from image `done` to the first image the
     /// checklist still needs, or announces the end of the plan.
     fn next_image(&mut self, done: u32) {
+        let saving = &self.session.saving;
         let next = self.session.view.as_ref().and_then(|v| {
             v.images
                 .iter()
-                .filter(|i| i.k != done)
+                // Accepted a moment ago, saved any moment now: not the next.
+                .filter(|i| i.k != done && !saving.contains(&i.k))
                 .find(|i| !(i.outputs && !i.stale && i.damaged.is_empty()))
                 .map(|i| i.k)
         });
@@ -688,5 +701,5 @@ impl Ctx<'_> {
 fn not_saved_message(c: &Loaded) -> String {
     let letters = c.unsaved_letters();
     let why = c.unsaved.first().map_or("", |d| d.1.as_str());
-    format!("lighting {letters} NOT saved ({why}); once that is put right, R captures it again")
+    format!("{letters} NOT saved ({why}); once that is put right, R captures it again")
 }

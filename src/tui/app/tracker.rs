@@ -71,8 +71,9 @@ impl Loaded {
     }
 
     /// The letters of the lightings the session could not save (`unsaved`).
+    /// The lightings not saved, in words: `lighting d`, `lightings d and e`.
     pub fn unsaved_letters(&self) -> String {
-        self.unsaved.iter().map(|d| d.0).collect()
+        lightings(&self.unsaved.iter().map(|d| d.0).collect::<Vec<_>>())
     }
 
     /// The frame of lighting `letter`.
@@ -323,5 +324,19 @@ impl Ctx<'_> {
             c.in_session = true;
         }
         Some(cmds)
+    }
+}
+
+/// Lighting letters in words: `lighting b`, `lightings d and e`,
+/// `lightings a, b and c` (a run of letters read as a word: "lighting de");
+/// empty for none.
+pub fn lightings(letters: &[char]) -> String {
+    match letters {
+        [] => String::new(),
+        [l] => format!("lighting {l}"),
+        [init @ .., last] => {
+            let init: Vec<String> = init.iter().map(char::to_string).collect();
+            format!("lightings {} and {last}", init.join(", "))
+        }
     }
 }

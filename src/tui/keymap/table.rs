@@ -13,7 +13,8 @@ use ratatui::crossterm::event::KeyCode;
 
 use super::{
     Action, Binding, CalibrateAction, CaptureAction, EditAction, FilesAction, GlobalAction, Key,
-    ModalAction, NavAction, PipelineAction, Scope, ScreenId, SurveyAction, ViewerAction,
+    ModalAction, NavAction, PipelineAction, Scope, ScreenId, SearchAction, SurveyAction,
+    ViewerAction,
 };
 
 const fn ch(c: char) -> Key {
@@ -56,6 +57,7 @@ const CB: Scope = Scope::Screen(ScreenId::Calibrate);
 const CO: Scope = Scope::Confirm;
 const PR: Scope = Scope::Prompt;
 const VI: Scope = Scope::Viewer;
+const SR: Scope = Scope::Search;
 
 use KeyCode as K;
 
@@ -79,6 +81,7 @@ macro_rules! rows {
     (@act Calibrate($($a:tt)+)) => { Action::Calibrate(CalibrateAction::$($a)+) };
     (@act Modal($($a:tt)+)) => { Action::Modal(ModalAction::$($a)+) };
     (@act Viewer($($a:tt)+)) => { Action::Viewer(ViewerAction::$($a)+) };
+    (@act Search($($a:tt)+)) => { Action::Search(SearchAction::$($a)+) };
 }
 
 /// The key table.
@@ -106,6 +109,9 @@ pub const KEYMAP: &[Binding] = rows! {
     VI, k(K::Down), Viewer(Down), "scroll down", "";
     VI, k(K::PageUp), Viewer(PageUp), "a page up", "scroll";
     VI, k(K::PageDown), Viewer(PageDown), "a page down", "scroll";
+    VI, k(K::Home), Viewer(Top), "the first row", "";
+    VI, k(K::End), Viewer(Bottom), "the last row", "";
+    VI, ch('/'), Search(Start), "search the window for a text", "search";
     VI, k(K::Esc), Viewer(Close), "close", "close";
     VI, ch('q'), Viewer(Close), "close", "";
     VI, k(K::Enter), Viewer(Close), "close", "";
@@ -216,6 +222,11 @@ pub const KEYMAP: &[Binding] = rows! {
     G, k(K::PageDown), Global(LogDown), "scroll the message log down", "";
     G, k(K::Home), Global(LogTop), "the log's first message", "";
     G, k(K::End), Global(LogEnd), "the log's newest message", "";
+    G, ch('/'), Search(Start), "search the message log (on the Session screen: its file list)", "";
     G, ch('q'), Global(Quit), "quit (asks while a capture runs)", "quit";
+    // While a search is on.
+    SR, ch('n'), Search(Next), "the next match", "next";
+    SR, ch('N'), Search(Prev), "the previous match", "previous";
+    SR, k(K::Esc), Search(Clear), "end the search", "end search";
     G, ctrl('c'), Global(Quit), "quit", "";
 };

@@ -13,8 +13,8 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Clear, Paragraph, Widget, Wrap};
 
 use super::{block, gauge_text};
-use crate::tui::app::{App, Modal, Overlay};
-use crate::tui::keymap::{self, Scope, ScreenId, has_picture};
+use crate::tui::app::{App, Modal, Overlay, SearchTarget};
+use crate::tui::keymap::{self, Action, Scope, ScreenId, SurveyAction, has_picture};
 
 /// Most rows the newest message takes at the bottom.
 pub const MESSAGE_ROWS: usize = 3;
@@ -126,20 +126,7 @@ pub fn log_pane(app: &App, area: Rect, buf: &mut Buffer) {
     let h = inner.height as usize;
     let w = inner.width as usize;
     let want = app.chrome.log_scroll.saturating_add(h);
-    // Wrapped rows from the newest back, as many as the view needs.
-    let mut rows: Vec<Line> = Vec::new();
-    for e in app.chrome.log.entries().rev() {
-        let mut wrapped: Vec<Line> = wrap(&format!("{} {}", e.time, e.text), w)
-            .into_iter()
-            .map(|r| Line::styled(r, t.level(e.level)))
-            .collect();
-        wrapped.reverse();
-        rows.extend(wrapped);
-        if rows.len() >= want {
-            break;
-        }
-    }
-    rows.reverse();
+    let rows = marked(app, SearchTarget::Log, newest_rows(app, w, want));
     let total = rows.len();
     let scroll = app.chrome.log_scroll.min(total.saturating_sub(h));
     let end = total - scroll;
@@ -153,14 +140,66 @@ pub fn log_pane(app: &App, area: Rect, buf: &mut Buffer) {
     Paragraph::new(shown).render(inner, buf);
 }
 
+/// The log's rows at `width`, oldest first: at least the newest `want`
+/// (all of them for `usize::MAX`).
+fn newest_rows(app: &App, width: usize, want: usize) -> Vec<Line<'static>> {
+    let t = app.theme();
+    let mut rows: Vec<Line> = Vec::new();
+    for e in app.chrome.log.entries().rev() {
+        let mut wrapped: Vec<Line> = wrap(&format!("{} {}", e.time, e.text), width)
+            .into_iter()
+            .map(|r| Line::styled(r, t.level(e.level)))
+            .collect();
+        wrapped.reverse();
+        rows.extend(wrapped);
+        if rows.len() >= want {
+            break;
+        }
+    }
+    rows.reverse();
+    rows
+}
+
+/// Every row of the expanded log at `width`, oldest first (what `/`
+/// searches).
+pub fn log_rows(app: &App, width: usize) -> Vec<Line<'static>> {
+    newest_rows(app, width, usize::MAX)
+}
+
+/// `rows` with those that match the search on `target` marked.
+pub fn marked(app: &App, target: SearchTarget, rows: Vec<Line<'static>>) -> Vec<Line<'static>> {
+    let Some(s) = app
+        .chrome
+        .search
+        .as_ref()
+        .filter(|s| s.target == target && app.search_in_front())
+    else {
+        return rows;
+    };
+    let t = app.theme();
+    rows.into_iter()
+        .map(|l| {
+            let text: String = l.spans.iter().map(|s| s.content.as_ref()).collect();
+            if s.matches(&text) {
+                l.patch_style(t.selected())
+            } else {
+                l
+            }
+        })
+        .collect()
+}
+
 /// What the devices and the pipeline are doing, then the hints.
 fn hint_spans(app: &App) -> Vec<Span<'static>> {
     let t = app.theme();
     let d = &app.cell.device;
     let mut spans = Vec::new();
     if let Some(lost) = &d.lost {
-        let short: String = lost.chars().take(30).collect();
-        spans.push(Span::styled(format!("DEVICE LOST: {short} "), t.error()));
+        // Word by word, so that the hint rows wrap it whole.
+        spans.push(Span::styled("DEVICE LOST: ", t.error()));
+        for w in lost.split_whitespace() {
+            spans.push(Span::styled(format!("{w} "), t.error()));
+        }
     } else if !d.connected {
         spans.push(Span::styled("connecting… ", t.warn()));
     }
@@ -175,13 +214,59 @@ fn hint_spans(app: &App) -> Vec<Span<'static>> {
     if app.tracker.busy() {
         spans.push(Span::styled("running… ", t.warn()));
     }
-    let scope = app.scope();
-    let mut hints = keymap::hints(scope);
+    if let Some(s) = app.chrome.search.as_ref().filter(|_| app.search_in_front()) {
+        spans.push(Span::styled(
+            format!("/{} match {} of {} ", s.query, s.current + 1, s.count),
+            t.selected(),
+        ));
+    }
+    spans.extend(key_hints(app));
+    spans
+}
+
+/// The keys of the screen in front, then the picture's and the global ones.
+fn key_hints(app: &App) -> Vec<Span<'static>> {
+    key_hints_of(app, app.scope())
+}
+
+/// The hints of `scope` (with the picture's and the global ones on a
+/// screen).
+fn key_hints_of(app: &App, scope: Scope) -> Vec<Span<'static>> {
+    let t = app.theme();
+    let mut spans = Vec::new();
+    let searching = app.search_in_front() && !matches!(scope, Scope::Prompt | Scope::Confirm);
+    let mut hints = if searching {
+        keymap::hints(Scope::Search)
+    } else {
+        Vec::new()
+    };
+    // Not offered: keys a search on takes, and the image keys before a
+    // session is open (there is no image to accept or capture again).
+    let keep = |b: &keymap::Binding| {
+        let taken = searching
+            && keymap::KEYMAP
+                .iter()
+                .any(|s| s.scope == Scope::Search && s.key == b.key);
+        let no_image = app.session.view.is_none()
+            && matches!(
+                b.action,
+                Action::Survey(
+                    SurveyAction::Accept
+                        | SurveyAction::Redo
+                        | SurveyAction::Camera
+                        | SurveyAction::Location
+                        | SurveyAction::ResetParams
+                )
+            );
+        !taken && !no_image
+    };
+    hints.extend(keymap::hints_where(scope, keep));
     if let Scope::Screen(s) = scope {
-        if has_picture(s) {
-            hints.extend(keymap::hints(Scope::Picture));
+        // The picture's keys once there is a picture to move over.
+        if has_picture(s) && app.picture_size(s).is_some() {
+            hints.extend(keymap::hints_where(Scope::Picture, keep));
         }
-        hints.extend(keymap::hints(Scope::Global));
+        hints.extend(keymap::hints_where(Scope::Global, keep));
     }
     for (k, d) in hints {
         spans.push(Span::styled(k, t.key()));
@@ -190,12 +275,27 @@ fn hint_spans(app: &App) -> Vec<Span<'static>> {
     spans
 }
 
+/// The room kept on the hint rows for what comes and goes while the
+/// operator tunes ("running…"), so that its coming does not take a row
+/// from the screen above: a picture that lost a row would be drawn one
+/// column narrower and sent again whole (issue 33). A transfer's gauge is
+/// not kept room for: it comes with a capture, when the picture changes
+/// anyway, and its room would cost a row at 80 × 24 for good.
+/// `running… ` is 9 columns.
+const STATUS_ROOM: usize = 9;
+
 /// The hints laid out in rows of `width`: a key and its label stay
 /// together.
 fn hint_layout(app: &App, width: usize) -> Vec<Vec<Span<'static>>> {
+    layout_spans(hint_spans(app), width, 0)
+}
+
+/// `spans` in rows of `width`, the first row starting after `used`
+/// columns.
+fn layout_spans(spans: Vec<Span<'static>>, width: usize, used: usize) -> Vec<Vec<Span<'static>>> {
     let mut rows: Vec<Vec<Span>> = vec![Vec::new()];
-    let mut used = 0;
-    let mut it = hint_spans(app).into_iter().peekable();
+    let mut used = used;
+    let mut it = spans.into_iter().peekable();
     while let Some(s) = it.next() {
         let mut group = vec![s];
         if group[0].style.add_modifier.contains(Modifier::BOLD)
@@ -216,9 +316,20 @@ fn hint_layout(app: &App, width: usize) -> Vec<Vec<Span<'static>>> {
     rows
 }
 
-/// Rows the hints need at `width` (at most three).
+/// Rows the hints need at `width` (at most three), with room kept for the
+/// passing status ([`STATUS_ROOM`]) and for the screen's own hints while a
+/// question or a field shows shorter ones: the same while a run comes and
+/// goes, or a value is typed.
 pub fn hint_rows(app: &App, width: u16) -> u16 {
-    hint_layout(app, width as usize).len().clamp(1, 3) as u16
+    let now = hint_layout(app, width as usize).len();
+    // Kept once there is a picture a key can re-run.
+    let kept = if app.tracker.current.is_some() {
+        let screen = key_hints_of(app, Scope::Screen(app.chrome.screen));
+        layout_spans(screen, width as usize, STATUS_ROOM.min(width as usize)).len()
+    } else {
+        0
+    };
+    now.max(kept).clamp(1, 3) as u16
 }
 
 pub fn hints(app: &App, area: Rect, buf: &mut Buffer) {
@@ -226,6 +337,13 @@ pub fn hints(app: &App, area: Rect, buf: &mut Buffer) {
         .into_iter()
         .map(Line::from)
         .collect();
+    // At the bottom of their rows: a row kept free is the upper one.
+    let free = area.height.saturating_sub(lines.len() as u16);
+    let area = Rect {
+        y: area.y + free,
+        height: area.height - free,
+        ..area
+    };
     Paragraph::new(lines).render(area, buf);
 }
 
@@ -325,7 +443,8 @@ pub const LEGEND: &[(&str, &str)] = &[
     ("eN", "N hand edits in effect"),
 ];
 
-fn help_lines(app: &App, width: usize) -> Vec<Line<'static>> {
+/// The help window's rows at `width` (the drawing and `/` both use them).
+pub fn help_lines(app: &App, width: usize) -> Vec<Line<'static>> {
     let t = app.theme();
     let screen = app.chrome.screen;
     let mut sections: Vec<(String, Scope)> =
@@ -371,16 +490,17 @@ fn help_lines(app: &App, width: usize) -> Vec<Line<'static>> {
 
 pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
-    let r = Rect::new(
-        area.x + 1,
-        area.y + 1,
-        area.width.saturating_sub(2),
-        area.height.saturating_sub(2),
-    );
+    // The whole screen: a window one column inside it let the borders of
+    // the screen under it show at its edges.
+    let r = area;
     Clear.render(r, buf);
     let inner_w = r.width.saturating_sub(2) as usize;
     let (name, lines, scroll) = match o {
-        Overlay::Help { scroll } => ("help", help_lines(app, inner_w), scroll),
+        Overlay::Help { scroll } => (
+            "help",
+            marked(app, SearchTarget::Help, help_lines(app, inner_w)),
+            scroll,
+        ),
         Overlay::Message { scroll } => {
             let mut lines: Vec<Line> = Vec::new();
             let mut entry = |e: &crate::tui::app::LogEntry, what: &str| {

@@ -351,12 +351,22 @@ fn cursor_line(app: &App, cur: &Loaded, area: Rect, buf: &mut Buffer) {
             .map_or("-".into(), signed)
     };
     let out = cur.outputs.as_deref();
-    let text = format!(
-        "x{x} y{y} grey {g} H {} V {} · ×{} {}",
+    let (h, v) = (
         resp(out.map(|o| &o.response_h)),
         resp(out.map(|o| &o.response_v)),
-        nav.view.zoom,
-        nav.position(size),
     );
+    let (zoom, at) = (nav.view.zoom, nav.position(size));
+    // The longest that fits: at 80 columns a zoomed view's place would
+    // run past the edge, so the words shorten, then the responses go
+    // (the zoom and the place stay: they say what the picture shows).
+    let compact = at.replace("x ", "x").replace("y ", "y");
+    let text = [
+        format!("x{x} y{y} grey {g} H {h} V {v} · ×{zoom} {at}"),
+        format!("x{x} y{y} g{g} H{h} V{v} ×{zoom} {compact}"),
+        format!("x{x} y{y} g{g} ×{zoom} {compact}"),
+    ]
+    .into_iter()
+    .find(|t| t.chars().count() <= area.width as usize)
+    .unwrap_or_else(|| format!("×{zoom} {compact}"));
     Paragraph::new(text).render(area, buf);
 }

@@ -8,7 +8,7 @@ use ratatui::text::Line;
 use ratatui::widgets::{Paragraph, Widget, Wrap};
 
 use super::{block, split_panel, window};
-use crate::tui::app::App;
+use crate::tui::app::{App, SearchTarget};
 
 pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
@@ -80,20 +80,38 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
             t.ok(),
         )]
     };
-    // Problems first, each wrapped whole (why a file is damaged is what
-    // the operator came for); the files that read one row each.
+    let rows = super::chrome::marked(app, SearchTarget::Files, file_rows(app, inner_w));
+    let room = (right.height.saturating_sub(2) as usize).saturating_sub(lines.len());
+    lines.extend(window(rows, app.screens.files.scroll, room, t));
+    Paragraph::new(lines)
+        .block(block(app, &format!("files ({})", s.files.len())))
+        .render(right, buf);
+}
+
+/// The file list's rows at `width`: problems first, each wrapped whole
+/// (why a file is damaged is what the operator came for), then the files
+/// that read, one row each (the drawing and `/` both use them).
+pub fn file_rows(app: &App, width: usize) -> Vec<Line<'static>> {
+    let t = app.theme();
+    let Some(s) = &app.session.view else {
+        return Vec::new();
+    };
     let mut files: Vec<&crate::tui::event::FileState> = s.files.iter().collect();
     files.sort_by_key(|f| f.ok);
     let mut rows: Vec<Line> = Vec::new();
     for f in files {
         let text = format!("{:<16} {}", f.name, f.state);
         if !f.ok {
-            rows.extend(wrapped(&text, t.error()));
+            rows.extend(
+                super::chrome::wrap(&text, width)
+                    .into_iter()
+                    .map(|l| Line::styled(l, t.error())),
+            );
             continue;
         }
-        let text: String = if text.chars().count() > inner_w {
+        let text: String = if text.chars().count() > width {
             text.chars()
-                .take(inner_w.saturating_sub(1))
+                .take(width.saturating_sub(1))
                 .collect::<String>()
                 + "…"
         } else {
@@ -101,9 +119,5 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         };
         rows.push(Line::styled(text, t.ok()));
     }
-    let room = (right.height.saturating_sub(2) as usize).saturating_sub(lines.len());
-    lines.extend(window(rows, app.screens.files.scroll, room, t));
-    Paragraph::new(lines)
-        .block(block(app, &format!("files ({})", s.files.len())))
-        .render(right, buf);
+    rows
 }

@@ -82,10 +82,13 @@ fn first_frame<'a>(
         .find_map(|l| c.frame(*l).map(|g| (*l, g)))
 }
 
-fn sessions(app: &App, area: Rect, buf: &mut Buffer) {
+/// The session list's rows at `width` columns, each with the index of its
+/// session: a session whose row would run past the edge (a long name, "in
+/// use by" a long user name, why it does not read) goes on over more rows,
+/// indented, rather than being cut. The drawing and the mouse both use it.
+pub fn session_rows(app: &App, width: usize) -> Vec<(usize, Line<'static>)> {
     let t = app.theme();
-    let inner_h = area.height.saturating_sub(2) as usize;
-    let mut rows: Vec<Line> = Vec::new();
+    let mut rows = Vec::new();
     for (i, e) in app.session.list.iter().enumerate() {
         let st = if i == app.screens.survey.selected {
             t.selected()
@@ -96,28 +99,38 @@ fn sessions(app: &App, area: Rect, buf: &mut Buffer) {
         };
         let text = match &e.damaged {
             Some(why) => {
-                // The row is narrow: the file's name, not its folder (Enter
-                // shows the whole error).
+                // The row is narrow: the file's name, not its folder.
                 let folder = format!("{}/", e.dir.display());
                 let why = why.strip_prefix(folder.as_str()).unwrap_or(why);
                 format!(" {}  DAMAGED: {why}", e.name)
             }
             None => format!(" {:<10} {}", e.name, e.summary),
         };
-        let w = area.width.saturating_sub(2) as usize;
-        let text: String = if text.chars().count() > w {
-            text.chars().take(w.saturating_sub(1)).collect::<String>() + "…"
-        } else {
-            text
-        };
-        rows.push(Line::styled(text, st));
+        let opts = textwrap::Options::new(width.max(4)).subsequent_indent("   ");
+        for r in textwrap::wrap(&text, opts) {
+            rows.push((i, Line::styled(r.into_owned(), st)));
+        }
     }
+    rows
+}
+
+/// The first row of the selected session in [`session_rows`].
+pub fn selected_row(rows: &[(usize, Line)], selected: usize) -> usize {
+    rows.iter().position(|r| r.0 == selected).unwrap_or(0)
+}
+
+fn sessions(app: &App, area: Rect, buf: &mut Buffer) {
+    let t = app.theme();
+    let inner_h = area.height.saturating_sub(2) as usize;
+    let listed = session_rows(app, area.width.saturating_sub(2) as usize);
+    let focus = selected_row(&listed, app.screens.survey.selected);
+    let rows: Vec<Line> = listed.into_iter().map(|r| r.1).collect();
     let mut lines = vec![Line::raw("Sessions in the survey folder:")];
     if rows.is_empty() {
         lines.push(Line::styled("  (none yet)", t.dim()));
     }
     let room = inner_h.saturating_sub(4);
-    lines.extend(window(rows, app.screens.survey.selected, room, t));
+    lines.extend(window(rows, focus, room, t));
     lines.push(Line::raw(""));
     lines.push(Line::from(vec![
         Span::styled("↑↓ Enter", t.key()),
@@ -277,7 +290,12 @@ fn step_lines(app: &App) -> Vec<Line<'static>> {
             ]),
             Line::from(vec![
                 key("Esc"),
-                Span::raw(format!(" back to image {}", w.k)),
+                Span::raw(if w.phase == Phase::Complete {
+                    // The survey is done: there is no image `w.k`.
+                    " back to the survey's end".to_string()
+                } else {
+                    format!(" back to image {}", w.k)
+                }),
             ]),
         ]
     } else {
@@ -363,7 +381,7 @@ fn step_lines(app: &App) -> Vec<Line<'static>> {
                     // Not accepted until every lighting is on disk.
                     vec![
                         Line::raw(format!("Image {}: {n} lines ({raw} before CONNECT)", w.k)),
-                        Line::styled(format!("lighting {unsaved} NOT saved"), t.error()),
+                        Line::styled(format!("{unsaved} NOT saved"), t.error()),
                         Line::from(vec![
                             key("R"),
                             Span::raw(" captures again · "),
@@ -399,5 +417,20 @@ fn step_lines(app: &App) -> Vec<Line<'static>> {
     {
         text.push(l);
     }
-    text
+    // An acceptance that failed stays said here, first, until the image
+    // is accepted: the message row only shows the newest message.
+    let refused: Vec<Line> = app
+        .session
+        .refused
+        .iter()
+        // The image under review says it itself.
+        .filter(|r| app.session.view.is_some() && !(r.0 == w.k && w.phase == Phase::Review))
+        .map(|(k, why)| {
+            Line::styled(
+                format!("Image {k} NOT accepted: its outputs were not saved ({why}) — ↑↓ Enter goes to it, then a"),
+                t.error(),
+            )
+        })
+        .collect();
+    refused.into_iter().chain(text).collect()
 }

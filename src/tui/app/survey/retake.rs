@@ -69,11 +69,12 @@ impl Ctx<'_> {
         }
         let letters: Vec<char> = damaged.iter().map(|d| d.0).collect();
         let list: String = letters.iter().collect();
+        let words = crate::tui::app::tracker::lightings(&letters);
         let why: Vec<String> = damaged.iter().map(|(l, w)| format!("{l}: {w}")).collect();
         self.chrome.modal = Some(Modal::Confirm {
             question: format!(
-                "Image {k}: lighting {list} {state} ({}). y retakes only {list}, a every \
-                 lighting, n nothing.",
+                "Image {k}: {words} {state} ({}). y sets up the retake of only {list} \
+                 (Enter then captures), a of every lighting, n nothing.",
                 why.join("; ")
             ),
             on_yes: Pending::Retake { k, letters },
@@ -96,9 +97,9 @@ impl Ctx<'_> {
             self.info(format!("image {k} will be captured again: Enter starts"));
             return vec![Cmd::Store(StoreCmd::Redo(k))];
         }
-        let list: String = letters.iter().collect();
         self.info(format!(
-            "image {k}: Enter captures lighting {list} again; the others are kept"
+            "image {k}: Enter captures {} again; the others are kept",
+            crate::tui::app::tracker::lightings(&letters)
         ));
         match self.tracker.current.as_mut() {
             Some(c) if c.k == k => {
