@@ -87,11 +87,21 @@ impl Worker {
         }
     }
 
+    /// Least time between two live frames: the grabber's own (a GenICam
+    /// camera's is short), or [`LIVE_INTERVAL`].
+    fn live_interval(&self) -> Duration {
+        self.cell
+            .as_ref()
+            .and_then(|c| c.grabber.live_interval())
+            .unwrap_or(LIVE_INTERVAL)
+    }
+
     fn run(mut self, rx: Receiver<DeviceCmd>) {
         loop {
             self.ensure_connected();
+            let interval = self.live_interval();
             let wait = match (self.live, self.last_live) {
-                (Some(_), Some(t)) => LIVE_INTERVAL.saturating_sub(t.elapsed()),
+                (Some(_), Some(t)) => interval.saturating_sub(t.elapsed()),
                 (Some(_), None) => Duration::ZERO,
                 _ if !self.healthy => RETRY_INTERVAL,
                 _ => Duration::from_secs(3600),
@@ -103,7 +113,7 @@ impl Worker {
             }
             if let Some(cam) = self.live
                 && self.healthy
-                && self.last_live.is_none_or(|t| t.elapsed() >= LIVE_INTERVAL)
+                && self.last_live.is_none_or(|t| t.elapsed() >= interval)
             {
                 self.last_live = Some(Instant::now());
                 self.grab(FramePurpose::Live, cam, None);
@@ -128,11 +138,12 @@ impl Worker {
         };
         let hello = result.and_then(|_| match self.cell.as_mut() {
             Some(c) => c.grabber.hello().map(|h| {
-                (
-                    h,
-                    c.lights.port_name().to_string(),
-                    c.grabber.port_name().to_string(),
-                )
+                // A GenICam camera also says what it is and how it is set.
+                let port = match c.grabber.camera_state() {
+                    Some(st) => format!("{}: {}", c.grabber.port_name(), st.summary()),
+                    None => c.grabber.port_name().to_string(),
+                };
+                (h, c.lights.port_name().to_string(), port)
             }),
             None => Err(RigError::Config("no cell".into())),
         });
