@@ -168,6 +168,9 @@ pub struct CameraState {
     pub gain_db: f64,
     /// Region of interest `[x, y, width, height]` (px).
     pub roi: [u32; 4],
+    /// The camera's own frame rate (AcquisitionFrameRate, frames/s); NaN
+    /// when it has none.
+    pub frame_rate_hz: f64,
 }
 
 impl CameraState {

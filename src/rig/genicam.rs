@@ -359,6 +359,7 @@ fn read_state(camera: &Camera, format: Mono, id: &str) -> CameraState {
         exposure_us: camera.exposure_time().unwrap_or(f64::NAN),
         gain_db: camera.gain().unwrap_or(f64::NAN),
         roi: [x, y, w, h].map(|v| v.max(0) as u32),
+        frame_rate_hz: camera.frame_rate().unwrap_or(f64::NAN),
     }
 }
 

@@ -390,3 +390,39 @@ fn a_camera_that_is_not_there_is_named_and_nothing_is_made() {
     assert!(!session.exists(), "no session made: {:?}", files(&session));
     assert!(t.elapsed() < Duration::from_secs(15), "{:?}", t.elapsed());
 }
+
+#[test]
+fn trigger_to_saved_img_within_two_frame_times() {
+    let _cam = FakeCamera::start("TIME1", None);
+    let tmp = tempfile::tempdir().expect("tmp");
+    let mut p = genicam_profile(mono8());
+    p.relay.settle_ms = 0;
+    let mut cell = vss::rig::Cell::open(&p).expect("the cell opens");
+    let st = cell.grabber.camera_state().expect("the camera's state");
+    let frame = Duration::from_secs_f64(1.0 / st.frame_rate_hz);
+    let mut sess = vss::session::Session::create(tmp.path(), "t", &p).expect("a session");
+    let mut times = Vec::new();
+    for k in 1..=4 {
+        for l in ['a', 'b', 'c', 'd', 'e'] {
+            let t = Instant::now();
+            let cap = cell.capture(1, l, &mut |_, _| true).expect("a frame");
+            let img = vss::formats::img::ImgFile::new(cap.image).with_comment(format!("t{k}{l}"));
+            sess.save_image(k, l, &img).expect("saved");
+            times.push(t.elapsed());
+        }
+    }
+    times.sort();
+    let (median, max) = (times[times.len() / 2], times[times.len() - 1]);
+    eprintln!(
+        "trigger to saved .img (512 x 512 Mono8, settle 0): median {:.1} ms, max {:.1} ms; \
+         the camera's frame time {:.1} ms ({:.1} frames/s)",
+        median.as_secs_f64() * 1e3,
+        max.as_secs_f64() * 1e3,
+        frame.as_secs_f64() * 1e3,
+        st.frame_rate_hz
+    );
+    assert!(
+        median <= 2 * frame,
+        "median {median:?} vs frame time {frame:?}"
+    );
+}
