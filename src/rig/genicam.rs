@@ -518,6 +518,10 @@ impl FrameGrabber for GenicamGrabber {
         let label = self.label(cam);
         let id = self.ids.get(cam as usize - 1).cloned().unwrap_or_default();
         let o = self.opened(cam)?;
+        let us = match o.camera.exposure_time_bounds() {
+            Ok((lo, hi)) if lo <= hi && us.is_finite() => us.clamp(lo, hi),
+            _ => us,
+        };
         let _ = o.camera.set_exposure_time_auto(aravis::Auto::Off);
         o.camera
             .set_exposure_time(us)
@@ -535,6 +539,10 @@ impl FrameGrabber for GenicamGrabber {
         let label = self.label(cam);
         let id = self.ids.get(cam as usize - 1).cloned().unwrap_or_default();
         let o = self.opened(cam)?;
+        let db = match o.camera.gain_bounds() {
+            Ok((lo, hi)) if lo <= hi && db.is_finite() => db.clamp(lo, hi),
+            _ => db,
+        };
         let _ = o.camera.set_gain_auto(aravis::Auto::Off);
         o.camera.set_gain(db).map_err(|e| RigError::Camera {
             port: label,

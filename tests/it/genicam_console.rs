@@ -110,6 +110,16 @@ fn survey_of_four_images_under_five_lightings_at_80x24() {
         "light switched during live view in {} ms",
         t.elapsed().as_millis()
     );
+    // Exposure and gain, changed by keys during live view: the grabber
+    // line and the log say the new values.
+    c.send("]");
+    c.wait("exposure × 1.25", 10, |s| {
+        s.contains("exp 12500") && s.contains("exposure 12500 µs")
+    });
+    c.send("+");
+    c.wait("gain + 1 dB", 10, |s| s.contains("gain 1.0 dB"));
+    c.send("[");
+    c.wait("exposure ÷ 1.25", 10, |s| s.contains("exp 10000"));
     c.send("v");
     c.wait_text("live off (v)", 10);
     c.send("q");
