@@ -119,8 +119,9 @@ pub enum RigError {
         timeout_ms: u64,
         attempts: u32,
     },
-    /// A GenICam camera ([`genicam`]): `gone` when it does not answer or
-    /// sends nothing (the console then reconnects, as for a vanished port).
+    /// A GenICam camera (`src/rig/genicam.rs`, feature `genicam`): `gone`
+    /// when it does not answer or sends nothing (the console then
+    /// reconnects, as for a vanished port).
     #[error("{port}: {detail}")]
     Camera {
         port: String,

@@ -26,7 +26,7 @@
 //! the camera is opened.
 //!
 //! The one `unsafe` block of vss's own code outside the allocator test is
-//! here ([`copy_frame`]): Aravis hands a frame as a pointer and a length.
+//! here (`copy_frame`): Aravis hands a frame as a pointer and a length.
 
 use std::time::Duration;
 
