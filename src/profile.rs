@@ -85,6 +85,40 @@ pub struct GrabberConfig {
     pub retries: u32,
     /// Bytes per READ block (at most the grabber's maxblock).
     pub block: u32,
+    /// `genicam`: camera N is entry N, each the device id as Aravis names
+    /// it (`Aravis-Fake-GV01`) or its address (`192.168.1.20`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub cameras: Vec<String>,
+    /// `genicam`: settings of camera N (`[[grabber.camera]]`, entry N); a
+    /// camera without an entry, or a setting left out, keeps the camera's
+    /// own (its pixel format must then be one vss reads).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub camera: Vec<CameraSettings>,
+}
+
+/// What a GenICam camera is set to before it grabs (each `None` leaves the
+/// camera's own value).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CameraSettings {
+    /// `Mono8`, `Mono10`, `Mono12` or `Mono16` (reduced to 8 bits:
+    /// docs/hardware.md says how).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pixel_format: Option<String>,
+    /// Exposure time (µs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exposure_us: Option<f64>,
+    /// Analogue gain (dB).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gain_db: Option<f64>,
+    /// Region of interest `[x, y, width, height]` (px).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub roi: Option<[u32; 4]>,
+    /// GigE Vision stream packet size (bytes): fewer, larger packets where
+    /// the network carries jumbo frames. Unset: the largest the camera's
+    /// test packets get through, or the camera's own.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub packet_size: Option<u32>,
 }
 
 impl Default for GrabberConfig {
@@ -96,6 +130,8 @@ impl Default for GrabberConfig {
             timeout_ms: 1000,
             retries: 3,
             block: 16384,
+            cameras: Vec::new(),
+            camera: Vec::new(),
         }
     }
 }
@@ -108,6 +144,9 @@ pub enum GrabberKind {
     Simulated,
     /// A VSG/1 grabber on a serial port.
     Vsg,
+    /// GigE Vision / USB3 Vision cameras through Aravis (`cameras`); needs
+    /// a vss built with `--features genicam`.
+    Genicam,
 }
 
 /// Which relay board switches the lights.

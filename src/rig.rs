@@ -11,8 +11,11 @@ use std::io::{self, Read, Write};
 use std::time::Duration;
 
 pub mod cell;
+#[cfg(feature = "genicam")]
+pub mod genicam;
 pub mod grabber;
 pub mod lights;
+pub mod pixels;
 pub mod protocol;
 pub mod replay;
 #[cfg(test)]
@@ -116,6 +119,15 @@ pub enum RigError {
         timeout_ms: u64,
         attempts: u32,
     },
+    /// A GenICam camera (`src/rig/genicam.rs`, feature `genicam`): `gone`
+    /// when it does not answer or sends nothing (the console then
+    /// reconnects, as for a vanished port).
+    #[error("{port}: {detail}")]
+    Camera {
+        port: String,
+        detail: String,
+        gone: bool,
+    },
     #[error("{0}")]
     Config(String),
     #[error("simulator: {0}")]
@@ -134,7 +146,54 @@ fn tries(n: u32) -> String {
 impl RigError {
     /// Whether the device has gone away (unplugged, powered off).
     pub fn is_vanished(&self) -> bool {
-        matches!(self, RigError::Vanished { .. })
+        matches!(
+            self,
+            RigError::Vanished { .. } | RigError::Camera { gone: true, .. }
+        )
+    }
+}
+
+/// A camera's identity and settings as it reports them (GenICam cameras;
+/// the VSG/1 grabber does not say).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CameraState {
+    /// The profile's id or address for it.
+    pub id: String,
+    pub vendor: String,
+    pub model: String,
+    pub serial: String,
+    pub pixel_format: String,
+    /// Exposure time (µs); NaN when the camera has none.
+    pub exposure_us: f64,
+    /// Gain (dB); NaN when the camera has none.
+    pub gain_db: f64,
+    /// Region of interest `[x, y, width, height]` (px).
+    pub roi: [u32; 4],
+    /// The camera's own frame rate (AcquisitionFrameRate, frames/s); NaN
+    /// when it has none.
+    pub frame_rate_hz: f64,
+}
+
+impl CameraState {
+    /// One line for the console and the log: vendor, model, serial, pixel
+    /// format, exposure, gain.
+    pub fn summary(&self) -> String {
+        let num = |v: f64, unit: &str, digits: usize| {
+            if v.is_finite() {
+                format!("{v:.digits$} {unit}")
+            } else {
+                format!("— {unit}")
+            }
+        };
+        format!(
+            "{} {} #{} {} exp {} gain {}",
+            self.vendor,
+            self.model,
+            self.serial,
+            self.pixel_format,
+            num(self.exposure_us, "µs", 0),
+            num(self.gain_db, "dB", 1)
+        )
     }
 }
 

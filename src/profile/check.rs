@@ -183,6 +183,12 @@ fn cell_hint(key: &str) -> Option<&'static str> {
         "grabber.timeout_ms" | "relay.timeout_ms" => "a whole number, 1 to 600000 (ms)",
         "grabber.retries" => "a whole number, 0 to 100",
         "grabber.block" => "a whole number, 1 to 65536 (bytes)",
+        "grabber.cameras" => "a list of camera ids or addresses, camera 1 first",
+        "grabber.camera.pixel_format" => "\"Mono8\", \"Mono10\", \"Mono12\" or \"Mono16\"",
+        "grabber.camera.exposure_us" => "a number, 1 to 60000000 (µs)",
+        "grabber.camera.gain_db" => "a number, -50 to 100 (dB)",
+        "grabber.camera.roi" => "four whole numbers [x, y, width, height] (px)",
+        "grabber.camera.packet_size" => "a whole number, 576 to 65500 (bytes)",
         "relay.settle_ms" => "a whole number, 0 to 60000 (ms)",
         "lights.relay" => "a whole number, 0 to 15",
         "lights.position" => "three numbers [x, y, z] (mm)",
@@ -358,6 +364,7 @@ fn check_cell(p: &Profile, cx: &Ctx<'_, '_>) -> Result<(), ProfileError> {
     )?;
     range(cx, &[K("grabber"), K("retries")], g.retries.into(), 0, 100)?;
     range(cx, &[K("grabber"), K("block")], g.block.into(), 1, 65_536)?;
+    check_genicam(g, cx)?;
     let r = &p.relay;
     if r.kind != RelayKind::Simulated && r.port.trim().is_empty() {
         return Err(cx.at(
@@ -408,6 +415,93 @@ fn range(cx: &Ctx<'_, '_>, key: &[Seg<'_>], v: u64, lo: u64, hi: u64) -> Result<
     } else {
         Err(cx.at(key, format!("{v} is out of range: allowed {lo} to {hi}")))
     }
+}
+
+/// The `genicam` grabber's cameras and their settings.
+fn check_genicam(g: &super::GrabberConfig, cx: &Ctx<'_, '_>) -> Result<(), ProfileError> {
+    use Seg::{Index as I, Key as K};
+    if g.kind == GrabberKind::Genicam && g.cameras.is_empty() {
+        return Err(cx.at(
+            &[K("grabber"), K("kind")],
+            "a genicam grabber needs its cameras, e.g. cameras = [\"Aravis-Fake-GV01\"] \
+             (the device id as Aravis names it, or the camera's address)"
+                .into(),
+        ));
+    }
+    for (i, c) in g.cameras.iter().enumerate() {
+        if c.trim().is_empty() {
+            return Err(cx.at(
+                &[K("grabber"), K("cameras"), I(i)],
+                format!("camera {} has an empty id", i + 1),
+            ));
+        }
+        if g.cameras.iter().take(i).any(|x| x.trim() == c.trim()) {
+            return Err(cx.at(
+                &[K("grabber"), K("cameras"), I(i)],
+                format!("camera \"{c}\" is listed twice"),
+            ));
+        }
+    }
+    if g.camera.len() > g.cameras.len().max(1) {
+        return Err(cx.at(
+            &[K("grabber"), K("camera"), I(g.cameras.len())],
+            format!(
+                "{} [[grabber.camera]] settings for {} cameras: entry N is for camera N",
+                g.camera.len(),
+                g.cameras.len()
+            ),
+        ));
+    }
+    for (i, s) in g.camera.iter().enumerate() {
+        if let Some(f) = &s.pixel_format
+            && !crate::rig::pixels::PIXEL_FORMATS.contains(&f.as_str())
+        {
+            return Err(cx.at(
+                &[K("grabber"), K("camera"), I(i), K("pixel_format")],
+                format!(
+                    "pixel format \"{f}\" cannot be used; vss reads {}",
+                    crate::rig::pixels::PIXEL_FORMATS.join(", ")
+                ),
+            ));
+        }
+        if let Some(e) = s.exposure_us
+            && !(e.is_finite() && (1.0..=60_000_000.0).contains(&e))
+        {
+            return Err(cx.at(
+                &[K("grabber"), K("camera"), I(i), K("exposure_us")],
+                format!("exposure {e} µs is out of range: 1 to 60000000 µs"),
+            ));
+        }
+        if let Some(d) = s.gain_db
+            && !(d.is_finite() && (-50.0..=100.0).contains(&d))
+        {
+            return Err(cx.at(
+                &[K("grabber"), K("camera"), I(i), K("gain_db")],
+                format!("gain {d} dB is out of range: -50 to 100 dB"),
+            ));
+        }
+        if let Some(b) = s.packet_size {
+            range(
+                cx,
+                &[K("grabber"), K("camera"), I(i), K("packet_size")],
+                b.into(),
+                576,
+                65_500,
+            )?;
+        }
+        if let Some([_, _, w, h]) = s.roi
+            && (w == 0 || h == 0 || w > 65_535 || h > 65_535)
+        {
+            return Err(cx.at(
+                &[K("grabber"), K("camera"), I(i), K("roi")],
+                format!(
+                    "a region of {w} × {h} px: width and height are 1 to 65535 \
+                     (a .img holds at most 65535 × 65535)"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -79,6 +79,48 @@ pub fn open_lights(
     })
 }
 
+/// Opens the grabber a profile names and says hello: the VSG/1 client on
+/// its serial port or on the simulated cell's pseudo-terminal, or the
+/// GenICam cameras.
+fn open_grabber(
+    profile: &Profile,
+    sim: Option<&SimCell>,
+) -> Result<(Box<dyn FrameGrabber>, GrabberInfo), RigError> {
+    let g = &profile.grabber;
+    let path = match (g.kind, sim) {
+        (GrabberKind::Genicam, _) => return open_genicam(g),
+        (GrabberKind::Simulated, Some(s)) => s.grabber_path().to_string(),
+        _ => g.port.clone(),
+    };
+    let mut grabber = VsgClient::open(&path, g.baud, ClientConfig::from_profile(g))?;
+    let info = match grabber.info() {
+        Some(i) => i.clone(),
+        None => grabber.hello()?,
+    };
+    Ok((Box::new(grabber), info))
+}
+
+#[cfg(feature = "genicam")]
+fn open_genicam(
+    g: &crate::profile::GrabberConfig,
+) -> Result<(Box<dyn FrameGrabber>, GrabberInfo), RigError> {
+    let mut grabber = super::genicam::GenicamGrabber::open(g)?;
+    let info = grabber.hello()?;
+    Ok((Box::new(grabber), info))
+}
+
+#[cfg(not(feature = "genicam"))]
+fn open_genicam(
+    _g: &crate::profile::GrabberConfig,
+) -> Result<(Box<dyn FrameGrabber>, GrabberInfo), RigError> {
+    Err(RigError::Config(
+        "the profile's grabber is `genicam`, but this vss was built without GenICam cameras: \
+         install libaravis-dev and libusb-1.0-0-dev, then build with \
+         `cargo build --release --features genicam`"
+            .into(),
+    ))
+}
+
 impl Cell {
     /// Opens the cell a profile describes. `simulated` devices start the
     /// embedded simulator on pseudo-terminals and the same drivers connect
@@ -96,19 +138,10 @@ impl Cell {
         } else {
             None
         };
-        let g = &profile.grabber;
-        let grabber_path = match (&g.kind, &sim) {
-            (GrabberKind::Simulated, Some(s)) => s.grabber_path().to_string(),
-            _ => g.port.clone(),
-        };
-        let mut grabber = VsgClient::open(&grabber_path, g.baud, ClientConfig::from_profile(g))?;
-        let info = match grabber.info() {
-            Some(i) => i.clone(),
-            None => grabber.hello()?,
-        };
+        let (grabber, info) = open_grabber(profile, sim.as_ref())?;
         let lights = open_lights(profile, sim.as_ref())?;
         let mut cell = Cell {
-            grabber: Box::new(grabber),
+            grabber,
             lights,
             sim,
             profile: profile.clone(),

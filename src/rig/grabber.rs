@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use super::protocol::{
     Command, ErrCode, FrameInfo, GrabberInfo, GrabberStatus, Reply, crc32, decode_line,
 };
-use super::{Link, RigError, SerialLink, open_serial};
+use super::{CameraState, Link, RigError, SerialLink, open_serial};
 use crate::llv::GreyImage;
 
 /// The operations every grabber offers.
@@ -50,6 +50,33 @@ pub trait FrameGrabber: Send {
     fn reconnect(&mut self) -> Result<(), RigError>;
     /// Bytes moved so far.
     fn wire_stats(&self) -> WireStats;
+    /// The selected camera's identity and settings, when the grabber can
+    /// say (GenICam cameras); `None` for a VSG/1 grabber.
+    fn camera_state(&self) -> Option<CameraState> {
+        None
+    }
+    /// Sets the selected camera's exposure time (µs).
+    fn set_exposure(&mut self, us: f64) -> Result<CameraState, RigError> {
+        let _ = us;
+        Err(self.no_settings())
+    }
+    /// Sets the selected camera's gain (dB).
+    fn set_gain(&mut self, db: f64) -> Result<CameraState, RigError> {
+        let _ = db;
+        Err(self.no_settings())
+    }
+    /// Least time between two live-view frames, when the grabber sets it
+    /// (the console's own otherwise).
+    fn live_interval(&self) -> Option<Duration> {
+        None
+    }
+    /// Why exposure and gain cannot be set here.
+    fn no_settings(&self) -> RigError {
+        RigError::Config(format!(
+            "{}: this grabber does not set exposure or gain: set them on the camera",
+            self.port_name()
+        ))
+    }
 }
 
 /// Counters of what went over the wire.

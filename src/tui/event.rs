@@ -87,6 +87,9 @@ pub enum DeviceEvent {
     Lights { on: Vec<String>, mask: u32 },
     /// A hardware event worth a log line.
     Note(String),
+    /// A camera's exposure or gain was set: the grabber's new one-line
+    /// description, and what changed (for the log).
+    CameraSet { grabber: String, note: String },
 }
 
 /// A pipeline run's result, tagged with the generation that asked for it.
@@ -302,6 +305,16 @@ pub enum DeviceCmd {
     SimTarget(Option<crate::rig::sim::plate::PlateTarget>),
     /// Stop the transfer under way (and the live view).
     Cancel,
+    /// Multiply camera `camera`'s exposure time by `factor` (GenICam).
+    Exposure {
+        camera: u32,
+        factor: f64,
+    },
+    /// Add `db` to camera `camera`'s gain (GenICam).
+    Gain {
+        camera: u32,
+        db: f64,
+    },
 }
 
 /// A request to the pipeline worker: latest wins.

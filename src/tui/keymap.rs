@@ -151,6 +151,12 @@ pub enum CaptureAction {
     LightsOff,
     Lighting(u8),
     Cancel,
+    /// A GenICam camera's exposure time × 1.25 / ÷ 1.25.
+    ExposureUp,
+    ExposureDown,
+    /// A GenICam camera's gain ± 1 dB.
+    GainUp,
+    GainDown,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

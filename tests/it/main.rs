@@ -16,6 +16,10 @@ mod cli_pipe;
 mod cli_standalone;
 mod formats_malformed;
 mod formats_roundtrip;
+#[cfg(feature = "genicam")]
+mod genicam;
+#[cfg(feature = "genicam")]
+mod genicam_console;
 mod golden;
 mod llv_alloc;
 mod llv_auto;

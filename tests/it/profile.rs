@@ -274,3 +274,91 @@ fn the_built_in_profile_is_the_shipped_default() {
     }
     assert_eq!(built.camera_cdf(5).unwrap(), None);
 }
+
+/// The default profile with its `[grabber]` kind line replaced by `kind`
+/// and `camera` (`[[grabber.camera]]` tables) after the section's keys.
+fn genicam_text(kind: &str, camera: &str) -> String {
+    let block = "block = 16384";
+    let t = default_text();
+    assert!(t.contains(block), "{block}");
+    t.replacen("kind = \"simulated\"", kind, 1)
+        .replacen(block, &format!("{block}\n{camera}"), 1)
+}
+
+/// The `genicam` grabber's keys load without the feature (the profile does
+/// not depend on how vss was built), and bad ones name line and key.
+#[test]
+fn genicam_cameras_and_their_settings() {
+    let text = genicam_text(
+        "kind = \"genicam\"\ncameras = [\"Aravis-Fake-GV01\", \"192.168.1.21\"]",
+        "[[grabber.camera]]\npixel_format = \"Mono12\"\nexposure_us = 8000.0\n\
+         gain_db = 3.5\nroi = [0, 0, 640, 480]\npacket_size = 8192",
+    );
+    let p = Profile::from_toml(&text, Path::new("cell.toml")).expect("a genicam profile loads");
+    assert_eq!(p.grabber.kind, GrabberKind::Genicam);
+    assert_eq!(p.grabber.cameras, ["Aravis-Fake-GV01", "192.168.1.21"]);
+    let c = &p.grabber.camera[0];
+    assert_eq!(c.pixel_format.as_deref(), Some("Mono12"));
+    assert_eq!((c.exposure_us, c.gain_db), (Some(8000.0), Some(3.5)));
+    assert_eq!((c.roi, c.packet_size), (Some([0, 0, 640, 480]), Some(8192)));
+    // Round trip, and a simulated profile writes none of the new keys.
+    let back = Profile::from_toml(&toml::to_string(&p).unwrap(), Path::new("b.toml")).unwrap();
+    assert_eq!(back.grabber, p.grabber);
+    let sim = toml::to_string(&Profile::builtin().unwrap()).unwrap();
+    assert!(
+        !sim.contains("cameras = [") && !sim.contains("pixel_format"),
+        "{sim}"
+    );
+
+    let bad = |kind: &str, camera: &str, key: &str, also: &str| {
+        let text = genicam_text(kind, camera);
+        let e = Profile::from_toml(&text, Path::new("cell.toml")).unwrap_err();
+        let m = e.to_string();
+        let last = key.rsplit('.').next().unwrap_or(key);
+        let base = last.split('[').next().unwrap_or(last);
+        let line = line_of(&text, &format!("{base} ="));
+        assert!(
+            m.starts_with(&format!("cell.toml:{line}: ")),
+            "line {line}: {m}"
+        );
+        assert!(m.contains(key) && m.contains(also), "{key}, {also}: {m}");
+    };
+    let one = "kind = \"genicam\"\ncameras = [\"a\"]";
+    bad(
+        "kind = \"genicam\"",
+        "",
+        "grabber.kind",
+        "needs its cameras",
+    );
+    bad(
+        "kind = \"genicam\"\ncameras = [\"a\", \"a\"]",
+        "",
+        "grabber.cameras[1]",
+        "listed twice",
+    );
+    let cam = |kv: &str| format!("[[grabber.camera]]\n{kv}");
+    bad(
+        one,
+        &cam("pixel_format = \"RGB8\""),
+        "grabber.camera[0].pixel_format",
+        "Mono8, Mono10, Mono12, Mono16",
+    );
+    bad(
+        one,
+        &cam("exposure_us = 0.0"),
+        "grabber.camera[0].exposure_us",
+        "1 to 60000000",
+    );
+    bad(
+        one,
+        &cam("roi = [0, 0, 0, 480]"),
+        "grabber.camera[0].roi",
+        "1 to 65535",
+    );
+    bad(
+        one,
+        &cam("packet_size = 100"),
+        "grabber.camera[0].packet_size",
+        "576",
+    );
+}

@@ -91,3 +91,30 @@ fn an_unplugged_grabber_is_reported_and_reconnected() {
     };
     assert_eq!(image.size(), (128, 128));
 }
+
+/// Exposure and gain keys on a grabber that cannot set them (the VSG/1
+/// simulated one): a log line says so, nothing else changes.
+#[test]
+fn exposure_on_a_serial_grabber_says_it_cannot() {
+    let profile = Profile::from_toml(PROFILE, Path::new("t.toml")).unwrap();
+    let (tx, rx) = channel();
+    let h = device::spawn(profile, tx).unwrap();
+    next(&rx, 10, "connection", |e| {
+        matches!(e, DeviceEvent::Connected { .. })
+    });
+    h.send(DeviceCmd::Exposure {
+        camera: 1,
+        factor: 1.25,
+    });
+    let note = next(&rx, 10, "a note", |e| matches!(e, DeviceEvent::Note(_)));
+    let DeviceEvent::Note(n) = note else {
+        unreachable!()
+    };
+    assert!(n.contains("does not set exposure or gain"), "{n}");
+    h.send(DeviceCmd::Gain { camera: 1, db: 1.0 });
+    let note = next(&rx, 10, "a note", |e| matches!(e, DeviceEvent::Note(_)));
+    assert!(
+        matches!(&note, DeviceEvent::Note(n) if n.contains("does not set")),
+        "{note:?}"
+    );
+}

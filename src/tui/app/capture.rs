@@ -66,6 +66,28 @@ impl CaptureScreen {
                 }
             },
             CaptureAction::Cancel => super::App::cancel_transfer(ctx),
+            CaptureAction::ExposureUp | CaptureAction::ExposureDown => {
+                let factor = if a == CaptureAction::ExposureUp {
+                    1.25
+                } else {
+                    0.8
+                };
+                vec![Cmd::Device(DeviceCmd::Exposure {
+                    camera: self.camera,
+                    factor,
+                })]
+            }
+            CaptureAction::GainUp | CaptureAction::GainDown => {
+                let db = if a == CaptureAction::GainUp {
+                    1.0
+                } else {
+                    -1.0
+                };
+                vec![Cmd::Device(DeviceCmd::Gain {
+                    camera: self.camera,
+                    db,
+                })]
+            }
         }
     }
 }

@@ -154,6 +154,11 @@ impl App {
                 self.ctx().info(clean(&n));
                 Vec::new()
             }
+            DeviceEvent::CameraSet { grabber, note } => {
+                dev.grabber = clean(&grabber);
+                self.ctx().info(clean(&note));
+                Vec::new()
+            }
         }
     }
 

@@ -156,6 +156,11 @@ pub const KEYMAP: &[Binding] = rows! {
     CA, ch('E'), Capture(Lighting(4)), "lighting configuration e", "";
     CA, ch('F'), Capture(Lighting(5)), "lighting configuration f", "";
     CA, k(K::Esc), Capture(Cancel), "stop the transfer and the live view", "";
+    CA, ch(']'), Capture(ExposureUp), "exposure × 1.25 (GenICam cameras)", "";
+    CA, ch('['), Capture(ExposureDown), "exposure ÷ 1.25 (GenICam cameras)", "";
+    CA, ch('+'), Capture(GainUp), "gain + 1 dB (GenICam cameras)", "";
+    CA, ch('='), Capture(GainUp), "gain + 1 dB (GenICam cameras)", "";
+    CA, ch('-'), Capture(GainDown), "gain − 1 dB (GenICam cameras)", "";
     // Pipeline.
     PI, k(K::Up), Pipeline(ParamPrev), "choose the parameter above", "";
     PI, k(K::Down), Pipeline(ParamNext), "choose the parameter below", "";

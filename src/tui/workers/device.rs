@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use super::send;
 use crate::profile::Profile;
-use crate::rig::{Cell, RigError};
+use crate::rig::{CameraState, Cell, FrameGrabber, RigError};
 use crate::tui::event::{DeviceCmd, DeviceEvent, FramePurpose, Msg};
 
 /// Least time between two live frames: the link and the terminal keep up.
@@ -87,11 +87,21 @@ impl Worker {
         }
     }
 
+    /// Least time between two live frames: the grabber's own (a GenICam
+    /// camera's is short), or [`LIVE_INTERVAL`].
+    fn live_interval(&self) -> Duration {
+        self.cell
+            .as_ref()
+            .and_then(|c| c.grabber.live_interval())
+            .unwrap_or(LIVE_INTERVAL)
+    }
+
     fn run(mut self, rx: Receiver<DeviceCmd>) {
         loop {
             self.ensure_connected();
+            let interval = self.live_interval();
             let wait = match (self.live, self.last_live) {
-                (Some(_), Some(t)) => LIVE_INTERVAL.saturating_sub(t.elapsed()),
+                (Some(_), Some(t)) => interval.saturating_sub(t.elapsed()),
                 (Some(_), None) => Duration::ZERO,
                 _ if !self.healthy => RETRY_INTERVAL,
                 _ => Duration::from_secs(3600),
@@ -103,7 +113,7 @@ impl Worker {
             }
             if let Some(cam) = self.live
                 && self.healthy
-                && self.last_live.is_none_or(|t| t.elapsed() >= LIVE_INTERVAL)
+                && self.last_live.is_none_or(|t| t.elapsed() >= interval)
             {
                 self.last_live = Some(Instant::now());
                 self.grab(FramePurpose::Live, cam, None);
@@ -128,11 +138,12 @@ impl Worker {
         };
         let hello = result.and_then(|_| match self.cell.as_mut() {
             Some(c) => c.grabber.hello().map(|h| {
-                (
-                    h,
-                    c.lights.port_name().to_string(),
-                    c.grabber.port_name().to_string(),
-                )
+                // A GenICam camera also says what it is and how it is set.
+                let port = match c.grabber.camera_state() {
+                    Some(st) => format!("{}: {}", c.grabber.port_name(), st.summary()),
+                    None => c.grabber.port_name().to_string(),
+                };
+                (h, c.lights.port_name().to_string(), port)
             }),
             None => Err(RigError::Config("no cell".into())),
         });
@@ -214,6 +225,18 @@ impl Worker {
             }),
             DeviceCmd::AllOff => self.lights(|c| c.set_lights(0)),
             DeviceCmd::Lighting(l) => self.lights(|c| c.switch_lighting(l)),
+            DeviceCmd::Exposure { camera, factor } => self.camera_setting(camera, |g| {
+                let now = g.camera_state().map_or(f64::NAN, |s| s.exposure_us);
+                let st = g.set_exposure(now * factor)?;
+                let note = format!("exposure {:.0} µs", st.exposure_us);
+                Ok((st, note))
+            }),
+            DeviceCmd::Gain { camera, db } => self.camera_setting(camera, |g| {
+                let now = g.camera_state().map_or(f64::NAN, |s| s.gain_db);
+                let st = g.set_gain(now + db)?;
+                let note = format!("gain {:.1} dB", st.gain_db);
+                Ok((st, note))
+            }),
             DeviceCmd::SimTarget(t) => {
                 let note = match self.cell.as_ref().and_then(|c| c.sim()) {
                     Some(sim) => {
@@ -224,6 +247,51 @@ impl Worker {
                     None => "no simulated cell: hold the plate in front of the camera".into(),
                 };
                 ev(&self.ui, DeviceEvent::Note(note));
+            }
+        }
+    }
+
+    /// Sets camera `camera`'s exposure or gain through `f`; logs what it
+    /// became (with the camera and its settings) or why not.
+    fn camera_setting(
+        &mut self,
+        camera: u32,
+        f: impl FnOnce(&mut dyn FrameGrabber) -> Result<(CameraState, String), RigError>,
+    ) {
+        let Some(c) = self.cell.as_mut().filter(|_| self.healthy) else {
+            ev(
+                &self.ui,
+                DeviceEvent::Note("the grabber is not connected (see the log)".into()),
+            );
+            return;
+        };
+        let g = c.grabber.as_mut();
+        match g.select_camera(camera).and_then(|_| f(g)) {
+            Ok((st, what)) => {
+                let port = g.port_name().to_string();
+                let info = g.hello().ok();
+                let grabber = match info {
+                    Some(h) => format!(
+                        "{} {}×{} {} cameras on {port}: {}",
+                        h.model,
+                        h.width,
+                        h.height,
+                        h.cameras,
+                        st.summary()
+                    ),
+                    None => format!("{port}: {}", st.summary()),
+                };
+                ev(
+                    &self.ui,
+                    DeviceEvent::CameraSet {
+                        grabber,
+                        note: format!("{port}: {what} ({})", st.summary()),
+                    },
+                );
+            }
+            Err(e) => {
+                ev(&self.ui, DeviceEvent::Note(e.to_string()));
+                self.failed(&e);
             }
         }
     }
