@@ -192,7 +192,7 @@ fn covered_each(samples: &[Segment], against: &[Segment]) -> Vec<(f64, f64)> {
 pub const CONTRAST_BOUNDS: [f64; 3] = [10.0, 20.0, 40.0];
 
 /// How far to either side of a true line its contrast is read (px).
-const CONTRAST_REACH: f64 = 2.0;
+pub const CONTRAST_REACH: f64 = 2.0;
 
 /// A true line's contrast in `img`: the median over its samples (1 px
 /// apart) of the difference of the grey levels [`CONTRAST_REACH`] px to

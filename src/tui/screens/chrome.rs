@@ -317,7 +317,7 @@ fn layout_spans(spans: Vec<Span<'static>>, width: usize, used: usize) -> Vec<Vec
 }
 
 /// Rows the hints need at `width` (at most three), with room kept for the
-/// passing status ([`STATUS_ROOM`]) and for the screen's own hints while a
+/// passing status (`STATUS_ROOM`) and for the screen's own hints while a
 /// question or a field shows shorter ones: the same while a run comes and
 /// goes, or a value is typed.
 pub fn hint_rows(app: &App, width: u16) -> u16 {
