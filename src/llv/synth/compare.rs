@@ -36,7 +36,7 @@ use crate::llv::{GreyImage, LlvError, Params, Point, Segment};
 
 mod files;
 
-pub use files::{read_segments, read_times, read_truth, write_segments};
+pub use files::{mean_times, read_segments, read_times, read_truth, write_segments};
 
 /// The name vss's own files carry.
 pub const VSS: &str = "vss";
@@ -326,17 +326,7 @@ pub fn score_dir(dir: &Path) -> Result<Vec<FamilyScores>, FormatError> {
                     }
                     tally.add_with(&read_segments(&path)?, t, dc);
                 }
-                let times_path = ldir.join(format!("{det}.times"));
-                let (fastest_ms, median_ms) = if times_path.exists() {
-                    let t = read_times(&times_path)?;
-                    let n = t.len().max(1) as f64;
-                    (
-                        Some(t.iter().map(|x| x.0).sum::<f64>() / n),
-                        Some(t.iter().map(|x| x.1).sum::<f64>() / n),
-                    )
-                } else {
-                    (None, None)
-                };
+                let (fastest_ms, median_ms) = mean_times(&ldir, &det)?;
                 let metrics = tally.metrics();
                 dets.push(DetectorScore {
                     detector: det,

@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::compare::{CompareError, VSS, read_segments, read_times, timed_run};
+use super::compare::{CompareError, VSS, mean_times, read_segments, timed_run};
 use crate::formats::imageio::{ImageKind, read_any_sized};
 use crate::formats::{FormatError, FormatErrorKind as K, Location, write_bytes};
 use crate::llv::pipeline::Workspace;
@@ -510,17 +510,7 @@ pub fn score_dir(photos: &Path, segs: &Path) -> Result<Vec<RealScore>, FormatErr
             tally.add(&detected, t);
             by_contrast.add(t, c, &detected);
         }
-        let times_path = segs.join(format!("{det}.times"));
-        let (fastest_ms, median_ms) = if times_path.exists() {
-            let t = read_times(&times_path)?;
-            let n = t.len().max(1) as f64;
-            (
-                Some(t.iter().map(|x| x.0).sum::<f64>() / n),
-                Some(t.iter().map(|x| x.1).sum::<f64>() / n),
-            )
-        } else {
-            (None, None)
-        };
+        let (fastest_ms, median_ms) = mean_times(segs, &det)?;
         out.push(RealScore {
             detector: det,
             metrics: tally.metrics(),

@@ -83,6 +83,21 @@ pub fn read_segments(path: &Path) -> Result<Vec<Segment>, FormatError> {
         .collect()
 }
 
+/// A detector's `DET.times` in `dir`, if it wrote one: the mean over its
+/// images of their fastest and median times (ms).
+pub fn mean_times(dir: &Path, det: &str) -> Result<(Option<f64>, Option<f64>), FormatError> {
+    let path = dir.join(format!("{det}.times"));
+    if !path.exists() {
+        return Ok((None, None));
+    }
+    let t = read_times(&path)?;
+    let n = t.len().max(1) as f64;
+    Ok((
+        Some(t.iter().map(|x| x.0).sum::<f64>() / n),
+        Some(t.iter().map(|x| x.1).sum::<f64>() / n),
+    ))
+}
+
 /// A times file: (fastest ms, median ms) per scene.
 pub fn read_times(path: &Path) -> Result<Vec<(f64, f64)>, FormatError> {
     let text = read_text(path)?;
