@@ -555,19 +555,29 @@ impl Ctx<'_> {
         cmds
     }
 
-    /// Makes image `k` the one the survey works on, loading what the
-    /// session holds of it.
-    pub fn go_to(&mut self, k: u32) -> Vec<Cmd> {
+    /// Makes image `k` the image under work, in Setup, with the plan's
+    /// camera and location; refused (said, `false`) while a capture or a
+    /// run of the image under work is out.
+    pub(super) fn set_image_under_work(&mut self, k: u32) -> bool {
         if matches!(
             self.session.work.phase,
             Phase::Capturing | Phase::Processing
         ) {
             self.warn("busy with the image under work: wait for it, or Esc stops the capture");
-            return Vec::new();
+            return false;
         }
         self.session.work.k = k;
         self.session.work.phase = Phase::Setup;
         self.follow_plan();
+        true
+    }
+
+    /// Makes image `k` the one the survey works on, loading what the
+    /// session holds of it.
+    pub fn go_to(&mut self, k: u32) -> Vec<Cmd> {
+        if !self.set_image_under_work(k) {
+            return Vec::new();
+        }
         self.info(format!("image {k}"));
         let captured = self
             .session

@@ -115,16 +115,9 @@ impl Ctx<'_> {
     /// recorded values (the session's redo, as `vss session redo`); the
     /// store reads the image back when done.
     pub fn remake(&mut self, k: u32) -> Vec<Cmd> {
-        if matches!(
-            self.session.work.phase,
-            Phase::Capturing | Phase::Processing
-        ) {
-            self.warn("busy with the image under work: wait for it, or Esc stops the capture");
+        if !self.set_image_under_work(k) {
             return Vec::new();
         }
-        self.session.work.k = k;
-        self.session.work.phase = Phase::Setup;
-        self.follow_plan();
         self.use_recorded_params(k);
         self.tracker.current = None;
         self.info(format!(
