@@ -1,11 +1,14 @@
 //! PostScript and SVG reports of a survey (spec/formats.md §7): the grey-image
 //! page of the original `img2ps`, the line page of `ldr2ps`, and a multi-page
 //! survey report per image (grey images, edge images, raw and connected
-//! lines, parameters, counts, timings). The writers build text in memory from
-//! plain data ([`GreyImage`], [`Segment`], [`EdgePoints`]); [`survey`]
-//! gathers that data from a session and is the one writer of a session's
-//! report, for the command line and the console alike; saving goes through
-//! [`crate::fsutil::write_atomic`].
+//! lines, parameters, counts, timings). The writers draw from plain data
+//! ([`GreyImage`], [`Segment`], [`EdgePoints`]) straight into an
+//! [`std::io::Write`], page by page: a report is streamed into the temporary
+//! file of [`crate::fsutil::write_atomic_with`], never built whole in
+//! memory, so its cost is one image's pictures, not the length of the
+//! document. [`survey`] gathers that data from a session, one image at a
+//! time, and is the one writer of a session's report, for the command line
+//! and the console alike.
 
 pub mod calibration;
 pub mod clip;
@@ -75,12 +78,7 @@ pub fn edge_image(
     width: usize,
     height: usize,
 ) -> Result<GreyImage, PictureSizeError> {
-    let (w, h) = if e.width > 0 && e.height > 0 {
-        (e.width, e.height)
-    } else {
-        (width, height)
-    };
-    check_picture_size(w, h)?;
+    let (w, h) = edge_image_size(e, width, height)?;
     let mut img = GreyImage::filled(w, h, 255).map_err(|_| PictureSizeError {
         width: w,
         height: h,
@@ -112,6 +110,23 @@ pub fn edge_image(
         }
     }
     Ok(img)
+}
+
+/// The size [`edge_image`] draws the points of `e` at, checked with
+/// [`check_picture_size`]: the edge file's size, or `width × height` when
+/// the file gives none. A report plans its pages with it before drawing.
+pub fn edge_image_size(
+    e: &EdgePoints,
+    width: usize,
+    height: usize,
+) -> Result<(usize, usize), PictureSizeError> {
+    let (w, h) = if e.width > 0 && e.height > 0 {
+        (e.width, e.height)
+    } else {
+        (width, height)
+    };
+    check_picture_size(w, h)?;
+    Ok((w, h))
 }
 
 /// Text safe for a PostScript string or an XML attribute: the crate's one

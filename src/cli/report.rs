@@ -2,6 +2,8 @@
 //! single files (`--ldr test1.ldr` as `ldr2ps`, `--img cube1a.img` as
 //! `img2ps`).
 
+use std::fs::File;
+use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -9,7 +11,7 @@ use anyhow::{Context as _, bail};
 
 use super::Global;
 use crate::formats;
-use crate::fsutil::write_atomic;
+use crate::fsutil::write_atomic_with;
 use crate::llv::GreyImage;
 use crate::report::{ps, survey, svg};
 use crate::session::Session;
@@ -55,9 +57,19 @@ pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     session_report(dir, &a)
 }
 
-fn write(path: &Path, text: &str) -> anyhow::Result<()> {
-    write_atomic(path, text.as_bytes())
-        .with_context(|| format!("cannot write {}", path.display()))?;
+/// Writes `path` atomically, streaming the document into the temporary
+/// file: nothing at `path` changes unless all of it was written.
+fn write(
+    path: &Path,
+    fill: impl FnOnce(&mut BufWriter<&mut File>) -> std::io::Result<()>,
+) -> anyhow::Result<()> {
+    write_atomic_with(path, fill).with_context(|| {
+        format!(
+            "cannot write {} ({})",
+            path.display(),
+            survey::on_disk(path)
+        )
+    })?;
     outln!("wrote {}", path.display());
     Ok(())
 }
@@ -76,10 +88,14 @@ fn lines_report(ldr: &Path, a: &Args) -> anyhow::Result<ExitCode> {
         a.ps.clone()
             .or_else(|| a.svg.is_none().then(|| ldr.with_extension("ps")));
     if let Some(p) = ps_path {
-        write(&p, &ps::lines_page(&caption, &lines, w, h))?;
+        write(&p, |o| {
+            ps::write_lines_page(o, &caption, &lines, w, h).map(drop)
+        })?;
     }
     if let Some(p) = &a.svg {
-        write(p, &svg::lines_svg(&caption, &lines, w, h))?;
+        write(p, |o| {
+            svg::write_lines_svg(o, &caption, &lines, w, h).map(drop)
+        })?;
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -152,7 +168,7 @@ fn grey_report(a: &Args) -> anyhow::Result<ExitCode> {
     if let Some(p) = ps_path {
         let refs: Vec<(&str, &GreyImage)> = images.iter().map(|(n, i)| (n.as_str(), i)).collect();
         let title = images.first().map_or("", |(n, _)| n.as_str());
-        write(&p, &ps::grey_page(title, &refs))?;
+        write(&p, |o| ps::write_grey_page(o, title, &refs).map(drop))?;
     }
     if let Some(p) = &a.svg {
         for (i, (name, img)) in images.iter().enumerate() {
@@ -161,7 +177,7 @@ fn grey_report(a: &Args) -> anyhow::Result<ExitCode> {
             } else {
                 survey::numbered(p, i as u32 + 1)
             };
-            write(&path, &svg::grey_svg(name, img))?;
+            write(&path, |o| svg::write_grey_svg(o, name, img).map(drop))?;
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -180,7 +196,12 @@ fn session_report(dir: &Path, a: &Args) -> anyhow::Result<ExitCode> {
         }),
         svg: a.svg.clone(),
     };
-    for p in survey::write(&s, a.image, &targets)? {
+    let written = survey::write(&s, a.image, &targets).map_err(|e| match e.on_disk() {
+        // Which file is still the old one.
+        Some(old) => anyhow::anyhow!("{e} ({old})"),
+        None => e.into(),
+    })?;
+    for p in written {
         outln!("wrote {}", p.display());
     }
     Ok(ExitCode::SUCCESS)

@@ -5,8 +5,9 @@
 //! checks before trusting a `.cdf`.
 
 use std::fmt::Write as _;
+use std::io;
 
-use super::ps::{PsDoc, page_heading, ps_string, text_cell};
+use super::ps::{PsWriter, in_memory, page_heading, ps_string, text_cell};
 use crate::calib::{COVERAGE, Calibration, coverage};
 
 /// The page's text: parameters, views, warnings.
@@ -71,13 +72,23 @@ pub fn magnification(c: &Calibration) -> f64 {
     }
 }
 
-/// Adds the calibration page of camera `camera` to `doc`.
-pub fn page(doc: &mut PsDoc, camera: u32, c: &Calibration) {
-    page_named(doc, &format!("camera {camera}"), c);
+/// Writes the calibration page of camera `camera` into `doc`.
+pub fn page<W: io::Write>(doc: &mut PsWriter<W>, camera: u32, c: &Calibration) -> io::Result<()> {
+    page_named(doc, &format!("camera {camera}"), c)
 }
 
-/// Adds the calibration page of the camera called `name` to `doc`.
-pub fn page_named(doc: &mut PsDoc, name: &str, c: &Calibration) {
+/// Writes the calibration page of the camera called `name` into `doc`.
+pub fn page_named<W: io::Write>(
+    doc: &mut PsWriter<W>,
+    name: &str,
+    c: &Calibration,
+) -> io::Result<()> {
+    doc.raw_page(&page_body(name, c))
+}
+
+/// The body of the calibration page of the camera called `name` (a few
+/// thousand lines of vectors at most: no pictures).
+fn page_body(name: &str, c: &Calibration) -> Vec<u8> {
     let (w, h) = (c.width.max(1) as f64, c.height.max(1) as f64);
     let mut body = page_heading(&format!("{name}: calibration"), 0, 1);
     let k = magnification(c);
@@ -136,8 +147,10 @@ pub fn page_named(doc: &mut PsDoc, name: &str, c: &Calibration) {
             "coverage: corners per {COVERAGE} x {COVERAGE} cell (darker: more); {empty} cells empty"
         ))
     );
-    text_cell(&mut body, &summary_lines(c), (0, 1), (1, 2));
-    doc.push_page(body);
+    let mut body = body.into_bytes();
+    // Writing into a `Vec` cannot fail.
+    let _ = text_cell(&mut body, &summary_lines(c), (0, 1), (1, 2));
+    body
 }
 
 /// A document of one calibration page.
@@ -147,7 +160,9 @@ pub fn document(camera: u32, c: &Calibration) -> String {
 
 /// The calibration page of the camera called `name` as a PostScript file.
 pub fn document_named(name: &str, c: &Calibration) -> String {
-    let mut doc = PsDoc::new(&format!("{name} calibration"));
-    page_named(&mut doc, name, c);
-    doc.finish()
+    in_memory(|v| {
+        let mut doc = PsWriter::begin(v, &format!("{name} calibration"), 1)?;
+        page_named(&mut doc, name, c)?;
+        doc.finish()
+    })
 }

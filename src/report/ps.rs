@@ -8,11 +8,11 @@
 //! original: a grey image is drawn with `W H 8 [W 0 0 -H 0 H]` and a line
 //! `(x1,y1)-(x2,y2)` becomes `x1/W 1-y1/H x2/W 1-y2/H l`.
 
-use std::fmt::Write as _;
+use std::io::{self, Write};
 
 use super::clip::DrawBox;
-use super::{ImageReport, edge_image, encode, printable};
-use crate::llv::{GreyImage, Segment};
+use super::{ImageReport, edge_image, edge_image_size, encode, printable};
+use crate::llv::{EdgePoints, GreyImage, Segment};
 
 /// Images per grey-image page, as in `img2ps`.
 pub const IMAGES_PER_PAGE: usize = 6;
@@ -47,169 +47,306 @@ vssdict begin
 end
 "#;
 
-/// A PostScript document being assembled page by page.
-#[derive(Debug, Default)]
-pub struct PsDoc {
-    title: String,
-    pages: Vec<String>,
+/// A PostScript document written page by page to `W` (the report's
+/// temporary file, or a `Vec<u8>`): nothing but the page being drawn is held
+/// in memory, so a report of any length costs what one page's pictures cost.
+///
+/// The DSC header comes first and states the page count, so the caller
+/// counts the pages before writing them ([`image_report_pages`] and the
+/// other `*_pages` functions, the same plan the writer follows); [`finish`]
+/// checks that the pages written are the pages declared, so a session that
+/// changed between the count and the writing gives an error, not a file that
+/// lies about its pages.
+///
+/// [`finish`]: PsWriter::finish
+#[derive(Debug)]
+pub struct PsWriter<W: Write> {
+    out: W,
+    declared: usize,
+    written: usize,
 }
 
-impl PsDoc {
-    pub fn new(title: &str) -> PsDoc {
-        PsDoc {
-            title: printable(title),
-            pages: Vec::new(),
-        }
+impl<W: Write> PsWriter<W> {
+    /// Writes the header and prolog of a document of `pages` pages titled
+    /// `title`. A document without pages gets one page saying so (declared
+    /// here, written by [`PsWriter::finish`]), so every file prints.
+    pub fn begin(mut out: W, title: &str, pages: usize) -> io::Result<PsWriter<W>> {
+        let declared = pages.max(1);
+        out.write_all(b"%!PS-Adobe-2.0\n")?;
+        writeln!(out, "%%Title: {}", printable(title))?;
+        writeln!(out, "%%Creator: vss {}", env!("CARGO_PKG_VERSION"))?;
+        writeln!(out, "%%Pages: {declared}")?;
+        out.write_all(b"%%DocumentFonts: Helvetica Helvetica-Bold Courier\n")?;
+        out.write_all(b"%%EndComments\n")?;
+        out.write_all(PROLOG.as_bytes())?;
+        out.write_all(b"%%EndProlog\n")?;
+        Ok(PsWriter {
+            out,
+            declared,
+            written: 0,
+        })
     }
 
-    /// Appends a page whose body another module drew with this prolog's
+    /// Writes one page whose body `body` draws with the prolog's procedures.
+    fn page(&mut self, body: impl FnOnce(&mut W) -> io::Result<()>) -> io::Result<()> {
+        self.written += 1;
+        writeln!(self.out, "%%Page: {} {}", self.written, self.written)?;
+        self.out.write_all(b"vssdict begin\npagebox\n")?;
+        body(&mut self.out)?;
+        self.out.write_all(b"showpage\nend\n")
+    }
+
+    /// Writes a page whose body another module drew with this prolog's
     /// procedures (`crate::report::calibration`).
-    pub(super) fn push_page(&mut self, body: String) {
-        self.pages.push(body);
+    pub(super) fn raw_page(&mut self, body: &[u8]) -> io::Result<()> {
+        self.page(|o| o.write_all(body))
     }
 
-    /// Number of pages so far.
+    /// Number of pages written so far.
     pub fn page_count(&self) -> usize {
-        self.pages.len()
+        self.written
     }
 
     /// `img2ps`: grey images with their captions, up to six per page (two
-    /// columns, three rows), as many pages as needed.
-    pub fn grey_pages(&mut self, heading: &str, images: &[(&str, &GreyImage)]) {
-        let chunks: Vec<_> = images.chunks(IMAGES_PER_PAGE).collect();
-        let n = chunks.len();
-        for (i, chunk) in chunks.into_iter().enumerate() {
-            let mut body = page_heading(heading, i, n);
-            for (j, (caption, img)) in chunk.iter().enumerate() {
-                image_cell(&mut body, img, caption, (j % 2, j / 2), (2, 3));
+    /// columns, three rows), as many pages as needed
+    /// ([`grey_pages_count`]).
+    pub fn grey_pages(&mut self, heading: &str, images: &[(&str, &GreyImage)]) -> io::Result<()> {
+        let n = grey_pages_count(images.len());
+        for (i, chunk) in images.chunks(IMAGES_PER_PAGE).enumerate() {
+            self.page(|o| {
+                o.write_all(page_heading(heading, i, n).as_bytes())?;
+                for (j, (caption, img)) in chunk.iter().enumerate() {
+                    image_cell(o, img, caption, (j % 2, j / 2), (2, 3))?;
+                }
+                Ok(())
+            })?;
+        }
+        Ok(())
+    }
+
+    /// `ldr2ps`: one page, a picture of `width × height` pixels with its
+    /// lines.
+    pub fn lines_page(
+        &mut self,
+        caption: &str,
+        lines: &[Segment],
+        width: usize,
+        height: usize,
+    ) -> io::Result<()> {
+        self.page(|o| {
+            o.write_all(page_heading(caption, 0, 1).as_bytes())?;
+            lines_cell(o, lines, width, height, caption, (0, 0), (1, 1))
+        })
+    }
+
+    /// Pages of plain text (parameters, counts, timings)
+    /// ([`text_pages_count`]).
+    pub fn text_pages(&mut self, heading: &str, text: &[String]) -> io::Result<()> {
+        let n = text_pages_count(text.len());
+        for (i, chunk) in text.chunks(NOTES_PER_PAGE).enumerate() {
+            self.page(|o| {
+                o.write_all(page_heading(heading, i, n).as_bytes())?;
+                text_cell(o, chunk, (0, 0), (1, 1))
+            })?;
+        }
+        Ok(())
+    }
+
+    /// The survey report pages of one image ([`image_report_pages`]): its
+    /// grey and edge images, then the raw and connected lines side by side
+    /// with the notes below. An edge image is drawn when its page is
+    /// written and dropped after it: at most one is in memory.
+    pub fn image_report(&mut self, r: &ImageReport) -> io::Result<()> {
+        let plan = Plan::of(r);
+        if !plan.cells.is_empty() {
+            let heading = format!("{}: grey and edge images", r.title);
+            let n = grey_pages_count(plan.cells.len());
+            for (i, chunk) in plan.cells.chunks(IMAGES_PER_PAGE).enumerate() {
+                self.page(|o| {
+                    o.write_all(page_heading(&heading, i, n).as_bytes())?;
+                    for (j, cell) in chunk.iter().enumerate() {
+                        let at = ((j % 2, j / 2), (2, 3));
+                        match cell {
+                            Cell::Grey(caption, img) => image_cell(o, img, caption, at.0, at.1)?,
+                            Cell::Edges(caption, e) => {
+                                // Checked by the plan: the size is drawable.
+                                let img =
+                                    edge_image(e, r.width, r.height).map_err(io::Error::other)?;
+                                image_cell(o, &img, caption, at.0, at.1)?;
+                            }
+                        }
+                    }
+                    Ok(())
+                })?;
             }
-            self.pages.push(body);
         }
-    }
-
-    /// `ldr2ps`: one picture of `width × height` pixels with its lines.
-    pub fn lines_page(&mut self, caption: &str, lines: &[Segment], width: usize, height: usize) {
-        let mut body = page_heading(caption, 0, 1);
-        lines_cell(&mut body, lines, width, height, caption, (0, 0), (1, 1));
-        self.pages.push(body);
-    }
-
-    /// Pages of plain text (parameters, counts, timings).
-    pub fn text_pages(&mut self, heading: &str, text: &[String]) {
-        let chunks: Vec<_> = text.chunks(NOTES_PER_PAGE).collect();
-        let n = chunks.len();
-        for (i, chunk) in chunks.into_iter().enumerate() {
-            let mut body = page_heading(heading, i, n);
-            text_cell(&mut body, chunk, (0, 0), (1, 1));
-            self.pages.push(body);
+        let (w, h) = (r.width.max(1), r.height.max(1));
+        let (first, rest) = plan
+            .notes
+            .split_at(plan.notes.len().min(NOTES_ON_LINE_PAGE));
+        self.page(|o| {
+            o.write_all(page_heading(&format!("{}: lines", r.title), 0, 1).as_bytes())?;
+            let sets = [
+                (r.lines_raw.as_ref(), "extracted (.lex)"),
+                (r.lines.as_ref(), "post-processed (.ldr)"),
+            ];
+            for (col, (lines, what)) in sets.into_iter().enumerate() {
+                let caption = match lines {
+                    Some(l) => format!("{}: {} lines, {what}", r.title, l.len()),
+                    None => format!("{}: no lines {what}", r.title),
+                };
+                lines_cell(
+                    o,
+                    lines.map_or(&[][..], |l| l.as_slice()),
+                    w,
+                    h,
+                    &caption,
+                    (col, 0),
+                    (2, 2),
+                )?;
+            }
+            text_cell(o, first, (0, 1), (1, 2))
+        })?;
+        if !rest.is_empty() {
+            self.text_pages(&format!("{}: notes (continued)", r.title), rest)?;
         }
+        Ok(())
     }
 
-    /// The survey report pages of one image: its grey and edge images, then
-    /// the raw and connected lines side by side with the notes below.
-    pub fn image_report(&mut self, r: &ImageReport) {
+    /// Writes the trailer and hands back the output. A document without
+    /// pages gets its one page saying so here. An error when the pages
+    /// written are not the pages the header declared.
+    pub fn finish(mut self) -> io::Result<W> {
+        if self.written == 0 {
+            self.page(|o| o.write_all(page_heading("(nothing to show)", 0, 1).as_bytes()))?;
+        }
+        if self.written != self.declared {
+            return Err(io::Error::other(format!(
+                "the report declares {} pages but has {}: its files changed while it was \
+                 written; write it again",
+                self.declared, self.written
+            )));
+        }
+        self.out.write_all(b"%%Trailer\n%%EOF\n")?;
+        Ok(self.out)
+    }
+}
+
+/// What the pages of one image show, in order: the one plan that both
+/// [`image_report_pages`] counts and [`PsWriter::image_report`] writes.
+struct Plan<'a> {
+    cells: Vec<Cell<'a>>,
+    notes: Vec<String>,
+}
+
+/// A picture cell of an image's grey-and-edge pages.
+enum Cell<'a> {
+    Grey(&'a str, &'a GreyImage),
+    /// Edge points, drawn as an image only when their page is written.
+    Edges(String, &'a EdgePoints),
+}
+
+impl<'a> Plan<'a> {
+    fn of(r: &'a ImageReport) -> Plan<'a> {
         // An edge image that cannot be drawn is left out with a note, like a
         // file the report cannot read.
         let mut notes = r.notes.clone();
-        let mut edges: Vec<(String, GreyImage)> = Vec::new();
+        let mut cells: Vec<Cell<'a>> = r
+            .greys
+            .iter()
+            .map(|(c, i)| Cell::Grey(c.as_str(), i))
+            .collect();
         for (e, what) in [
             (r.edges_h.as_ref(), "horizontal scan"),
             (r.edges_v.as_ref(), "vertical scan"),
         ] {
             let Some(e) = e else { continue };
-            match edge_image(e, r.width, r.height) {
-                Ok(img) => edges.push((
+            match edge_image_size(e, r.width, r.height) {
+                Ok(_) => cells.push(Cell::Edges(
                     format!("{}: edges, {what} ({} points)", r.title, e.points.len()),
-                    img,
+                    e,
                 )),
                 Err(err) => notes.push(format!("cannot show the edges, {what}: {err}")),
             }
         }
-        let cells: Vec<(&str, &GreyImage)> = r
-            .greys
-            .iter()
-            .chain(edges.iter())
-            .map(|(c, i)| (c.as_str(), i))
-            .collect();
-        if !cells.is_empty() {
-            self.grey_pages(&format!("{}: grey and edge images", r.title), &cells);
-        }
-        let mut body = page_heading(&format!("{}: lines", r.title), 0, 1);
-        let (w, h) = (r.width.max(1), r.height.max(1));
-        let sets = [
-            (r.lines_raw.as_ref(), "extracted (.lex)"),
-            (r.lines.as_ref(), "post-processed (.ldr)"),
-        ];
-        for (col, (lines, what)) in sets.into_iter().enumerate() {
-            let caption = match lines {
-                Some(l) => format!("{}: {} lines, {what}", r.title, l.len()),
-                None => format!("{}: no lines {what}", r.title),
-            };
-            lines_cell(
-                &mut body,
-                lines.map_or(&[][..], |l| l.as_slice()),
-                w,
-                h,
-                &caption,
-                (col, 0),
-                (2, 2),
-            );
-        }
-        let (first, rest) = notes.split_at(notes.len().min(NOTES_ON_LINE_PAGE));
-        text_cell(&mut body, first, (0, 1), (1, 2));
-        self.pages.push(body);
-        if !rest.is_empty() {
-            self.text_pages(&format!("{}: notes (continued)", r.title), rest);
-        }
-    }
-
-    /// The finished document with its DSC header and trailer. A document
-    /// without pages gets one page saying so, so every file prints.
-    pub fn finish(mut self) -> String {
-        if self.pages.is_empty() {
-            self.pages.push(page_heading("(nothing to show)", 0, 1));
-        }
-        let mut out = String::new();
-        out.push_str("%!PS-Adobe-2.0\n");
-        let _ = writeln!(out, "%%Title: {}", self.title);
-        let _ = writeln!(out, "%%Creator: vss {}", env!("CARGO_PKG_VERSION"));
-        let _ = writeln!(out, "%%Pages: {}", self.pages.len());
-        out.push_str("%%DocumentFonts: Helvetica Helvetica-Bold Courier\n");
-        out.push_str("%%EndComments\n");
-        out.push_str(PROLOG);
-        out.push_str("%%EndProlog\n");
-        for (i, body) in self.pages.iter().enumerate() {
-            let _ = writeln!(out, "%%Page: {} {}", i + 1, i + 1);
-            out.push_str("vssdict begin\npagebox\n");
-            out.push_str(body);
-            out.push_str("showpage\nend\n");
-        }
-        out.push_str("%%Trailer\n%%EOF\n");
-        out
+        Plan { cells, notes }
     }
 }
 
-/// A whole `img2ps` document.
+/// Pages `img2ps` needs for `images` pictures.
+pub fn grey_pages_count(images: usize) -> usize {
+    images.div_ceil(IMAGES_PER_PAGE)
+}
+
+/// Pages of `lines` lines of text.
+pub fn text_pages_count(lines: usize) -> usize {
+    lines.div_ceil(NOTES_PER_PAGE)
+}
+
+/// Pages [`PsWriter::image_report`] writes for `r`.
+pub fn image_report_pages(r: &ImageReport) -> usize {
+    let plan = Plan::of(r);
+    grey_pages_count(plan.cells.len())
+        + 1
+        + text_pages_count(plan.notes.len().saturating_sub(NOTES_ON_LINE_PAGE))
+}
+
+/// Writes a whole `img2ps` document to `out`.
+pub fn write_grey_page<W: Write>(
+    out: W,
+    title: &str,
+    images: &[(&str, &GreyImage)],
+) -> io::Result<W> {
+    let mut doc = PsWriter::begin(out, title, grey_pages_count(images.len()))?;
+    doc.grey_pages(title, images)?;
+    doc.finish()
+}
+
+/// Writes a whole `ldr2ps` document to `out`.
+pub fn write_lines_page<W: Write>(
+    out: W,
+    caption: &str,
+    lines: &[Segment],
+    width: usize,
+    height: usize,
+) -> io::Result<W> {
+    let mut doc = PsWriter::begin(out, caption, 1)?;
+    doc.lines_page(caption, lines, width, height)?;
+    doc.finish()
+}
+
+/// A document built in memory by `write` (which writes into a `Vec`, so
+/// cannot fail on output), as text.
+pub(super) fn in_memory(write: impl FnOnce(Vec<u8>) -> io::Result<Vec<u8>>) -> String {
+    // The writers emit printable ASCII only (`printable`, hex, numbers).
+    match write(Vec::new()) {
+        Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+        Err(e) => format!("%!PS-Adobe-2.0\n%% {}\n", printable(&e.to_string())),
+    }
+}
+
+/// A whole `img2ps` document, in memory.
 pub fn grey_page(title: &str, images: &[(&str, &GreyImage)]) -> String {
-    let mut doc = PsDoc::new(title);
-    doc.grey_pages(title, images);
-    doc.finish()
+    in_memory(|v| write_grey_page(v, title, images))
 }
 
-/// A whole `ldr2ps` document.
+/// A whole `ldr2ps` document, in memory.
 pub fn lines_page(caption: &str, lines: &[Segment], width: usize, height: usize) -> String {
-    let mut doc = PsDoc::new(caption);
-    doc.lines_page(caption, lines, width, height);
-    doc.finish()
+    in_memory(|v| write_lines_page(v, caption, lines, width, height))
 }
 
-/// The survey report: every image's pages, in order.
+/// The survey report of `images`, every image's pages in order, in memory
+/// (a session's report is written by `crate::report::survey::write`, one
+/// image at a time).
 pub fn survey_report(title: &str, images: &[ImageReport]) -> String {
-    let mut doc = PsDoc::new(title);
-    for r in images {
-        doc.image_report(r);
-    }
-    doc.finish()
+    in_memory(|v| {
+        let pages = images.iter().map(image_report_pages).sum();
+        let mut doc = PsWriter::begin(v, title, pages)?;
+        for r in images {
+            doc.image_report(r)?;
+        }
+        doc.finish()
+    })
 }
 
 /// A PostScript string literal: `(`, `)` and `\` escaped, non-ASCII dropped.
@@ -236,35 +373,35 @@ pub(super) fn page_heading(heading: &str, i: usize, n: usize) -> String {
 }
 
 fn image_cell(
-    out: &mut String,
+    out: &mut impl Write,
     img: &GreyImage,
     caption: &str,
     (col, row): (usize, usize),
     (nc, nr): (usize, usize),
-) {
+) -> io::Result<()> {
     let (w, h) = img.size();
-    let _ = writeln!(out, "gsave\n{w} {h} {col} {row} {nc} {nr} place");
-    let _ = writeln!(out, "/buf {w} string def");
-    let _ = writeln!(
+    writeln!(out, "gsave\n{w} {h} {col} {row} {nc} {nr} place")?;
+    writeln!(out, "/buf {w} string def")?;
+    writeln!(
         out,
         "{w} {h} 8 [{w} 0 0 -{h} 0 {h}] {{currentfile buf readhexstring pop}} image"
-    );
-    encode::push_hex(out, img);
-    let _ = writeln!(out, "grestore\n{} caption", ps_string(caption));
+    )?;
+    encode::write_hex(out, img)?;
+    writeln!(out, "grestore\n{} caption", ps_string(caption))
 }
 
 fn lines_cell(
-    out: &mut String,
+    out: &mut impl Write,
     lines: &[Segment],
     width: usize,
     height: usize,
     caption: &str,
     (col, row): (usize, usize),
     (nc, nr): (usize, usize),
-) {
+) -> io::Result<()> {
     let (w, h) = (width.max(1) as f64, height.max(1) as f64);
-    let _ = writeln!(out, "gsave\n{w} {h} {col} {row} {nc} {nr} place");
-    out.push_str("0 setlinewidth\nframe stroke\nframe clip newpath\n");
+    writeln!(out, "gsave\n{w} {h} {col} {row} {nc} {nr} place")?;
+    out.write_all(b"0 setlinewidth\nframe stroke\nframe clip newpath\n")?;
     // Clipped to the drawing box, every number written is within [-1, 2]:
     // Ghostscript refuses far larger ones (`/limitcheck`).
     let bx = DrawBox::around(width, height);
@@ -275,27 +412,32 @@ fn lines_cell(
         // read as object edges.
         if s.shadow != gray {
             gray = s.shadow;
-            out.push_str(if gray { "0.5 setgray\n" } else { "0 setgray\n" });
+            out.write_all(if gray {
+                b"0.5 setgray\n"
+            } else {
+                b"0 setgray\n"
+            })?;
         }
-        let _ = writeln!(
+        writeln!(
             out,
             "{:.5} {:.5} {:.5} {:.5} l",
             coords[0], coords[1], coords[2], coords[3]
-        );
+        )?;
     }
-    let _ = writeln!(out, "grestore\n{} caption", ps_string(caption));
+    writeln!(out, "grestore\n{} caption", ps_string(caption))
 }
 
 pub(super) fn text_cell(
-    out: &mut String,
+    out: &mut impl Write,
     text: &[String],
     (col, row): (usize, usize),
     (nc, nr): (usize, usize),
-) {
-    let _ = writeln!(out, "{col} {row} {nc} {nr} textcell");
+) -> io::Result<()> {
+    writeln!(out, "{col} {row} {nc} {nr} textcell")?;
     for line in text {
-        let _ = writeln!(out, "{} t", ps_string(line));
+        writeln!(out, "{} t", ps_string(line))?;
     }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -332,8 +474,42 @@ mod tests {
     }
 
     #[test]
+    fn pages_that_do_not_match_the_header_are_an_error() {
+        let img = GreyImage::filled(4, 3, 128).unwrap();
+        // Declared two, written one: the header would lie.
+        let mut doc = PsWriter::begin(Vec::new(), "t", 2).unwrap();
+        doc.grey_pages("t", &[("x", &img)]).unwrap();
+        let err = doc.finish().unwrap_err();
+        assert!(
+            err.to_string().contains("declares 2 pages but has 1"),
+            "{err}"
+        );
+        // The count of an image's pages is the pages it writes, notes
+        // overflowing onto pages of their own and an edge image that
+        // cannot be drawn (a note) included.
+        let r = ImageReport {
+            title: "cube1".into(),
+            width: 4,
+            height: 3,
+            greys: (0..7).map(|i| (format!("g{i}"), img.clone())).collect(),
+            edges_h: Some(crate::llv::EdgePoints {
+                width: 1 << 20,
+                height: 1 << 20,
+                ..Default::default()
+            }),
+            notes: (0..100).map(|i| format!("note {i}")).collect(),
+            ..Default::default()
+        };
+        assert_eq!(image_report_pages(&r), 2 + 1 + 2);
+        let ps = survey_report("s", &[r.clone(), r]);
+        assert!(ps.contains("%%Pages: 10\n"));
+        assert_eq!(ps.matches("%%Page: ").count(), 10);
+        assert!(ps.contains("cannot show the edges, horizontal scan"));
+    }
+
+    #[test]
     fn empty_document_still_has_a_page() {
-        let ps = PsDoc::new("empty").finish();
+        let ps = survey_report("empty", &[]);
         assert!(ps.contains("%%Pages: 1\n"));
         assert!(ps.contains("showpage"));
     }

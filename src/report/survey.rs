@@ -8,11 +8,14 @@
 //! unreadable becomes a note on the page naming it, instead of failing the
 //! whole report or being left out without a word.
 
+use std::fs::File;
+use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
-use super::{ImageReport, check_picture_size, ps, svg};
+use super::ps::{self, PsWriter};
+use super::{ImageReport, check_picture_size, svg};
 use crate::formats;
-use crate::fsutil::write_atomic;
+use crate::fsutil::write_atomic_with;
 use crate::session::progress::{OutputState, output_state};
 use crate::session::{Session, SessionError};
 
@@ -26,6 +29,37 @@ pub enum ReportError {
         path: PathBuf,
         source: std::io::Error,
     },
+}
+
+impl ReportError {
+    /// What is on disk where the report could not be written (see
+    /// [`on_disk`]), or `None` when nothing was being written.
+    pub fn on_disk(&self) -> Option<String> {
+        match self {
+            ReportError::Write { path, .. } => Some(on_disk(path)),
+            ReportError::Session(_) => None,
+        }
+    }
+}
+
+/// What a failed write left at `path`: the file that was there before,
+/// untouched (the writes are atomic), with the time it was written, or
+/// nothing. For the message after "cannot write …", so the operator knows
+/// the report on disk is not the new one.
+pub fn on_disk(path: &Path) -> String {
+    match std::fs::metadata(path).and_then(|m| m.modified()) {
+        Ok(t) => {
+            let secs = t
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs());
+            format!(
+                "{} on disk is the OLD report, untouched, written {}",
+                path.display(),
+                crate::session::stamp::rfc3339(secs)
+            )
+        }
+        Err(_) => format!("there is no {} yet", path.display()),
+    }
 }
 
 /// Where a survey report goes.
@@ -58,56 +92,89 @@ pub fn title(s: &Session, image: Option<u32>) -> String {
     }
 }
 
-/// The reports of image `image`, or of every image with anything recorded,
-/// in order, each with its number.
-pub fn image_reports(
-    s: &Session,
-    image: Option<u32>,
-) -> Result<Vec<(u32, ImageReport)>, SessionError> {
+/// The image numbers a report of `image` (or of every image with anything
+/// recorded) shows, in order. An image the manifest does not record is an
+/// error naming it.
+pub fn image_numbers(s: &Session, image: Option<u32>) -> Result<Vec<u32>, SessionError> {
     match image {
-        Some(k) => Ok(vec![(k, image_report(s, k)?)]),
-        None => s
-            .manifest()
-            .image
-            .iter()
-            .map(|r| Ok((r.number, image_report(s, r.number)?)))
-            .collect(),
+        Some(k) if s.manifest().image(k).is_some() => Ok(vec![k]),
+        // The error `image_report` gives for it.
+        Some(k) => image_report(s, k).map(|_| vec![k]),
+        None => Ok(s.manifest().image.iter().map(|r| r.number).collect()),
     }
 }
 
 /// Writes the survey report of `image` (or of every image) to `targets`
 /// and returns the files written, in order. A session without images
 /// gives a report without pages.
+///
+/// One image's pictures are in memory at a time, and no file's text is
+/// held whole: the PostScript is streamed page by page into the temporary
+/// file of [`write_atomic_with`], each SVG likewise. The PostScript header
+/// states the page count, so the images are read twice: once to count
+/// their pages, once to write them (reading a survey's files costs far less
+/// than holding all its pictures). A failure half-way (a full disk, a file
+/// that changed so the pages no longer match the count) leaves the file
+/// that was there untouched, and the error names it.
 pub fn write(
     s: &Session,
     image: Option<u32>,
     targets: &Targets,
 ) -> Result<Vec<PathBuf>, ReportError> {
-    let reports = image_reports(s, image)?;
+    let numbers = image_numbers(s, image)?;
     let mut written = Vec::new();
-    let mut put = |path: &Path, text: String| -> Result<(), ReportError> {
-        write_atomic(path, text.as_bytes()).map_err(|source| ReportError::Write {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        written.push(path.to_path_buf());
-        Ok(())
-    };
     if let Some(p) = &targets.ps {
-        let pages: Vec<ImageReport> = reports.iter().map(|(_, r)| r.clone()).collect();
-        put(p, ps::survey_report(&title(s, image), &pages))?;
+        let mut pages = 0;
+        for &k in &numbers {
+            pages += ps::image_report_pages(&image_report(s, k)?);
+        }
+        let title = title(s, image);
+        stream(p, |w, failed| {
+            let mut doc = PsWriter::begin(w, &title, pages)?;
+            for &k in &numbers {
+                let r = image_report(s, k).map_err(|e| {
+                    let err = std::io::Error::other(e.to_string());
+                    *failed = Some(e);
+                    err
+                })?;
+                doc.image_report(&r)?;
+            }
+            doc.finish().map(drop)
+        })?;
+        written.push(p.clone());
     }
     if let Some(p) = &targets.svg {
-        for (k, r) in &reports {
-            let path = if reports.len() == 1 && image.is_some() {
+        for &k in &numbers {
+            let path = if numbers.len() == 1 && image.is_some() {
                 p.clone()
             } else {
-                numbered(p, *k)
+                numbered(p, k)
             };
-            put(&path, svg::image_svg(r))?;
+            let r = image_report(s, k)?;
+            stream(&path, |w, _| svg::write_image_svg(w, &r).map(drop))?;
+            written.push(path);
         }
     }
     Ok(written)
+}
+
+/// Writes `path` atomically with `fill`, which writes into the temporary
+/// file and may set the session error that stopped it. Nothing at `path`
+/// changes unless all of it was written.
+fn stream(
+    path: &Path,
+    fill: impl FnOnce(&mut BufWriter<&mut File>, &mut Option<SessionError>) -> std::io::Result<()>,
+) -> Result<(), ReportError> {
+    let mut failed = None;
+    let result = write_atomic_with(path, |w| fill(w, &mut failed));
+    match (result, failed) {
+        (Ok(()), _) => Ok(()),
+        (Err(_), Some(e)) => Err(ReportError::Session(e)),
+        (Err(source), None) => Err(ReportError::Write {
+            path: path.to_path_buf(),
+            source,
+        }),
+    }
 }
 
 /// `out.svg` → `out3.svg`.

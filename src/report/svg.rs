@@ -11,7 +11,7 @@
 //! off the picture left out, by the same [`DrawBox`] as the PostScript, so
 //! no coordinate written is far beyond the picture.
 
-use std::fmt::Write as _;
+use std::io::{self, Write};
 
 use super::clip::DrawBox;
 use super::{ImageReport, encode, printable};
@@ -35,24 +35,14 @@ fn xml(s: &str) -> String {
 /// An SVG document of one image: grey image (the first of `r.greys`), edge
 /// points, raw lines and connected lines, each in its own group.
 pub fn image_svg(r: &ImageReport) -> String {
+    in_memory(|v| write_image_svg(v, r))
+}
+
+/// Writes the SVG document of one image ([`image_svg`]) to `out`, layer by
+/// layer: no layer's text is held whole.
+pub fn write_image_svg<W: Write>(mut out: W, r: &ImageReport) -> io::Result<W> {
     let (w, h) = (r.width.max(1), r.height.max(1));
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        r#"<?xml version="1.0" encoding="UTF-8"?>
-<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" version="1.1" width="{w}" height="{h}" viewBox="0 0 {w} {h}">
-<title>{}</title>"#,
-        xml(&r.title)
-    );
-    if !r.notes.is_empty() {
-        // The parameters, counts and timings travel with the picture.
-        let notes: Vec<String> = r.notes.iter().map(|n| xml(n)).collect();
-        let _ = writeln!(out, "<desc>{}</desc>", notes.join("\n"));
-    }
-    let _ = writeln!(
-        out,
-        "<rect id=\"paper\" width=\"{w}\" height=\"{h}\" fill=\"white\"/>"
-    );
+    head(&mut out, &r.title, &r.notes, w, h)?;
     for (i, (caption, img)) in r.greys.iter().enumerate() {
         // The first lighting shows; the others are there to switch on.
         let (id, hidden) = if i == 0 {
@@ -60,119 +50,170 @@ pub fn image_svg(r: &ImageReport) -> String {
         } else {
             (format!("grey-{}", i + 1), true)
         };
-        grey_layer(&mut out, &id, caption, img, hidden);
+        grey_layer(&mut out, &id, caption, img, hidden)?;
     }
     let bx = DrawBox::around(w, h);
     if let Some(e) = &r.edges_h {
-        edge_layer(&mut out, "edges-h", e, "#00a0ff", &bx);
+        edge_layer(&mut out, "edges-h", e, "#00a0ff", &bx)?;
     }
     if let Some(e) = &r.edges_v {
-        edge_layer(&mut out, "edges-v", e, "#ff8000", &bx);
+        edge_layer(&mut out, "edges-v", e, "#ff8000", &bx)?;
     }
     if let Some(l) = &r.lines_raw {
-        lines_layer(&mut out, "lines-raw", l, "#00c000", 1.0, &bx);
+        lines_layer(&mut out, "lines-raw", l, "#00c000", 1.0, &bx)?;
     }
     if let Some(l) = &r.lines {
-        lines_layer(&mut out, "lines", l, "#ff0000", 1.0, &bx);
+        lines_layer(&mut out, "lines", l, "#ff0000", 1.0, &bx)?;
     }
-    out.push_str("</svg>\n");
-    out
+    out.write_all(b"</svg>\n")?;
+    Ok(out)
+}
+
+/// The XML declaration, the `<svg>` element, title, notes and white paper.
+fn head(out: &mut impl Write, title: &str, notes: &[String], w: usize, h: usize) -> io::Result<()> {
+    writeln!(
+        out,
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" version="1.1" width="{w}" height="{h}" viewBox="0 0 {w} {h}">
+<title>{}</title>"#,
+        xml(title)
+    )?;
+    if !notes.is_empty() {
+        // The parameters, counts and timings travel with the picture.
+        let notes: Vec<String> = notes.iter().map(|n| xml(n)).collect();
+        writeln!(out, "<desc>{}</desc>", notes.join("\n"))?;
+    }
+    writeln!(
+        out,
+        "<rect id=\"paper\" width=\"{w}\" height=\"{h}\" fill=\"white\"/>"
+    )
+}
+
+/// A document written into a `Vec` (which cannot fail on output), as text.
+fn in_memory(write: impl FnOnce(Vec<u8>) -> io::Result<Vec<u8>>) -> String {
+    match write(Vec::new()) {
+        Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+        Err(e) => format!("<!-- {} -->\n", xml(&e.to_string())),
+    }
 }
 
 /// An SVG of a line set alone (the `ldr2ps` equivalent): a frame and the
 /// lines in black on white.
 pub fn lines_svg(title: &str, lines: &[Segment], width: usize, height: usize) -> String {
-    let r = ImageReport {
-        title: title.to_string(),
-        width,
-        height,
-        lines: Some(lines.to_vec()),
-        ..Default::default()
-    };
-    let mut s = image_svg(&r);
+    in_memory(|v| write_lines_svg(v, title, lines, width, height))
+}
+
+/// Writes [`lines_svg`] to `out`.
+pub fn write_lines_svg<W: Write>(
+    mut out: W,
+    title: &str,
+    lines: &[Segment],
+    width: usize,
+    height: usize,
+) -> io::Result<W> {
+    let (w, h) = (width.max(1), height.max(1));
+    head(&mut out, title, &[], w, h)?;
     // Black lines and a frame, like the printed page.
-    s = s.replace(
-        "<g id=\"lines\" stroke=\"#ff0000\"",
-        "<g id=\"lines\" stroke=\"#000000\"",
-    );
-    let frame = format!(
-        "<rect id=\"frame\" x=\"0\" y=\"0\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"black\" stroke-width=\"1\"/>\n</svg>\n",
-        width.max(1),
-        height.max(1)
-    );
-    s.replace("</svg>\n", &frame)
+    lines_layer(
+        &mut out,
+        "lines",
+        lines,
+        "#000000",
+        1.0,
+        &DrawBox::around(w, h),
+    )?;
+    writeln!(
+        out,
+        "<rect id=\"frame\" x=\"0\" y=\"0\" width=\"{w}\" height=\"{h}\" fill=\"none\" stroke=\"black\" stroke-width=\"1\"/>\n</svg>"
+    )?;
+    Ok(out)
 }
 
 /// An SVG of a grey image alone.
 pub fn grey_svg(caption: &str, img: &GreyImage) -> String {
-    let r = ImageReport {
-        title: caption.to_string(),
-        width: img.width(),
-        height: img.height(),
-        greys: vec![(caption.to_string(), img.clone())],
-        ..Default::default()
-    };
-    image_svg(&r)
+    in_memory(|v| write_grey_svg(v, caption, img))
 }
 
-fn grey_layer(out: &mut String, id: &str, caption: &str, img: &GreyImage, hidden: bool) {
+/// Writes [`grey_svg`] to `out`.
+pub fn write_grey_svg<W: Write>(mut out: W, caption: &str, img: &GreyImage) -> io::Result<W> {
+    let (w, h) = (img.width().max(1), img.height().max(1));
+    head(&mut out, caption, &[], w, h)?;
+    grey_layer(&mut out, "grey", caption, img, false)?;
+    out.write_all(b"</svg>\n")?;
+    Ok(out)
+}
+
+fn grey_layer(
+    out: &mut impl Write,
+    id: &str,
+    caption: &str,
+    img: &GreyImage,
+    hidden: bool,
+) -> io::Result<()> {
     let Ok(png) = encode::png_grey(img) else {
-        return;
+        return Ok(());
     };
     let vis = if hidden { " visibility=\"hidden\"" } else { "" };
-    let _ = writeln!(
+    write!(
         out,
-        "<g id=\"{id}\"{vis}><title>{}</title><image x=\"0\" y=\"0\" width=\"{}\" height=\"{}\" style=\"image-rendering:pixelated\" xlink:href=\"data:image/png;base64,{}\"/></g>",
+        "<g id=\"{id}\"{vis}><title>{}</title><image x=\"0\" y=\"0\" width=\"{}\" height=\"{}\" style=\"image-rendering:pixelated\" xlink:href=\"data:image/png;base64,",
         xml(caption),
         img.width(),
         img.height(),
-        encode::base64(&png)
-    );
+    )?;
+    encode::write_base64(out, &png)?;
+    out.write_all(b"\"/></g>\n")
 }
 
-fn edge_layer(out: &mut String, id: &str, e: &EdgePoints, colour: &str, bx: &DrawBox) {
-    let _ = writeln!(
+fn edge_layer(
+    out: &mut impl Write,
+    id: &str,
+    e: &EdgePoints,
+    colour: &str,
+    bx: &DrawBox,
+) -> io::Result<()> {
+    writeln!(
         out,
         "<g id=\"{id}\" fill=\"{colour}\" transform=\"translate(0.5 0.5)\">"
-    );
+    )?;
     for p in &e.points {
         if bx.contains(Point::new(f64::from(p.x), f64::from(p.y))) {
-            let _ = writeln!(
+            writeln!(
                 out,
                 "<rect x=\"{:.2}\" y=\"{:.2}\" width=\"0.8\" height=\"0.8\"/>",
                 p.x - 0.4,
                 p.y - 0.4
-            );
+            )?;
         }
     }
-    out.push_str("</g>\n");
+    out.write_all(b"</g>\n")
 }
 
 fn lines_layer(
-    out: &mut String,
+    out: &mut impl Write,
     id: &str,
     lines: &[Segment],
     colour: &str,
     width: f64,
     bx: &DrawBox,
-) {
-    let _ = writeln!(
+) -> io::Result<()> {
+    writeln!(
         out,
         "<g id=\"{id}\" stroke=\"{colour}\" stroke-width=\"{width}\" stroke-linecap=\"round\" fill=\"none\" transform=\"translate(0.5 0.5)\">"
-    );
+    )?;
     for s in lines.iter().filter_map(|s| bx.clip(s)) {
         let dash = if s.shadow {
             " stroke-dasharray=\"2 2\""
         } else {
             ""
         };
-        let _ = writeln!(
+        writeln!(
             out,
             "<line x1=\"{:.3}\" y1=\"{:.3}\" x2=\"{:.3}\" y2=\"{:.3}\"{dash}/>",
             s.a.x, s.a.y, s.b.x, s.b.y
-        );
+        )?;
     }
-    out.push_str("</g>\n");
+    out.write_all(b"</g>\n")
 }
 
 #[cfg(test)]

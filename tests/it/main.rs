@@ -33,6 +33,7 @@ mod llv_shadow;
 mod photometric;
 mod profile;
 mod report_cli;
+mod report_memory;
 mod report_ps;
 mod report_svg;
 mod rig_cdf;

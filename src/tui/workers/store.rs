@@ -557,19 +557,11 @@ impl Store {
         let targets = report::survey::Targets::in_session(s);
         let ps = targets.ps.clone().unwrap_or_default();
         report::survey::write(s, None, &targets).map_err(|e| {
-            let old = match std::fs::metadata(&ps).and_then(|m| m.modified()) {
-                Ok(t) => {
-                    let secs = t
-                        .duration_since(std::time::UNIX_EPOCH)
-                        .map_or(0, |d| d.as_secs());
-                    format!(
-                        "; {} on disk is the OLD report, written {}",
-                        ps.display(),
-                        crate::session::stamp::rfc3339(secs)
-                    )
-                }
-                Err(_) => format!("; there is no {} yet", ps.display()),
-            };
+            // The file that failed, else the PostScript report.
+            let old = format!(
+                "; {}",
+                e.on_disk().unwrap_or_else(|| report::survey::on_disk(&ps))
+            );
             StoreError::Report {
                 why: e.to_string(),
                 old,
