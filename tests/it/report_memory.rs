@@ -228,3 +228,47 @@ fn a_report_that_fails_half_way_leaves_the_old_one_and_says_so() {
         .collect();
     assert!(left.is_empty(), "temporary files left: {left:?}");
 }
+
+/// The peak resident memory (VmHWM) of process `pid`, KiB.
+fn vm_hwm_kib(pid: u32) -> u64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).expect("status");
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .expect("VmHWM")
+}
+
+/// Issue 33: the console's report (`5 e`) costs next to nothing above what
+/// the survey itself needed. Two images of three lightings at 1024²: the
+/// report raised the console's peak by about 50 MiB (every picture held
+/// twice, the PostScript text twice); now by at most 8 MiB. Memory, not
+/// time: the peak is the same from run to run within a few MiB.
+#[test]
+fn the_console_s_report_adds_little_to_its_peak_memory() {
+    use super::tui_harness::{Console, PROFILE};
+    let profile = PROFILE
+        .replace("width = 128", "width = 1024")
+        .replace("height = 128", "height = 1024");
+    let mut c = Console::start_with(&profile, 100, 32, &[], |_| {});
+    c.survey(2);
+    let pid = c.child.process_id().expect("pid");
+    let survey = vm_hwm_kib(pid);
+    c.send("5");
+    c.wait_text("files (", 10);
+    c.send("e");
+    c.wait_text("report written", 60);
+    let report = vm_hwm_kib(pid);
+    eprintln!("console peak: {survey} KiB after the survey, {report} KiB after its report");
+    c.send("q");
+    c.wait_exit(15);
+    assert!(
+        c.session().join("cube.ps").is_file() && c.session().join("cube2.svg").is_file(),
+        "the report is on disk"
+    );
+    assert!(
+        report <= survey + 8 * 1024,
+        "peak {survey} KiB after the survey, {report} KiB after its report"
+    );
+}
