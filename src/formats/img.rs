@@ -177,9 +177,21 @@ pub fn parse_img(bytes: &[u8], path: &Path) -> Result<ImgFile, FormatError> {
             "file ends inside the comment",
         ));
     };
+    assemble(&h, comment, pixels.to_vec(), path)
+}
+
+/// An `.img` from its checked header, its comment bytes and its pixels
+/// (which become the image's buffer, not copied).
+fn assemble(
+    h: &ImgHeader,
+    comment: &[u8],
+    pixels: Vec<u8>,
+    path: &Path,
+) -> Result<ImgFile, FormatError> {
+    let px = HEADER_LEN + usize::from(h.comment_len);
     let comment = comment.strip_suffix(&[0]).unwrap_or(comment);
     let comment: String = comment.iter().map(|&b| char::from(b)).collect();
-    let image = GreyImage::new(usize::from(h.width), usize::from(h.height), pixels.to_vec())
+    let image = GreyImage::new(usize::from(h.width), usize::from(h.height), pixels)
         .map_err(|e| FormatError::at_byte(path, px as u64, K::SizeMismatch, e.to_string()))?;
     Ok(ImgFile {
         image,
@@ -224,15 +236,35 @@ pub fn read_img_sized<E: std::fmt::Display>(
     accept: impl Fn(usize, usize) -> Result<(), E>,
 ) -> Result<ImgFile, FormatError> {
     use std::io::Read;
-    let (h, mut bytes, f) = open_checked(path)?;
+    let (h, mut bytes, mut f) = open_checked(path)?;
     accept(usize::from(h.width), usize::from(h.height))
         .map_err(|m| FormatError::at_byte(path, 4, K::Range, m.to_string()))?;
-    let rest = h.file_len().saturating_sub(HEADER_LEN as u64);
-    bytes.reserve_exact(usize::try_from(rest).unwrap_or(0));
-    f.take(rest)
+    // The comment after the header; the pixels into a buffer of their own
+    // that becomes the image, so they are in memory once, not twice.
+    let comment_len = u64::from(h.comment_len);
+    (&mut f)
+        .take(comment_len)
         .read_to_end(&mut bytes)
         .map_err(|e| FormatError::io(path, "read", &e))?;
-    parse_img(&bytes, path)
+    let Some(comment) = bytes.get(HEADER_LEN..HEADER_LEN + usize::from(h.comment_len)) else {
+        // The file shrank after its size was checked.
+        return Err(FormatError::at_byte(
+            path,
+            HEADER_LEN as u64,
+            K::Truncated,
+            "file ends inside the comment",
+        ));
+    };
+    let rest = h
+        .file_len()
+        .saturating_sub(HEADER_LEN as u64)
+        .saturating_sub(comment_len);
+    let mut pixels = Vec::new();
+    pixels.reserve_exact(usize::try_from(rest).unwrap_or(0));
+    f.take(rest)
+        .read_to_end(&mut pixels)
+        .map_err(|e| FormatError::io(path, "read", &e))?;
+    assemble(&h, comment, pixels, path)
 }
 
 /// Reads only the header of an `.img` (for `vss info`).

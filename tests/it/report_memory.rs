@@ -5,7 +5,7 @@
 //! (the PostScript text twice, and every image's pictures twice): a report
 //! of an 8192² `.img` needed 511 MiB of address space, a five-image survey
 //! of 512² pictures 75 MiB. They are now streamed page by page into the
-//! temporary file, one image's pictures at a time.
+//! temporary file, one image's pictures at a time (75 MiB and 12 MiB).
 //!
 //! Also: a write that fails half-way (here the file size limit, `ulimit -f`,
 //! with SIGXFSZ ignored so the write returns EFBIG) leaves the report that
@@ -80,10 +80,13 @@ fn declared_pages(ps: &Path) -> (Option<usize>, bool) {
 }
 
 /// Issue 34, N5: the report of an `.img` at the picture bound (8192², a
-/// 64 MiB file) within 4 × the file's size. It held the image and its
-/// PostScript text twice at once, 5 × the file (337 MB resident).
+/// 64 MiB file) within 4 × the file's size, the issue's bound. It held the
+/// file's bytes, the image and its PostScript text twice, 5 × the file
+/// (337 MB resident). Now it holds one copy of the pixels (the `.img`
+/// reader reads them into the image's own buffer) and a few buffers: the
+/// limit here is 1.5 × the file, which a second copy of the pixels exceeds.
 #[test]
-fn a_report_of_the_largest_picture_stays_within_4x_its_file() {
+fn a_report_of_the_largest_picture_holds_one_copy_of_its_pixels() {
     let tmp = tempfile::tempdir().expect("tmp");
     let root = tmp.path();
     let side = 8192usize;
@@ -94,7 +97,7 @@ fn a_report_of_the_largest_picture_stays_within_4x_its_file() {
     let len = std::fs::metadata(root.join("max1a.img"))
         .expect("len")
         .len();
-    let limit_kib = 4 * len / 1024;
+    let limit_kib = 3 * len / 2 / 1024;
     let o = vss_with(
         root,
         &format!("ulimit -v {limit_kib}"),
