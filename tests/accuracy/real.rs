@@ -61,9 +61,9 @@ fn york_urban_tune_f_recall_precision() {
 
 /// The floors: within 0.01 of what the engine measures (`cargo test
 /// --test accuracy real:: -- --nocapture` prints it).
-const F: f64 = 0.726;
+const F: f64 = 0.727;
 const RECALL: f64 = 0.722;
-const PRECISION: f64 = 0.730;
+const PRECISION: f64 = 0.733;
 
 /// Recall by the true lines' contrast (the breakdown): floors
 /// within 0.01 of what the engine measures, printed by `cargo test --test
@@ -80,6 +80,36 @@ fn york_urban_tune_recall_by_contrast() {
 }
 
 const BY_CONTRAST: [f64; 4] = [0.540, 0.638, 0.753, 0.836];
+
+/// False lines on flat structure: the detected length matching no true
+/// line whose edge slope is below `FLAT_SLOPE` (px per photograph). A
+/// ceiling within 10 % of what the engine measures, printed by `cargo test
+/// --test accuracy real:: -- --nocapture`. The goal (fewer than
+/// LSD's, about 11 px) is not met; the peers' figures come from
+/// `benches/opencv_lines.py real` (docs/accuracy.md).
+#[test]
+fn york_urban_tune_false_length_on_flat_structure() {
+    use vss::llv::synth::real::SLOPE_BOUNDS;
+    let (_, _, c) = scores();
+    let u = c.unmatched_per_photo();
+    eprintln!(
+        "unmatched length per photograph by edge slope (< {}, {}-{}, {}-{}, >= {} grey/px): {u:?}",
+        SLOPE_BOUNDS[0],
+        SLOPE_BOUNDS[0],
+        SLOPE_BOUNDS[1],
+        SLOPE_BOUNDS[1],
+        SLOPE_BOUNDS[2],
+        SLOPE_BOUNDS[2]
+    );
+    assert_eq!(c.photos, 51);
+    let flat = u[0] + u[1];
+    assert!(
+        flat <= FLAT_CEILING,
+        "{flat:.1} px a photograph on flat structure"
+    );
+}
+
+const FLAT_CEILING: f64 = 50.0;
 
 /// Several lightings on real photographs: each tune photograph lit three
 /// ways (dimmed to 70 %; a shadow darkening its left half to 35 % through
@@ -154,7 +184,7 @@ fn three_lightings_of_each_photograph_against_the_best_one() {
     );
     assert!(b.f >= 0.732, "best single F {:.4}", b.f);
     assert!(
-        c.f >= 0.707,
+        c.f >= 0.716,
         "combined F {:.4} (best single {:.4})",
         c.f,
         b.f

@@ -188,7 +188,7 @@ fn covered_each(samples: &[Segment], against: &[Segment]) -> Vec<(f64, f64)> {
 }
 
 /// Upper bounds (grey levels) of the contrast classes of
-/// [`ContrastRecall`]: below 10, 10–20, 20–40, 40 and more.
+/// [`ByContrast`]: below 10, 10–20, 20–40, 40 and more.
 pub const CONTRAST_BOUNDS: [f64; 3] = [10.0, 20.0, 40.0];
 
 /// How far to either side of a true line its contrast is read (px).
@@ -223,34 +223,113 @@ pub fn contrast(img: &GreyImage, s: &Segment) -> Option<f64> {
     Some(*d.select_nth_unstable_by(mid, f64::total_cmp).1)
 }
 
+/// Upper bounds (grey levels a pixel) of the edge-slope classes of
+/// [`ByContrast::unmatched`]: below 2, 2–3, 3–5, 5 and more.
+pub const SLOPE_BOUNDS: [f64; 3] = [2.0, FLAT_SLOPE, 5.0];
+
+/// Below this edge slope (grey levels a pixel) a segment lies on flat
+/// structure.
+pub const FLAT_SLOPE: f64 = 3.0;
+
+/// A segment's edge slope in `img`: the image's profile across it (nearest
+/// pixels 1 px apart, 3 px to either side, one profile a pixel along it)
+/// averaged along it, and its steepest 1-px step within 2 px of the line.
+/// Averaging along the segment cancels noise and texture, which a line
+/// through them does not follow. `None` when no profile lies inside.
+pub fn edge_slope(img: &GreyImage, s: &Segment) -> Option<f64> {
+    const R: usize = 3;
+    let s = usable(s)?;
+    let (nx, ny) = (-(s.b.y - s.a.y) / s.len, (s.b.x - s.a.x) / s.len);
+    let mut sum = [0.0; 2 * R + 1];
+    let mut count = 0usize;
+    let n = s.len.ceil().max(1.0);
+    let mut p = [0.0; 2 * R + 1];
+    'sample: for k in 0..n as usize {
+        let t = (k as f64 + 0.5) / n;
+        let (x, y) = (s.a.x + (s.b.x - s.a.x) * t, s.a.y + (s.b.y - s.a.y) * t);
+        for (j, v) in p.iter_mut().enumerate() {
+            let o = j as f64 - R as f64;
+            let (u, w) = ((x + o * nx).round(), (y + o * ny).round());
+            match (u >= 0.0 && w >= 0.0)
+                .then(|| img.get(u as usize, w as usize))
+                .flatten()
+            {
+                Some(g) => *v = f64::from(g),
+                None => continue 'sample,
+            }
+        }
+        for (a, v) in sum.iter_mut().zip(&p) {
+            *a += v;
+        }
+        count += 1;
+    }
+    (count > 0).then(|| {
+        (1..2 * R - 1)
+            .map(|j| (sum[j + 1] - sum[j]).abs())
+            .fold(0.0, f64::max)
+            / count as f64
+    })
+}
+
 /// The class of a contrast: the index of the first bound above it.
 fn contrast_class(c: f64) -> usize {
     CONTRAST_BOUNDS.iter().take_while(|&&b| c >= b).count()
 }
 
-/// Recall by the true lines' contrast (lengths pooled over photographs).
+/// Recall by the true lines' contrast, and the detected length that
+/// matches no true line by the detected segment's edge slope (lengths
+/// pooled over photographs). The second measures false lines on flat
+/// structure: where the image's mean profile across a segment is nowhere
+/// steeper than [`FLAT_SLOPE`] grey levels a pixel, the segment lies on a
+/// faint cloud, faint print or shading, not on an outline a person would
+/// draw. (Contrast alone cannot say so: a thin wire against the sky has
+/// the same grey level on both sides. York Urban's labels leave out many
+/// steep edges too, which is why only the flat class is read as false.)
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct ContrastRecall {
+pub struct ByContrast {
     /// True length per class, and the part of it found.
     pub truth: [f64; 4],
     pub found: [f64; 4],
+    /// Detected length matching no true line, per class of the detected
+    /// segment's edge slope ([`SLOPE_BOUNDS`]).
+    pub unmatched: [f64; 4],
+    /// Photographs added.
+    pub photos: usize,
 }
 
-impl ContrastRecall {
+impl ByContrast {
     /// Adds one photograph: its true lines with their classes (`None`: no
     /// contrast could be read) and a detector's segments.
-    pub fn add(&mut self, truth: &[Segment], classes: &[Option<usize>], detected: &[Segment]) {
+    pub fn add(
+        &mut self,
+        img: &GreyImage,
+        truth: &[Segment],
+        classes: &[Option<usize>],
+        detected: &[Segment],
+    ) {
         for ((f, t), c) in covered_each(truth, detected).into_iter().zip(classes) {
             if let Some(c) = *c {
                 self.found[c] += f;
                 self.truth[c] += t;
             }
         }
+        for ((m, t), s) in covered_each(detected, truth).into_iter().zip(detected) {
+            if let Some(c) = edge_slope(img, s) {
+                self.unmatched[SLOPE_BOUNDS.iter().take_while(|&&b| c >= b).count()] += t - m;
+            }
+        }
+        self.photos += 1;
     }
 
     /// Recall per class (`None` for a class without true lines).
     pub fn recall(&self) -> [Option<f64>; 4] {
         std::array::from_fn(|i| (self.truth[i] > 0.0).then(|| self.found[i] / self.truth[i]))
+    }
+
+    /// Unmatched detected length per photograph (px), per class.
+    pub fn unmatched_per_photo(&self) -> [f64; 4] {
+        let n = self.photos.max(1) as f64;
+        self.unmatched.map(|u| u / n)
     }
 }
 
@@ -388,13 +467,13 @@ pub fn read_photo(path: &Path) -> Result<GreyImage, FormatError> {
 
 /// What [`evaluate_real`] measures: the pooled metrics, each
 /// photograph's own (by name), and recall by contrast.
-pub type RealEvaluation = (RealMetrics, Vec<(String, RealMetrics)>, ContrastRecall);
+pub type RealEvaluation = (RealMetrics, Vec<(String, RealMetrics)>, ByContrast);
 
 /// Runs vss on every photograph of `dir` and scores it.
 pub fn evaluate_real(dir: &Path, params: &Params) -> Result<RealEvaluation, CompareError> {
     let mut ws = Workspace::new();
     let mut tally = RealTally::default();
-    let mut by_contrast = ContrastRecall::default();
+    let mut by_contrast = ByContrast::default();
     let mut each = Vec::new();
     for p in photographs(dir)? {
         let img = read_photo(&p.image)?;
@@ -411,7 +490,7 @@ pub fn evaluate_real(dir: &Path, params: &Params) -> Result<RealEvaluation, Comp
             .iter()
             .map(|s| contrast(&img, s).map(contrast_class))
             .collect();
-        by_contrast.add(&truth, &classes, &lines);
+        by_contrast.add(&img, &truth, &classes, &lines);
         each.push((p.name, one.metrics()));
     }
     Ok((tally.metrics(), each, by_contrast))
@@ -465,8 +544,8 @@ pub struct RealScore {
     /// (ms), when the detector wrote its times.
     pub fastest_ms: Option<f64>,
     pub median_ms: Option<f64>,
-    /// Recall by the true lines' contrast in the photograph.
-    pub by_contrast: ContrastRecall,
+    /// Recall and unmatched length by contrast in the photograph.
+    pub by_contrast: ByContrast,
 }
 
 /// Scores every detector with segment files `NAME.DET.seg` in `segs` for
@@ -478,22 +557,25 @@ pub fn score_dir(photos: &Path, segs: &Path) -> Result<Vec<RealScore>, FormatErr
         .iter()
         .map(|p| read_truth(&p.truth))
         .collect::<Result<_, _>>()?;
-    // Each true line's contrast class, read from its photograph once.
-    let classes: Vec<Vec<Option<usize>>> = list
+    // The photographs, and each true line's contrast class, read once.
+    let imgs: Vec<GreyImage> = list
+        .iter()
+        .map(|p| read_photo(&p.image))
+        .collect::<Result<_, _>>()?;
+    let classes: Vec<Vec<Option<usize>>> = imgs
         .iter()
         .zip(&truths)
-        .map(|(p, t)| {
-            let img = read_photo(&p.image)?;
-            Ok(t.iter()
-                .map(|s| contrast(&img, s).map(contrast_class))
-                .collect())
+        .map(|(img, t)| {
+            t.iter()
+                .map(|s| contrast(img, s).map(contrast_class))
+                .collect()
         })
-        .collect::<Result<_, FormatError>>()?;
+        .collect();
     let mut out = Vec::new();
     for det in super::compare::detectors(segs)? {
         let mut tally = RealTally::default();
-        let mut by_contrast = ContrastRecall::default();
-        for ((p, t), c) in list.iter().zip(&truths).zip(&classes) {
+        let mut by_contrast = ByContrast::default();
+        for (((p, t), c), img) in list.iter().zip(&truths).zip(&classes).zip(&imgs) {
             let path = segs.join(format!("{}.{det}.seg", p.name));
             if !path.exists() {
                 return Err(FormatError::new(
@@ -508,7 +590,7 @@ pub fn score_dir(photos: &Path, segs: &Path) -> Result<Vec<RealScore>, FormatErr
             }
             let detected = read_segments(&path)?;
             tally.add(&detected, t);
-            by_contrast.add(t, c, &detected);
+            by_contrast.add(img, t, c, &detected);
         }
         let (fastest_ms, median_ms) = mean_times(segs, &det)?;
         out.push(RealScore {
@@ -578,6 +660,23 @@ pub fn table(scores: &[RealScore], images: usize) -> String {
             s,
             "{:<10} {:>9} {:>9} {:>9} {:>9}",
             d.detector, r[0], r[1], r[2], r[3]
+        );
+    }
+    let _ = writeln!(
+        s,
+        "detected length matching no true line, by the segment's edge slope (px per photograph; grey levels a pixel; < 3: false lines on flat structure)"
+    );
+    let _ = writeln!(
+        s,
+        "{:<10} {:>9} {:>9} {:>9} {:>9}",
+        "slope", "< 2", "2-3", "3-5", ">= 5"
+    );
+    for d in scores {
+        let u = d.by_contrast.unmatched_per_photo();
+        let _ = writeln!(
+            s,
+            "{:<10} {:>9.0} {:>9.0} {:>9.0} {:>9.0}",
+            d.detector, u[0], u[1], u[2], u[3]
         );
     }
     s
