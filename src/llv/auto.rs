@@ -14,8 +14,7 @@
 //! `min_line_length` decides the shortest lines kept) → `connect.min_line_length`
 //! (CONNECT only). Each axis holds the base value and a ladder around it:
 //! with the default base, 45 edge runs, 540 line runs and 5940 CONNECT runs
-//! (CONNECT runs are cheap). With several lightings `edges.noise_factor`
-//! is a third edge-stage axis (three times the runs).
+//! (CONNECT runs are cheap).
 //!
 //! **"clean", measurably.** The edges an operator must not lose are the
 //! *trusted* lines of the base result: those at least [`TRUSTED_FACTOR`] ×
@@ -147,26 +146,16 @@ pub fn search(input: &Input, base: &Params, target: &Target) -> Result<AutoResul
 
     // One workspace, nested by stage: each re-run starts from the stage its
     // parameter belongs to and reuses the enclosing loops' earlier stages.
-    // The noise factor only matters when several lightings are combined.
-    let photometric = input.images.len() > 1 || input.ambient.is_some();
-    let noise_factors = if photometric {
-        ladder(base.edges.noise_factor, NOISE_FACTOR)
-    } else {
-        vec![base.edges.noise_factor]
-    };
-    let edge_grid = noise_factors.into_iter().flat_map(|nf| {
-        ladder(base.edges.per_region as f64, PER_REGION)
-            .into_iter()
-            .flat_map(move |pr| {
-                ladder(base.edges.noise_sigmas, NOISE_SIGMAS)
-                    .into_iter()
-                    .map(move |ns| (nf, pr, ns))
-            })
-    });
-    for (noise_factor, per_region, noise_sigmas) in edge_grid {
+    let edge_grid = ladder(base.edges.per_region as f64, PER_REGION)
+        .into_iter()
+        .flat_map(|pr| {
+            ladder(base.edges.noise_sigmas, NOISE_SIGMAS)
+                .into_iter()
+                .map(move |ns| (pr, ns))
+        });
+    for (per_region, noise_sigmas) in edge_grid {
         {
             let mut p = base.clone();
-            p.edges.noise_factor = noise_factor;
             p.edges.per_region = per_region as u32;
             p.edges.noise_sigmas = noise_sigmas;
             ws.rerun(Stage::Edges, input, &p)?;
@@ -212,7 +201,6 @@ pub fn search(input: &Input, base: &Params, target: &Target) -> Result<AutoResul
 /// The grid's ladders (module doc); the base value is always tried too.
 const PER_REGION: &[f64] = &[3.0, 4.0, 6.0, 8.0, 12.0, 16.0, 24.0, 32.0];
 const NOISE_SIGMAS: &[f64] = &[2.0, 2.5, 3.5, 5.0, 7.0];
-const NOISE_FACTOR: &[f64] = &[2.0, 3.0, 5.0];
 const MIN_ALIGNED: &[f64] = &[0.0];
 const LOG_NFA: &[f64] = &[-10.0, -5.0, 0.0, 5.0, 10.0, 15.0];
 const MIN_LINE_LENGTH: &[f64] = &[

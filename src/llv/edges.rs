@@ -84,25 +84,6 @@ pub struct Response {
     pub dir: ScanDir,
     scale: f32,
     sums: Vec<i16>,
-    /// Its noise, where whoever made it knows it better than its values'
-    /// statistics can tell ([`KnownNoise`]); `None` for one image's
-    /// response, whose noise map is estimated from it.
-    known_noise: Option<KnownNoise>,
-}
-
-/// The noise of a response as its maker knows it: several lightings
-/// combined (`photometric.rs`) take each image's noise level off, so the
-/// combined response is 0 almost everywhere on noise and the median of
-/// its values says nothing. [`NoiseMap::estimate_into`] takes this instead.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct KnownNoise {
-    /// The noise scale `σ_r` of the response the combination was made of
-    /// (grey levels).
-    pub sigma: f32,
-    /// Noise sigmas already taken off every value: a value `c` is as
-    /// unlikely on noise as one image's response of `offset + c / σ_r`
-    /// sigmas.
-    pub offset: f32,
 }
 
 impl Default for Response {
@@ -114,7 +95,6 @@ impl Default for Response {
             dir: ScanDir::Horizontal,
             scale: 0.0,
             sums: Vec::new(),
-            known_noise: None,
         }
     }
 }
@@ -128,7 +108,6 @@ impl Response {
         self.height = h;
         self.dir = dir;
         self.scale = scale;
-        self.known_noise = None;
         if self.sums.len() != w * h {
             self.sums.clear();
             self.sums.resize(w * h, NONE);
@@ -148,15 +127,6 @@ impl Response {
 
     pub(crate) fn sums_mut(&mut self) -> &mut [i16] {
         &mut self.sums
-    }
-
-    /// Its noise as its maker knows it (several lightings), if it does.
-    pub fn known_noise(&self) -> Option<KnownNoise> {
-        self.known_noise
-    }
-
-    pub(crate) fn set_known_noise(&mut self, k: Option<KnownNoise>) {
-        self.known_noise = k;
     }
 
     /// Whether the response has a value (or "none") for every pixel of a

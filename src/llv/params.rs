@@ -249,11 +249,13 @@ params! {
         threads: u32 = 1,
             "threads", 1.0..=2.0, step 1.0,
             "threads for the two scan directions; the results are the same";
-        /// Photometric combination (llv.md §2.6): an image's noise level `τ` is
-        /// this multiple of its median absolute kernel response.
+        /// Retired: the photometric combination (llv.md §2.6) once took
+        /// this multiple of each image's median |response| off its term;
+        /// it now takes nothing off (`photometric.rs`). Kept so that older
+        /// profiles, sessions and `.par` files read; it has no effect.
         noise_factor: f64 = 5.0,
             "× median", 0.5..=20.0, step 0.25,
-            "several lightings: noise level tau as a multiple of the median |response|";
+            "retired (no effect): several lightings take no noise level off";
     }
 
     /// The line extractor (llv.md §3).

@@ -213,9 +213,8 @@ impl Workspace {
             }
         };
         if from <= Stage::Lines {
-            let same_response = from >= Stage::Edges
-                && prev_params.edges.half_width == p.edges.half_width
-                && prev_params.edges.noise_factor == p.edges.noise_factor;
+            let same_response =
+                from >= Stage::Edges && prev_params.edges.half_width == p.edges.half_width;
             let job = Job {
                 from,
                 response: !same_response,

@@ -118,9 +118,10 @@ const FLAT_CEILING: f64 = 50.0;
 /// scorer. Printed by `cargo test --test accuracy real:: -- --nocapture`.
 ///
 /// The goal (the combination at least as good as the best single
-/// image) is not met here: the combination subtracts τ per image, which on
-/// textured photographs takes away recall (docs/accuracy.md).
-/// The floor keeps what it measures from getting worse.
+/// image) is nearly met here: within 0.005 F of the best of the three
+/// chosen afterwards for each photograph, whose noise is the same noise in
+/// all three (docs/accuracy.md). The floor keeps what it measures from
+/// getting worse.
 #[test]
 fn three_lightings_of_each_photograph_against_the_best_one() {
     use vss::llv::GreyImage;
@@ -184,7 +185,7 @@ fn three_lightings_of_each_photograph_against_the_best_one() {
     );
     assert!(b.f >= 0.732, "best single F {:.4}", b.f);
     assert!(
-        c.f >= 0.716,
+        c.f >= 0.726,
         "combined F {:.4} (best single {:.4})",
         c.f,
         b.f

@@ -57,7 +57,7 @@ fn auto_prints_its_changes_and_uses_them() {
     };
     let plain = String::from_utf8(run(&[])).unwrap();
     let base = read_lines(&d.join("out/cube1.ldr")).unwrap().len();
-    let want = base * 2;
+    let want = base / 2;
     let text = String::from_utf8(run(&["--auto", &format!("lines={want}")])).unwrap();
     eprintln!("{plain}\n{text}");
     let head = format!("cube1: auto lines={want}: ");

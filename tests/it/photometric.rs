@@ -26,13 +26,6 @@ const NOISE_HIGH: f64 = 12.0;
 /// True edges: visible geometry whose contrast reaches this under at least
 /// one of the four lights (grey levels).
 const MIN_CONTRAST: f64 = 10.0;
-/// `edges.noise_factor` proposed as the default (params.rs has 3): τ = 5 ×
-/// the median |response| ≈ 3.4 σ of the response noise. At 3 (≈ 2 σ) each of
-/// the four images lets 2–3 % of its noise pixels through, their sum keeps
-/// enough peaks above the floor for the adaptive threshold to fill every row
-/// with noise, and noise points fall by only ~20 % (measured: 50 k vs 62 k);
-/// at 4 they fall to 15 %, at 5 to 1 %, with recall unchanged.
-const PROPOSED_NOISE_FACTOR: f64 = 5.0;
 /// An edge point farther than this from every visible polygon edge supports
 /// no true edge (px).
 const NOISE_DIST: f64 = 2.0;
@@ -189,8 +182,7 @@ struct Figures {
 fn figures() -> &'static Figures {
     static FIGURES: std::sync::OnceLock<Figures> = std::sync::OnceLock::new();
     FIGURES.get_or_init(|| {
-        let mut p = Params::default();
-        p.edges.noise_factor = PROPOSED_NOISE_FACTOR;
+        let p = Params::default();
         let scenes = synth::test_scenes(SCENES, SIZE, SIZE, 0x1556);
         let (mut best, mut combined, mut no_ambient) =
             (Totals::default(), Totals::default(), Totals::default());
@@ -258,8 +250,7 @@ fn four_lightings_have_half_the_noise_and_no_worse_endpoints() {
 #[test]
 fn several_lightings_obey_the_noise_sigmas_and_the_nfa_test() {
     let scenes = synth::test_scenes(8, SIZE, SIZE, 0x1556);
-    let mut base = Params::default();
-    base.edges.noise_factor = PROPOSED_NOISE_FACTOR;
+    let base = Params::default();
     let mut more_sigmas = base.clone();
     more_sigmas.edges.noise_sigmas = 6.0;
     let (mut loose, mut strict) = (base.clone(), base.clone());

@@ -166,10 +166,10 @@ fn pictures_say_what_they_show_and_follow_the_cursor() {
     for _ in 0..2 {
         c.press(PIPELINE, Action::Nav(NavAction::ZoomIn));
     }
-    let before = c.wait_text("×4 x ", 5);
+    let before = c.wait_text("×4 x", 5);
     let view = |s: &str| {
         s.lines()
-            .find_map(|l| l.find("×4 x ").map(|i| l[i..].to_string()))
+            .find_map(|l| l.find("×4 x").map(|i| l[i..].to_string()))
             .unwrap_or_default()
     };
     let v0 = view(&before);

@@ -57,9 +57,6 @@ pub struct NoiseMap {
     sigma: Vec<f32>,
     /// The median of the tiles' estimates (0 if none had samples).
     global: f32,
-    /// Noise sigmas the response's values have had taken off already
-    /// ([`KnownNoise`](super::KnownNoise)); 0 for one image's response.
-    offset: f32,
 }
 
 /// Reusable buffers of the estimate.
@@ -151,28 +148,11 @@ impl NoiseMap {
         m
     }
 
-    /// Noise sigmas the response's values have had taken off already: a
-    /// value of `c` grey levels stands `offset + c / σ` sigmas above the
-    /// noise (several lightings combined; 0 for one image).
-    #[inline]
-    pub fn offset(&self) -> f32 {
-        self.offset
-    }
-
-    /// [`NoiseMap::estimate`] into reusable buffers. A response whose
-    /// maker knows its noise ([`Response::known_noise`]) gets a uniform
-    /// map of it instead.
+    /// [`NoiseMap::estimate`] into reusable buffers.
     pub fn estimate_into(&mut self, r: &Response, s: &mut NoiseScratch) {
         let (w, h) = (r.width, r.height);
         self.shape(w, h);
         self.global = 0.0;
-        self.offset = 0.0;
-        if let Some(k) = r.known_noise() {
-            self.sigma.fill(k.sigma);
-            self.global = k.sigma;
-            self.offset = k.offset;
-            return;
-        }
         if w == 0 || h == 0 || !r.covers(w, h) {
             return;
         }
@@ -240,7 +220,7 @@ impl NoiseMap {
     /// noise, and a textured one (gravel) not one far above it.
     /// `pct` ≤ 0 leaves the map as it is.
     pub fn bound(&mut self, pct: f64, cap: f64, s: &mut NoiseScratch) {
-        if pct.is_nan() || pct <= 0.0 || self.sigma.is_empty() || self.offset != 0.0 {
+        if pct.is_nan() || pct <= 0.0 || self.sigma.is_empty() {
             return;
         }
         let v = &mut s.known;

@@ -228,11 +228,10 @@ impl PeakMap {
 }
 
 /// Per tile of `noise`, the largest key at or below `floor` grey levels and
-/// `sigmas` noise sigmas (a key passes when it is above this; of a response
-/// whose values have had `noise.offset()` sigmas taken off, only the rest).
+/// `sigmas` noise sigmas (a key passes when it is above this).
 fn tile_floors(r: &Response, noise: &NoiseMap, floor: f64, sigmas: f64, out: &mut Vec<i32>) {
     let (nx, ny) = noise.tiles();
-    let rest = (sigmas as f32 - noise.offset()).max(0.0);
+    let rest = sigmas as f32;
     out.clear();
     for t in 0..nx * ny {
         let limit = (floor as f32).max(rest * noise.sigma(t));

@@ -56,9 +56,6 @@ pub struct ResponsePeaks<'a> {
     nlines: usize,
     /// Per tile, `scale / σ`.
     inv_sigma: Vec<f32>,
-    /// Noise sigmas the response's values have had taken off
-    /// ([`NoiseMap::offset`]).
-    offset: f32,
     /// The tile of scan position `(u, v)` is `tile_u[u] + tile_v[v]`.
     tile_u: Vec<u32>,
     tile_v: Vec<u32>,
@@ -115,7 +112,6 @@ impl<'a> ResponsePeaks<'a> {
             len_u,
             nlines: if sums.is_empty() { 0 } else { nlines },
             inv_sigma: std::mem::take(&mut b.inv_sigma),
-            offset: noise.offset(),
             tile_u: std::mem::take(&mut b.tile_u),
             tile_v: std::mem::take(&mut b.tile_v),
             map: std::mem::take(&mut b.map),
@@ -149,7 +145,7 @@ impl<'a> ResponsePeaks<'a> {
             u: f64::from(u as f32 + d),
             v,
             response: f32::from(self.sums[i]) * self.scale,
-            z: k0 * self.inv_sigma[(self.tile_u[u] + self.tile_v[v]) as usize] + self.offset,
+            z: k0 * self.inv_sigma[(self.tile_u[u] + self.tile_v[v]) as usize],
             id: i,
             pix: u as u32,
         }

@@ -315,7 +315,8 @@ impl ByContrast {
         }
         for ((m, t), s) in covered_each(detected, truth).into_iter().zip(detected) {
             if let Some(c) = edge_slope(img, s) {
-                self.unmatched[SLOPE_BOUNDS.iter().take_while(|&&b| c >= b).count()] += (t - m).max(0.0);
+                self.unmatched[SLOPE_BOUNDS.iter().take_while(|&&b| c >= b).count()] +=
+                    (t - m).max(0.0);
             }
         }
         self.photos += 1;
