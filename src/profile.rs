@@ -53,6 +53,9 @@ pub const BUILTIN_TOML: &str = include_str!("../profiles/default.toml");
 /// paths point (the folder vss runs in).
 pub const BUILTIN_NAME: &str = "default (built in)";
 
+/// What [`Profile::in_use`] says of the built-in profile.
+pub const BUILTIN_IN_USE: &str = "built-in";
+
 /// The simulated cameras' descriptions the built-in profile names in
 /// `survey.cdf`, compiled in: (path as the profile gives it, text).
 pub const BUILTIN_CDF: [(&str, &str); 4] = [
@@ -410,6 +413,21 @@ impl Profile {
     pub fn cdf_path(&self, cam: u32) -> Option<PathBuf> {
         let i = usize::try_from(cam).ok()?.checked_sub(1)?;
         self.survey.cdf.get(i).map(|p| self.resolve_path(p))
+    }
+
+    /// Which profile file is in use, for people and for `--json`: the
+    /// file's absolute path, or `built-in` for the compiled-in default.
+    /// The one owner of that answer: the console (its first message, the
+    /// Survey screen's step box, the help window) and every `--json`
+    /// output that depends on the profile call it.
+    pub fn in_use(&self) -> String {
+        match &self.source {
+            Some(p) if !self.builtin => std::path::absolute(p)
+                .unwrap_or_else(|_| p.clone())
+                .display()
+                .to_string(),
+            _ => BUILTIN_IN_USE.to_string(),
+        }
     }
 
     /// The lighting configuration of a letter.

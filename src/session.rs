@@ -394,7 +394,18 @@ impl Session {
     }
     /// Who holds the lock of this session right now, if anyone.
     pub fn lock_holder(&self) -> Option<LockInfo> {
-        lock::read_holder(&self.dir.join(format!("{}.lock", self.name)))
+        lock::read_holder(&self.lock_path())
+    }
+
+    /// The session's lock file, `NAME.lock`.
+    pub fn lock_path(&self) -> PathBuf {
+        self.dir.join(format!("{}.lock", self.name))
+    }
+
+    /// A checked request to release this session's lock, if one came
+    /// ([`Lock::leave_requested`]); `None` when not opened for writing.
+    pub fn leave_requested(&self) -> Option<Result<LockInfo, String>> {
+        self.lock.as_ref()?.leave_requested()
     }
     /// The lighting letters, in order.
     pub fn letters(&self) -> Vec<char> {

@@ -44,6 +44,27 @@ pub const BUILT_IN: [(&str, &str); 2] = [
     ),
 ];
 
+/// Whether [`Plate::load`] takes `name_or_path` for a file (anything with
+/// a `/` or ending in `.toml`) rather than a built-in plate's name.
+fn names_a_file(name_or_path: &str) -> bool {
+    name_or_path.ends_with(".toml") || Path::new(name_or_path).components().count() > 1
+}
+
+/// Which plate file `name_or_path` names, for people: a file's absolute
+/// path, or `NAME (built in)`. The one owner of that answer, with [`Plate::load`]'s
+/// rule; the Calibrate screen and `vss calibrate` show it.
+pub fn in_use(name_or_path: &str) -> String {
+    if names_a_file(name_or_path) {
+        let p = Path::new(name_or_path);
+        std::path::absolute(p)
+            .unwrap_or_else(|_| p.to_path_buf())
+            .display()
+            .to_string()
+    } else {
+        format!("{name_or_path} (built in)")
+    }
+}
+
 /// A plate that could not be read, or contradicts itself.
 #[derive(Debug, thiserror::Error)]
 pub enum PlateError {
@@ -179,7 +200,7 @@ impl Plate {
     /// `profiles/plates/` is never taken for a built-in plate.
     pub fn load(name_or_path: &str) -> Result<Plate, PlateError> {
         let p = Path::new(name_or_path);
-        if name_or_path.ends_with(".toml") || p.components().count() > 1 {
+        if names_a_file(name_or_path) {
             let text = crate::fsutil::read_input_text(p, MAX_PLATE_BYTES).map_err(|source| {
                 PlateError::Io {
                     path: p.to_path_buf(),

@@ -102,6 +102,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     let plate = Plate::load(&a.plate)?;
     if a.check_plate {
         outln!("{}: {}", plate.name, plate.describe());
+        outln!("plate file: {}", crate::calib::plate::in_use(&a.plate));
         outln!(
             "{} corners; origin corner {}",
             plate.corners().len(),
@@ -159,7 +160,12 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             calib::backup_name(&out).display()
         );
     }
-    outln!("plate {}: {}", plate.name, plate.describe());
+    outln!(
+        "plate {}: {} ({})",
+        plate.name,
+        plate.describe(),
+        crate::calib::plate::in_use(&a.plate)
+    );
     let t0 = Instant::now();
     let found = calib::detect_all(&images, &plate);
     let detect_ms = t0.elapsed().as_secs_f64() * 1e3;

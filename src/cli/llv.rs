@@ -145,7 +145,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         let [hpo, vpo] = files.as_slice() else {
             bail!("--from-edges needs two files: STEM.hpo STEM.vpo");
         };
-        let r = from_edges(hpo, vpo, &a, &p);
+        let r = from_edges(hpo, vpo, &profile, &a, &p);
         return finish(r.map(|()| 0));
     }
     let lacks = |shown: &dyn std::fmt::Display| {
@@ -182,11 +182,13 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         ),
         None => (FrameRule::of_profile(&profile), None),
     };
-    let mut runner = Runner::new();
+    // One-shot runs: one scan direction's buffers at a time.
+    let mut runner = Runner::lean();
     let mut failed = 0;
     for grp in group(&a.images) {
         if let Err(e) = run_group(
             &grp,
+            &profile,
             &a,
             &p,
             camera.as_ref(),
@@ -216,8 +218,10 @@ fn out_path(a: &Args, dir: &Path, name: &str) -> PathBuf {
     a.out.as_deref().unwrap_or(dir).join(name)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run_group(
     grp: &Group,
+    profile: &Profile,
     a: &Args,
     p: &Params,
     camera: Option<&(CameraModel, PathBuf)>,
@@ -245,12 +249,14 @@ fn run_group(
     }
     // Files without a lighting letter come one to a group: any key will do.
     let keys: Vec<char> = grp.letters.iter().map(|l| l.unwrap_or('a')).collect();
+    // The pixels move into the input (no second copy); each file's header
+    // stays for the `.imc` written from it.
+    let (images, headers): (Vec<_>, Vec<_>) = files
+        .into_iter()
+        .map(|f| (f.image, (f.comment, f.x0, f.y0)))
+        .unzip();
     let mut input = rule
-        .split(
-            keys.iter()
-                .copied()
-                .zip(files.iter().map(|f| f.image.clone())),
-        )
+        .split(keys.iter().copied().zip(images))
         .with_camera(camera.map(|c| c.0));
     if let Some((_, img)) = ambient {
         input.ambient = Some(('-', img.clone()));
@@ -288,15 +294,17 @@ fn run_group(
     if camera.is_some() {
         // The corrected images of the lit frames (the inputs themselves when
         // the map is the identity or correction is switched off).
-        for (k, (path, f)) in lit.iter().map(|&i| (&grp.files[i], &files[i])).enumerate() {
+        for (k, &i) in lit.iter().enumerate() {
+            let (path, (comment, x0, y0)) = (&grp.files[i], &headers[i]);
             let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
             let target = out_path(a, &grp.dir, &format!("{}.imc", stem.unwrap_or_default()));
-            let image = out.corrected.get(k).unwrap_or(&f.image).clone();
+            // The input's lit images are in the order of `lit`.
+            let image = out.corrected.get(k).or(input.images.get(k));
             let imc = ImgFile {
-                image,
-                comment: f.comment.clone(),
-                x0: f.x0,
-                y0: f.y0,
+                image: image.cloned().context("no image for the .imc")?,
+                comment: comment.clone(),
+                x0: *x0,
+                y0: *y0,
             };
             let bytes = crate::formats::img::encode_img(&imc)?;
             stage(&mut set, &target, &bytes)?;
@@ -311,6 +319,7 @@ fn run_group(
     }
     report(
         a,
+        &profile.in_use(),
         &grp.stem,
         &grp.files,
         ambient_file.as_deref(),
@@ -361,12 +370,18 @@ fn commit(set: crate::fsutil::StagedWrites) -> anyhow::Result<Vec<PathBuf>> {
     })
 }
 
-fn from_edges(hpo: &Path, vpo: &Path, a: &Args, p: &Params) -> anyhow::Result<()> {
+fn from_edges(
+    hpo: &Path,
+    vpo: &Path,
+    profile: &Profile,
+    a: &Args,
+    p: &Params,
+) -> anyhow::Result<()> {
     let saved = Saved::Edges {
         h: edgefile::read_edges(hpo)?,
         v: edgefile::read_edges(vpo)?,
     };
-    let mut runner = Runner::new();
+    let mut runner = Runner::lean();
     let out = runner.run_saved(saved, p, None)?;
     let stem = hpo
         .file_stem()
@@ -379,6 +394,7 @@ fn from_edges(hpo: &Path, vpo: &Path, a: &Args, p: &Params) -> anyhow::Result<()
     let size = (out.edges_h.width, out.edges_h.height);
     report(
         a,
+        &profile.in_use(),
         &stem,
         &[hpo.to_path_buf(), vpo.to_path_buf()],
         None,
@@ -422,6 +438,7 @@ fn auto_json(r: &AutoResult) -> serde_json::Value {
 #[allow(clippy::too_many_arguments)]
 fn report(
     a: &Args,
+    profile: &str,
     stem: &str,
     files: &[PathBuf],
     ambient: Option<&Path>,
@@ -440,6 +457,7 @@ fn report(
             .collect();
         let mut v = json!({
             "image": stem,
+            "profile": crate::formats::sanitize(profile),
             "files": files.iter().map(shown).collect::<Vec<_>>(),
             "width": size.0,
             "height": size.1,

@@ -124,7 +124,12 @@ fn configs(a: &Args) -> (Option<EvalConfig>, Option<YardConfig>) {
 
 /// The profile's parameters with the `--set` changes.
 fn params(g: &Global, a: &Args) -> anyhow::Result<crate::llv::Params> {
-    let mut p = g.load_profile()?.llv;
+    params_of(&g.load_profile()?, a)
+}
+
+/// `profile`'s parameters with the `--set` changes.
+fn params_of(profile: &crate::profile::Profile, a: &Args) -> anyhow::Result<crate::llv::Params> {
+    let mut p = profile.llv.clone();
     for s in &a.set {
         p.set_str(s).with_context(|| format!("--set {s}"))?;
     }
@@ -187,7 +192,8 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     if a.scenes == 0 {
         anyhow::bail!("--scenes must be at least 1");
     }
-    let llv = params(g, &a)?;
+    let profile = g.load_profile()?;
+    let llv = params_of(&profile, &a)?;
     let (cubes, yard) = configs(&a);
     let name = g.profile.as_deref().unwrap_or("default");
     if let Some(dir) = &a.export {
@@ -224,8 +230,11 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             Some(r) => serde_json::to_value(r)?,
             None => serde_json::json!({}),
         };
-        if let (Some(y), Some(obj)) = (&yard_report, v.as_object_mut()) {
-            obj.insert("yard".into(), serde_json::to_value(y)?);
+        if let Some(obj) = v.as_object_mut() {
+            if let Some(y) = &yard_report {
+                obj.insert("yard".into(), serde_json::to_value(y)?);
+            }
+            obj.insert("profile".into(), profile.in_use().into());
         }
         outln!("{}", serde_json::to_string(&v)?);
     } else {

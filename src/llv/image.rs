@@ -7,9 +7,9 @@ use super::LlvError;
 pub const MIN_SIZE: usize = 16;
 
 /// The most pixels the stages accept: 2²⁶, 8192 × 8192. The cell's cameras
-/// give 512 × 512; the stages' buffers take about 10 bytes a pixel for one
-/// image, more with a lens map or several lightings (`vss llv` on an 8192²
-/// image peaks at 0.7 GB, 1.3 GB with a `.cdf`). A small file that decodes
+/// give 512 × 512; the stages' buffers take several bytes a pixel for one
+/// image, more with a lens map or several lightings (docs/reliability.md,
+/// "Peak memory at the bounds", has `vss llv`'s). A small file that decodes
 /// to a huge image (a compressed PNG, a sparse `.img`) is refused up front
 /// rather than exhausting memory half-way.
 pub const MAX_PIXELS: usize = 1 << 26;

@@ -110,11 +110,23 @@ pub struct Workspace {
     align: super::lines::align::AlignScratch,
     /// Whether `out` holds the results of a complete run.
     valid: bool,
+    /// Free each direction's buffers after its lines ([`Workspace::lean`]).
+    lean: bool,
 }
 
 impl Workspace {
     pub fn new() -> Self {
         Workspace::default()
+    }
+
+    /// For runs whose responses nobody reads (`vss llv`): the directions
+    /// run in turn, each freeing its response and buffers after its lines,
+    /// so one direction's are held at a time. Same results; a rerun runs all.
+    pub fn lean() -> Self {
+        Workspace {
+            lean: true,
+            ..Workspace::default()
+        }
     }
 
     /// A workspace whose "previous run" is `prev` (for [`rerun`]).
@@ -219,7 +231,9 @@ impl Workspace {
                 from,
                 response: !same_response,
                 params: p,
+                lean: self.lean,
             };
+            let parallel = p.edges.threads >= 2 && !self.lean;
             let StageOutputs {
                 corrected,
                 response_h,
@@ -253,7 +267,7 @@ impl Workspace {
                 edges: edges_v,
                 s: &mut self.dir_v,
             };
-            let (th, tv) = if p.edges.threads >= 2 {
+            let (th, tv) = if parallel {
                 std::thread::scope(|sc| {
                     let other = sc.spawn(|| job.run(images, ambient, v));
                     let here = job.run(images, ambient, h);
@@ -266,13 +280,7 @@ impl Workspace {
                 (job.run(images, ambient, h)?, job.run(images, ambient, v)?)
             };
             // With two threads a stage takes as long as its slower direction.
-            let both = |a: u64, b: u64| {
-                if p.edges.threads >= 2 {
-                    a.max(b)
-                } else {
-                    a + b
-                }
-            };
+            let both = |a: u64, b: u64| if parallel { a.max(b) } else { a + b };
             if from <= Stage::Edges {
                 timings.edges_us = both(th.0, tv.0);
             }
@@ -442,6 +450,8 @@ struct Job<'p> {
     from: Stage,
     response: bool,
     params: &'p Params,
+    /// Free the response and buffers at the end (all but the lines).
+    lean: bool,
 }
 
 impl Job<'_> {
@@ -496,6 +506,11 @@ impl Job<'_> {
             &mut o.s.segs,
             &mut o.s.lines,
         );
+        if self.lean {
+            *o.response = Response::default();
+            let segs = std::mem::take(&mut o.s.segs);
+            (*o.s, o.s.segs) = (DirScratch::default(), segs);
+        }
         Ok((edges_us, micros(t)))
     }
 }

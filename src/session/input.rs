@@ -160,6 +160,16 @@ impl Runner {
         Runner::default()
     }
 
+    /// A runner for one-shot runs whose responses nobody reads (`vss llv`):
+    /// one scan direction's buffers in memory at a time
+    /// ([`Workspace::lean`]), the same results.
+    pub fn lean() -> Runner {
+        Runner {
+            ws: Workspace::lean(),
+            ..Runner::default()
+        }
+    }
+
     /// The lens map a run of `input` with `p` uses: none without a camera,
     /// with `lens.enabled = false` or for a camera that changes nothing.
     /// The size is checked first: a map is never made for an image the

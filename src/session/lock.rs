@@ -103,26 +103,40 @@ impl LockInfo {
 /// `PATH`. `Err` says why nothing was signalled.
 pub fn ask_holder_to_leave(holder: &LockInfo) -> Result<(), String> {
     let pid = holder.pid;
-    if holder.host != hostname() {
+    provably_vss(holder, "the lock's holder")?;
+    let pid_t = i32::try_from(pid)
+        .ok()
+        .and_then(rustix::process::Pid::from_raw)
+        .ok_or_else(|| format!("process {pid}: not a pid"))?;
+    rustix::process::kill_process(pid_t, rustix::process::Signal::TERM)
+        .map_err(|e| format!("cannot signal process {pid}: {e}"))
+}
+
+/// Whether `who` names a live vss of this user on this host, provably:
+/// its pid runs with the start time `who` records, as this user, from a
+/// vss executable. `Err` says which check failed; `role` names `who` in it.
+fn provably_vss(who: &LockInfo, role: &str) -> Result<(), String> {
+    let pid = who.pid;
+    if who.host != hostname() {
         return Err(format!(
-            "the holder runs on host {}, not this one",
-            crate::formats::sanitize(&holder.host)
+            "{role} runs on host {}, not this one",
+            crate::formats::sanitize(&who.host)
         ));
     }
     if pid <= 1 || pid == std::process::id() {
-        return Err(format!("process {pid} cannot be the holder"));
+        return Err(format!("process {pid} cannot be {role}"));
     }
     let Some(start) = proc_start(pid) else {
         return Err(format!("process {pid} no longer runs"));
     };
-    if holder.proc_start == 0 {
+    if who.proc_start == 0 {
         return Err(format!(
-            "the lock records no start time, so process {pid} cannot be told from another"
+            "{role} records no start time, so process {pid} cannot be told from another"
         ));
     }
-    if start != holder.proc_start {
+    if start != who.proc_start {
         return Err(format!(
-            "process {pid} started at another time than the lock's holder: it is another process"
+            "process {pid} started at another time than {role}: it is another process"
         ));
     }
     if proc_uid(pid) != proc_uid(std::process::id()) {
@@ -131,12 +145,41 @@ pub fn ask_holder_to_leave(holder: &LockInfo) -> Result<(), String> {
     if exe_is_vss(pid) != Some(true) {
         return Err(format!("process {pid} is not a vss"));
     }
-    let pid_t = i32::try_from(pid)
-        .ok()
-        .and_then(rustix::process::Pid::from_raw)
-        .ok_or_else(|| format!("process {pid}: not a pid"))?;
-    rustix::process::kill_process(pid_t, rustix::process::Signal::TERM)
-        .map_err(|e| format!("cannot signal process {pid}: {e}"))
+    Ok(())
+}
+
+/// A request to the holder of a lock to release it, in `NAME.lock.leave`
+/// beside the lock ([`request_leave`]): the holding console watches for it
+/// and leaves the session cleanly. It is only a request: the holder
+/// checks it ([`Lock::leave_requested`]) and acts on nothing it names
+/// without that.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LeaveRequest {
+    /// The token of the lock asked for: a request for another lock (an
+    /// earlier holder's) is void.
+    pub token: String,
+    /// Who asks: a vss on this host, shown to the holder once checked.
+    pub from: LockInfo,
+}
+
+/// The request file of the lock at `lock`: `NAME.lock.leave`.
+pub fn leave_path(lock: &Path) -> PathBuf {
+    let mut name = lock.file_name().unwrap_or_default().to_os_string();
+    name.push(".leave");
+    lock.with_file_name(name)
+}
+
+/// Asks the holder of the lock at `lock` (`holder`, as read from it) to
+/// release it: writes [`leave_path`] atomically (never through a link),
+/// naming the lock's token and this process. The taker then waits for the
+/// lock to go, and signals only if it does not ([`ask_holder_to_leave`]).
+pub fn request_leave(lock: &Path, holder: &LockInfo) -> io::Result<()> {
+    let req = LeaveRequest {
+        token: holder.token.clone(),
+        from: LockInfo::current(),
+    };
+    let text = toml::to_string(&req).map_err(io::Error::other)?;
+    crate::fsutil::write_atomic(&leave_path(lock), text.as_bytes())
 }
 
 /// The owner of `/proc/PID` (the process's effective user).
@@ -256,6 +299,39 @@ impl Lock {
     /// The lock file at `path()`.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// A request to release this lock ([`request_leave`]), checked: `None`
+    /// without one; `Some(Ok(asker))` when it names this lock's token and
+    /// its asker is provably a live vss of this user on this host (the
+    /// checks [`ask_holder_to_leave`] makes before a signal); `Some(Err)`
+    /// saying why a request file there is not one to act on (unreadable,
+    /// for another lock, from a process that is not a vss). Either way the
+    /// request file is then removed: it is read once.
+    pub fn leave_requested(&self) -> Option<Result<LockInfo, String>> {
+        let path = leave_path(&self.path);
+        if fs::symlink_metadata(&path).is_err() {
+            return None;
+        }
+        let read = crate::fsutil::read_input_text(&path, MAX_LOCK_LEN)
+            .map_err(|e| format!("{}: {e}", path.display()))
+            .and_then(|text| {
+                toml::from_str::<LeaveRequest>(&text)
+                    .map_err(|e| format!("{}: not a request: {}", path.display(), e.message()))
+            });
+        // Removed whatever it holds (a link is removed, not its target).
+        let _ = fs::remove_file(&path);
+        let req = match read {
+            Ok(r) => r,
+            Err(why) => return Some(Err(why)),
+        };
+        if req.token != self.info.token {
+            return Some(Err(format!(
+                "{}: the request is for another lock than this console's",
+                path.display()
+            )));
+        }
+        Some(provably_vss(&req.from, "the asker").map(|()| req.from))
     }
 
     /// Checks that the lock file still names this lock: after a take-over
@@ -466,6 +542,68 @@ mod tests {
         assert!(!holder.is_stale());
         assert_eq!(ask_holder_to_leave(&holder), Ok(()));
         assert_eq!(vss.wait().unwrap().signal(), Some(libc::SIGTERM));
+    }
+
+    /// Issue 34: a request to leave is acted on only when it names this
+    /// lock and comes from a live vss of this user (trust no file); read
+    /// once, whatever it holds.
+    #[test]
+    fn a_request_to_leave_is_checked_before_it_counts() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("s.lock");
+        let lock = Lock::acquire(&p, false).unwrap();
+        let req = leave_path(&p);
+        assert_eq!(req, dir.path().join("s.lock.leave"));
+        assert!(lock.leave_requested().is_none(), "no request");
+        let plant = |token: &str, from: &LockInfo| {
+            let r = LeaveRequest {
+                token: token.into(),
+                from: from.clone(),
+            };
+            fs::write(&req, toml::to_string(&r).unwrap()).unwrap();
+        };
+        let mut victim = sleeper(dir.path(), None);
+        let mut asker = sleeper(dir.path(), Some("vss"));
+        let as_proc = |c: &std::process::Child| LockInfo {
+            pid: c.id(),
+            proc_start: proc_start(c.id()).unwrap(),
+            ..LockInfo::current()
+        };
+        let token = lock.info().token.clone();
+        for (t, from, why) in [
+            ("0123", as_proc(&asker), "another lock"),
+            (token.as_str(), as_proc(&victim), "not a vss"),
+            (
+                token.as_str(),
+                LockInfo {
+                    proc_start: 1,
+                    ..as_proc(&asker)
+                },
+                "another process",
+            ),
+            (token.as_str(), LockInfo::current(), "cannot be"),
+        ] {
+            plant(t, &from);
+            let e = lock.leave_requested().expect("a request").unwrap_err();
+            assert!(e.contains(why), "{why}: {e}");
+            assert!(!req.exists(), "read once");
+        }
+        fs::write(&req, "garbage").unwrap();
+        assert!(lock.leave_requested().unwrap().is_err());
+        std::os::unix::fs::symlink("/dev/zero", &req).unwrap();
+        assert!(lock.leave_requested().unwrap().is_err());
+        assert!(!req.exists() && Path::new("/dev/zero").exists());
+        // Through request_leave, from a vss: it counts, and says who asked.
+        let from = as_proc(&asker);
+        plant(&token, &from);
+        assert_eq!(lock.leave_requested(), Some(Ok(from)));
+        request_leave(&p, lock.info()).unwrap();
+        let e = lock.leave_requested().unwrap().unwrap_err();
+        assert!(e.contains("cannot be"), "this process asks itself: {e}");
+        for c in [&mut victim, &mut asker] {
+            c.kill().unwrap();
+            c.wait().unwrap();
+        }
     }
 
     #[test]

@@ -147,8 +147,9 @@ impl App {
 
     /// The commands to send when the console starts.
     pub fn start(&mut self) -> Vec<Cmd> {
-        let name = self.cell.profile_name.clone();
-        self.ctx().info(format!("profile {name}"));
+        let (name, file) = (&self.cell.profile_name, &self.cell.profile_file);
+        let text = format!("profile {name}: {file}");
+        self.ctx().info(text);
         vec![Cmd::Store(StoreCmd::List)]
     }
 

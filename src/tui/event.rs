@@ -255,6 +255,12 @@ pub enum StoreEvent {
         dir: PathBuf,
         holder: String,
     },
+    /// The session was left at another console's request (`by` asked):
+    /// what was asked of the store before is saved, the lock released.
+    Left {
+        dir: PathBuf,
+        by: String,
+    },
     /// Where the console's log file is.
     LogFile(PathBuf),
     /// A captured frame the session could not save (a link where its file

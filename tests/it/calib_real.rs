@@ -428,6 +428,25 @@ fn plate_files_are_read_bounded_and_never_found_by_accident() {
     let so = String::from_utf8_lossy(&r.stdout);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     assert!(so.contains("8 columns × 6 rows"), "{so}");
+    // Which plate file is in use is said (issue 34): the built-in one, or
+    // the file named, by its absolute path.
+    assert!(so.contains("plate file: squares (built in)"), "{so}");
+    std::fs::write(
+        tmp.path().join("mine.toml"),
+        vss::calib::plate::BUILT_IN[0].1,
+    )
+    .unwrap();
+    let r = vss()
+        .current_dir(tmp.path())
+        .args(["calibrate", "--check-plate", "--plate", "mine.toml"])
+        .output()
+        .unwrap();
+    let so = String::from_utf8_lossy(&r.stdout);
+    let mine = tmp.path().join("mine.toml");
+    assert!(
+        so.contains(&format!("plate file: {}", mine.display())),
+        "{so}"
+    );
     // A FIFO does not block the reader; /dev/zero behind a link is refused.
     let fifo = tmp.path().join("fifo.toml");
     assert!(

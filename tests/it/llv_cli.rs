@@ -197,3 +197,123 @@ fn an_image_beyond_the_stages_limit_is_refused_up_front() {
     );
     assert!(!dir.path().join("huge1.ldr").exists());
 }
+
+/// Issue 34, N12: `--json` names the profile file in use — `built-in`
+/// for the compiled-in default, else the file's absolute path — on the
+/// image runs and on `--from-edges`, and so does `vss selftest --json`.
+#[test]
+fn json_names_the_profile_file_in_use() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let home = d.join("home");
+    std::fs::create_dir_all(&home).unwrap();
+    write(d, "box1.img", |x, y| rect(x, y, 200, 40));
+    std::fs::write(d.join("cell.toml"), vss::profile::BUILTIN_TOML).unwrap();
+    let json = |args: &[&str]| -> Vec<serde_json::Value> {
+        let r = vss()
+            .current_dir(d)
+            .env("HOME", &home)
+            .env("XDG_CONFIG_HOME", home.join(".config"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        String::from_utf8(r.stdout)
+            .unwrap()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
+    };
+    let file = d.join("cell.toml").display().to_string();
+    let o = json(&["llv", "--json", "--out", "a", "box1.img"]);
+    assert_eq!(o[0]["profile"], "built-in", "{}", o[0]);
+    let o = json(&[
+        "--profile",
+        "cell.toml",
+        "llv",
+        "--json",
+        "--out",
+        "b",
+        "box1.img",
+    ]);
+    assert_eq!(o[0]["profile"], file.as_str(), "{}", o[0]);
+    let o = json(&[
+        "--profile",
+        "cell.toml",
+        "llv",
+        "--json",
+        "--out",
+        "c",
+        "--from-edges",
+        "b/box1.hpo",
+        "b/box1.vpo",
+    ]);
+    assert_eq!(o[0]["profile"], file.as_str(), "{}", o[0]);
+    let o = json(&[
+        "--profile",
+        "cell.toml",
+        "selftest",
+        "--json",
+        "--family",
+        "cubes",
+        "--noise",
+        "2",
+        "--scenes",
+        "1",
+        "--size",
+        "64",
+    ]);
+    assert_eq!(o[0]["profile"], file.as_str());
+}
+
+/// Issue 34, N5: `vss llv` of an image at the picture bound (8192², a
+/// 64 MiB `.img`) within 5 × the file's size of address space (`ulimit
+/// -v`, so a run over it fails to allocate whatever the machine). It held
+/// the image twice and both scan directions' responses and buffers at once
+/// (480 MiB resident, 384 MiB of address space too little); it now holds
+/// one copy of the pixels and one direction's buffers at a time (247 MiB
+/// resident, runs in 272 MiB).
+#[test]
+fn llv_of_the_largest_picture_holds_one_direction_at_a_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let side = 8192usize;
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut px = vec![0u8; side * side];
+    for (i, p) in px.iter_mut().enumerate() {
+        let (x, y) = (i % side, i / side);
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        let noise = (seed % 7) as i32 - 3;
+        let base = if (1000..3000).contains(&x) && (1200..3500).contains(&y) {
+            190
+        } else if (2500..6100).contains(&x) && (4800..7400).contains(&y) {
+            30
+        } else {
+            60 + (40 * x / side) as i32
+        };
+        *p = (base + noise).clamp(0, 255) as u8;
+    }
+    let img = ImgFile::new(GreyImage::new(side, side, px).unwrap());
+    write_img(&dir.path().join("max1.img"), &img).unwrap();
+    drop(img);
+    let limit_kib = 5 * (side * side) as u64 / 1024;
+    let o = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {limit_kib} && exec \"$@\""))
+        .arg("sh")
+        .arg(assert_cmd::cargo::cargo_bin("vss"))
+        .args(["llv", "--json", "max1.img"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.success(),
+        "{:?}, most likely an allocation over the limit: {err}",
+        o.status
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["lines"].as_u64().unwrap() >= 8, "{v}");
+    assert!(dir.path().join("max1.ldr").is_file());
+}

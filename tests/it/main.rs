@@ -64,6 +64,7 @@ mod tui_pty_narrow;
 mod tui_pty_polish;
 mod tui_pty_review;
 mod tui_pty_search;
+mod tui_pty_takeover;
 mod tui_pty_trouble;
 mod tui_pty_tuning;
 mod tui_screens;

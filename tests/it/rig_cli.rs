@@ -363,11 +363,37 @@ fn ctrl_c_cancels_a_transfer_and_saves_nothing_of_it() {
         .stderr(Stdio::piped())
         .spawn()
         .expect("start grab");
+    // Ctrl-C once the transfer is under way: the progress on stderr shows
+    // bytes received (the stall comes after the first block).
+    let stderr = std::sync::Arc::new(std::sync::Mutex::new(Vec::<u8>::new()));
+    let reader = {
+        let (buf, mut e) = (stderr.clone(), child.stderr.take().expect("stderr"));
+        std::thread::spawn(move || {
+            let mut chunk = [0u8; 4096];
+            while let Ok(n) = std::io::Read::read(&mut e, &mut chunk) {
+                if n == 0 {
+                    break;
+                }
+                buf.lock().unwrap().extend_from_slice(&chunk[..n]);
+            }
+        })
+    };
+    let under_way = |text: &str| {
+        text.split('\r').any(|row| {
+            row.split_once(": ")
+                .and_then(|(_, rest)| rest.split('/').next()?.parse::<u64>().ok())
+                .is_some_and(|done| done > 0)
+        })
+    };
     let deadline = Instant::now() + Duration::from_secs(10);
-    while !session.exists() && Instant::now() < deadline {
+    while !under_way(&String::from_utf8_lossy(&stderr.lock().unwrap())) {
+        assert!(
+            Instant::now() < deadline,
+            "no transfer under way after 10 s: {}",
+            String::from_utf8_lossy(&stderr.lock().unwrap())
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
-    std::thread::sleep(Duration::from_millis(1200));
     let pid = child.id().to_string();
     assert!(
         Command::new("kill")
@@ -386,10 +412,8 @@ fn ctrl_c_cancels_a_transfer_and_saves_nothing_of_it() {
         );
         std::thread::sleep(Duration::from_millis(20));
     };
-    let mut err = String::new();
-    if let Some(mut e) = child.stderr.take() {
-        let _ = std::io::Read::read_to_string(&mut e, &mut err);
-    }
+    reader.join().expect("the stderr reader");
+    let err = String::from_utf8_lossy(&stderr.lock().unwrap()).into_owned();
     assert!(!status.success());
     assert!(
         err.contains("cancelled") && err.contains("nothing"),

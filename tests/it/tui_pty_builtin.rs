@@ -12,7 +12,7 @@ use vss::tui::keymap::{
     Action, CalibrateAction as CA, GlobalAction, PipelineAction, Scope, ScreenId,
 };
 
-use super::tui_harness::{Console, PIPELINE};
+use super::tui_harness::{Console, PIPELINE, flat};
 
 /// The console with the built-in profile in an empty folder, `HOME` and
 /// the XDG folders in another empty one (kept alive by the caller).
@@ -182,4 +182,33 @@ fn llv_camera_uses_the_builtin_description_from_an_empty_folder() {
     );
     let imc = vss::formats::img::read_img(&dir.path().join("view.imc")).unwrap();
     assert_ne!(imc.image, img, "the .imc is lens-corrected");
+}
+
+/// Issue 34, N12: the console names the profile file in use where the
+/// operator starts (the Survey screen's step box, the first message) and
+/// in the help window, with the plate Calibrate uses: `built-in` for the
+/// compiled-in profile, the file's absolute path otherwise.
+#[test]
+fn the_profile_file_in_use_is_named_on_screen() {
+    let home = tempfile::tempdir().unwrap();
+    let mut c = start_bare(80, 24, home.path());
+    let s = c.wait_text("profile: built-in", 15);
+    assert!(s.contains("choose a session"), "{s}");
+    c.press(Scope::Global, Action::Global(GlobalAction::Help));
+    let s = c.wait_text("Files in use", 10);
+    assert!(flat(&s).contains("profile built-in"), "{s}");
+    assert!(flat(&s).contains("plate squares (built in)"), "{s}");
+    c.send("q");
+    c.send("q");
+    c.wait_exit(10);
+
+    let mut c = Console::start(80, 24, &[]);
+    let file = c.dir.path().join("cell.toml");
+    let s = c.wait_text(&format!("profile: {}", file.display()), 15);
+    assert!(!s.contains("built-in"), "{s}");
+    c.create_session("cube");
+    // Still said while the first image is set up.
+    c.wait_text(&format!("profile: {}", file.display()), 10);
+    c.send("q");
+    c.wait_exit(10);
 }

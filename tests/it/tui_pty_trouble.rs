@@ -269,28 +269,6 @@ fn outputs_that_cannot_be_saved_keep_the_image_under_review() {
 }
 
 #[test]
-fn a_session_held_by_a_live_console_is_offered_for_take_over() {
-    let mut a = Console::start(80, 24, &[]);
-    a.create_session("cube");
-    let mut b = a.another(80, 24);
-    b.wait_text("in use by", 10);
-    b.send("\r");
-    let s = b.wait_text("over anyway?", 10);
-    assert!(s.contains("tmux attach"), "{s}");
-    b.yes();
-    b.wait_text("session cube", 20);
-    // The first console was asked to end, and did, restoring its terminal.
-    a.wait_exit(20);
-    let raw = String::from_utf8_lossy(&a.raw.lock().unwrap()).into_owned();
-    assert!(
-        raw.trim_end().ends_with("\x1b[?1049l"),
-        "left the alternate screen"
-    );
-    b.send("q");
-    b.wait_exit(10);
-}
-
-#[test]
 fn too_small_a_terminal_says_so_and_recovers() {
     let mut c = Console::start(80, 24, &[]);
     c.wait_text("choose a session", 10);

@@ -170,7 +170,12 @@ impl CalibrateScreen {
             }
             Field::Plate => {
                 let p = Plate::load(text).map_err(|e| e.to_string())?;
-                ctx.info(format!("plate {}: {}", p.name, p.describe()));
+                ctx.info(format!(
+                    "plate {}: {} ({})",
+                    p.name,
+                    p.describe(),
+                    crate::tui::text::clean(&crate::calib::plate::in_use(text))
+                ));
                 self.plate_name = text.to_string();
                 self.plate = Some(p);
                 self.last = None;

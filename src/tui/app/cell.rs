@@ -31,6 +31,9 @@ pub struct DeviceState {
 #[derive(Debug)]
 pub struct CellState {
     pub profile_name: String,
+    /// Which profile file is in use ([`Profile::in_use`]): its absolute
+    /// path, or `built-in`.
+    pub profile_file: String,
     /// Lighting letters of the profile, and which one is ambient (no light on).
     pub letters: Vec<char>,
     pub ambient: Option<char>,
@@ -59,6 +62,7 @@ impl CellState {
         CellState {
             rule,
             profile_name: clean(&profile.name),
+            profile_file: clean(&profile.in_use()),
             letters: profile.lighting.iter().map(|l| l.letter).collect(),
             ambient,
             lights: profile

@@ -292,6 +292,16 @@ impl App {
                 ));
                 Vec::new()
             }
+            StoreEvent::Left { dir, by } => {
+                self.session_left();
+                self.ctx().error(format!(
+                    "session {} was taken over by {} at its request: this console no longer \
+                     writes it (what it had saved is on disk); choose or create a session",
+                    clean(&dir.display().to_string()),
+                    clean(&by)
+                ));
+                Vec::new()
+            }
             StoreEvent::LogFile(path) => {
                 let p = clean(&path.display().to_string());
                 self.chrome.log.set_file(path);
@@ -338,6 +348,19 @@ impl App {
                 Vec::new()
             }
         }
+    }
+
+    /// Back to no session, on the Survey screen's session list: another
+    /// console took the session over at its request.
+    fn session_left(&mut self) {
+        self.session.view = None;
+        self.session.saving.clear();
+        self.session.refused.clear();
+        self.session.work.phase = Phase::NoSession;
+        self.tracker.current = None;
+        self.screens.survey.picking = false;
+        self.screens.survey.row = None;
+        self.chrome.screen = crate::tui::keymap::ScreenId::Survey;
     }
 
     /// The log lines written since the last call, for the log file.

@@ -458,7 +458,23 @@ pub fn help_lines(app: &App, width: usize) -> Vec<Line<'static>> {
     }
     let key_w = 11;
     let desc_w = width.saturating_sub(key_w + 1).max(10);
-    let mut lines = Vec::new();
+    let mut lines = vec![Line::styled("Files in use", t.title())];
+    let plate = &app.screens.calibrate.plate_name;
+    for (what, file) in [
+        ("profile", app.cell.profile_file.clone()),
+        (
+            "plate",
+            crate::tui::text::clean(&crate::calib::plate::in_use(plate)),
+        ),
+    ] {
+        for (i, part) in wrap(&file, desc_w).into_iter().enumerate() {
+            let what = if i == 0 { what } else { "" };
+            lines.push(Line::from(vec![
+                Span::styled(format!("{what:>key_w$} "), t.key()),
+                Span::raw(part),
+            ]));
+        }
+    }
     for (title, scope) in sections {
         lines.push(Line::styled(title, t.title()));
         for (k, d) in keymap::describe(scope) {

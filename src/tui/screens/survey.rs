@@ -410,6 +410,13 @@ fn step_lines(app: &App) -> Vec<Line<'static>> {
         }
     };
     let mut text = text;
+    // Which profile file the console runs on, where the operator starts.
+    if matches!(w.phase, Phase::NoSession | Phase::Setup) {
+        text.push(Line::styled(
+            format!("profile: {}", app.cell.profile_file),
+            t.dim(),
+        ));
+    }
     if matches!(
         w.phase,
         Phase::Setup | Phase::Processing | Phase::Review | Phase::Complete

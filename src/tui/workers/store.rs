@@ -66,9 +66,36 @@ pub enum StoreError {
     },
 }
 
-fn session_err(what: impl Into<String>) -> impl FnOnce(SessionError) -> StoreError {
+fn session_err(what: impl Into<String>) -> impl Fn(SessionError) -> StoreError {
     let what = what.into();
-    move |source| StoreError::Session { what, source }
+    move |source| StoreError::Session {
+        what: what.clone(),
+        source,
+    }
+}
+
+/// How often the store looks for a request to leave its session.
+const LEAVE_POLL: Duration = Duration::from_millis(200);
+
+/// How long a take-over waits for the holder to answer its request before
+/// signalling it.
+const LEAVE_WAIT: Duration = Duration::from_secs(5);
+
+/// Opens session `dir` once its lock is free (or stale), waiting at most
+/// `limit`: `Ok(None)` when it is still held then.
+fn wait_for_lock(dir: &Path, limit: Duration) -> Result<Option<Session>, SessionError> {
+    let end = Instant::now() + limit;
+    loop {
+        match Session::open(dir) {
+            Ok(s) => return Ok(Some(s)),
+            Err(SessionError::Locked { stale: true, .. }) => {
+                return Session::open_take_over(dir).map(Some);
+            }
+            Err(SessionError::Locked { .. }) if Instant::now() > end => return Ok(None),
+            Err(SessionError::Locked { .. }) => std::thread::sleep(Duration::from_millis(50)),
+            Err(e) => return Err(e),
+        }
+    }
 }
 
 /// The UI's handle on the store worker.
@@ -130,8 +157,48 @@ impl Store {
         if let Some(p) = logfile::state_path() {
             self.use_log(p);
         }
-        while let Ok(cmd) = rx.recv() {
-            self.handle(cmd);
+        // Between commands, and at least every LEAVE_POLL, a request to
+        // release the session's lock ([`Store::leave_if_asked`]).
+        let mut checked = Instant::now();
+        loop {
+            match rx.recv_timeout(LEAVE_POLL) {
+                Ok(cmd) => self.handle(cmd),
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            }
+            if checked.elapsed() >= LEAVE_POLL {
+                self.leave_if_asked();
+                checked = Instant::now();
+            }
+        }
+    }
+
+    /// Leaves the open session when another console on this host asked
+    /// for it through the session folder (`NAME.lock.leave`) and the
+    /// request checks out: everything asked of the store before is saved
+    /// (commands are done in order), the lock is released, and the console
+    /// is told who took the session. A request that does not check out is
+    /// removed and said, and the session stays.
+    pub fn leave_if_asked(&mut self) {
+        let Some(s) = &self.session else {
+            return;
+        };
+        let dir = s.dir().to_path_buf();
+        match s.leave_requested() {
+            None => {}
+            Some(Ok(asker)) => {
+                self.close();
+                self.reply(StoreEvent::Left {
+                    dir,
+                    by: asker.to_string(),
+                });
+                let list = self.list();
+                self.reply(StoreEvent::Sessions(list));
+            }
+            Some(Err(why)) => self.reply(StoreEvent::Note(format!(
+                "a request to leave session {} was ignored: {why}",
+                dir.display()
+            ))),
         }
     }
 
@@ -482,54 +549,68 @@ impl Store {
         out.into_iter().map(|(_, e)| e).collect()
     }
 
-    /// Opens a session held by a console that still runs on this host, by
-    /// asking that console to end (SIGTERM: it finishes its saves and
-    /// releases the lock, as on a hang-up); a holder on another host is
-    /// taken over as the lock allows.
+    /// Opens a session held by a console that still runs on this host:
+    /// first by request through the session folder (`NAME.lock.leave`,
+    /// which that console watches: it saves what it has, releases the lock
+    /// and says who took it), and only when the lock is still held after
+    /// [`LEAVE_WAIT`] by a signal (SIGTERM: it finishes its saves and
+    /// ends, as on a hang-up). A stale lock, or one held on another host,
+    /// is taken over as the lock allows, nobody asked.
     fn take_over(&self, dir: &Path) -> Result<Session, StoreError> {
+        use crate::session::lock;
         let err = session_err(format!("cannot take over {}", dir.display()));
-        let holder = Session::inspect(dir).ok().and_then(|s| s.lock_holder());
+        let inspected = Session::inspect(dir).ok();
+        let holder = inspected.as_ref().and_then(Session::lock_holder);
         let local = holder
             .as_ref()
-            .is_some_and(|h| h.host == crate::session::lock::LockInfo::current().host);
-        if let (true, Some(h)) = (local, holder.as_ref()) {
+            .is_some_and(|h| h.host == lock::LockInfo::current().host && !h.is_stale());
+        let (true, Some(h), Some(s)) = (local, holder.as_ref(), inspected.as_ref()) else {
+            return Session::open_take_over(dir).map_err(err);
+        };
+        let lock_path = s.lock_path();
+        let leave = lock::leave_path(&lock_path);
+        let asked = lock::request_leave(&lock_path, h);
+        if let Err(e) = &asked {
             self.reply(StoreEvent::Note(format!(
-                "asking process {} to end and release session {}…",
+                "cannot ask process {} through {} ({e}): signalling it instead",
+                h.pid,
+                leave.display()
+            )));
+        } else {
+            self.reply(StoreEvent::Note(format!(
+                "asking process {} to release session {}…",
                 h.pid,
                 dir.display()
             )));
-            // Only the lock's own vss console is signalled (a stale lock is
-            // taken over below without signalling anyone).
-            if let Err(why) = crate::session::lock::ask_holder_to_leave(h)
-                && !h.is_stale()
-            {
-                return Err(StoreError::TakeOverRefused {
-                    dir: dir.to_path_buf(),
-                    holder: h.to_string(),
-                    why,
-                });
-            }
-            let end = Instant::now() + Duration::from_secs(15);
-            loop {
-                match Session::open(dir) {
-                    Ok(s) => return Ok(s),
-                    Err(SessionError::Locked { stale: true, .. }) => {
-                        return Session::open_take_over(dir).map_err(err);
-                    }
-                    Err(SessionError::Locked { holder, .. }) if Instant::now() > end => {
-                        return Err(StoreError::TakeOver {
-                            dir: dir.to_path_buf(),
-                            holder,
-                        });
-                    }
-                    Err(SessionError::Locked { .. }) => {
-                        std::thread::sleep(Duration::from_millis(100));
-                    }
-                    Err(e) => return Err(err(e)),
-                }
+            if let Some(s) = wait_for_lock(dir, LEAVE_WAIT).map_err(&err)? {
+                let _ = std::fs::remove_file(&leave);
+                return Ok(s);
             }
         }
-        Session::open_take_over(dir).map_err(err)
+        // No answer: the request goes, and the holder is signalled — only
+        // the lock's own vss console.
+        let _ = std::fs::remove_file(&leave);
+        self.reply(StoreEvent::Note(format!(
+            "process {} did not release session {}: asking it to end…",
+            h.pid,
+            dir.display()
+        )));
+        if let Err(why) = lock::ask_holder_to_leave(h)
+            && !h.is_stale()
+        {
+            return Err(StoreError::TakeOverRefused {
+                dir: dir.to_path_buf(),
+                holder: h.to_string(),
+                why,
+            });
+        }
+        match wait_for_lock(dir, Duration::from_secs(15)).map_err(&err)? {
+            Some(s) => Ok(s),
+            None => Err(StoreError::TakeOver {
+                dir: dir.to_path_buf(),
+                holder: h.to_string(),
+            }),
+        }
     }
 
     /// Each camera's model (index 0 = camera 1) from
