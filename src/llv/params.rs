@@ -314,8 +314,10 @@ params! {
         wl: f64 = 6.0,
             "px", 0.0..=100.0, step 0.5,
             "environment length beyond each endpoint";
-        /// Environment half-width to each side of the segment (px).
-        wd: f64 = 1.5,
+        /// Environment half-width to each side of the segment (px). 1 px
+        /// keeps close parallel edges (window mullions, plate pairs 2–3 px
+        /// apart) from merging; 1.5 merged them (docs/accuracy.md).
+        wd: f64 = 1.0,
             "px", 0.0..=20.0, step 0.25,
             "environment half-width to each side";
         /// Largest direction difference of two segments that merge (degrees).

@@ -120,7 +120,7 @@ fn out_of_range_parameters_name_line_key_and_range() {
         "llv.edges.floor",
         &["0 to 255"],
     );
-    assert_names("wd = 1.5 ", "wd = 21.0 ", "llv.connect.wd", &["0 to 20"]);
+    assert_names("wd = 1.0 ", "wd = 21.0 ", "llv.connect.wd", &["0 to 20"]);
     assert_names(
         "max_gap = 3 ",
         "max_gap = 0 ",
