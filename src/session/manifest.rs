@@ -10,11 +10,15 @@
 //! numbers and letters, image numbers and `planned_images` within
 //! [`MAX_IMAGE_NUMBER`], file names that stay inside the session folder), so
 //! a manifest edited into nonsense is reported with its file and line and
-//! never silently rewritten.
+//! never silently rewritten. It is read record by record (`records`): each
+//! `[[image]]` is parsed on its own, never the whole file into one TOML
+//! document, which cost 21 to 76 times the text.
 
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+
+mod records;
 
 use super::{MAX_IMAGE_NUMBER, SessionError};
 use crate::llv::{Params, Segment};
@@ -22,10 +26,12 @@ use crate::llv::{Params, Segment};
 /// Version of the manifest schema this console writes.
 pub const FORMAT: u32 = 1;
 
-/// The largest manifest read: 4 MiB. TOML parsing costs 21 to 76 times the
-/// text in memory (76 for a file of nothing but one-digit array values: a
-/// 16 MiB one took 1.27 GB), so this bound keeps any manifest under about
-/// 320 MB; a real manifest takes about 4 KiB a fully processed image (see
+/// The largest manifest read: 4 MiB. Parsing a TOML record costs 21 to 76
+/// times its text in memory (76 for nothing but one-digit array values: a
+/// 16 MiB file of them took 1.27 GB). Records are parsed one at a time, so
+/// a manifest of many images costs about 2.5 times its text; but one record
+/// may be the whole file, and this bound keeps even that under about
+/// 330 MB. A real manifest takes about 4 KiB a fully processed image (see
 /// docs/reliability.md), so it holds about a thousand. Larger files are
 /// refused unread.
 pub const MAX_LEN: usize = 4 << 20;
@@ -279,20 +285,7 @@ impl Manifest {
                 ),
             });
         }
-        let m: Manifest = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|s| {
-                    let end = s.start.min(text.len());
-                    text.get(..end).map_or(0, |t| t.matches('\n').count() + 1)
-                })
-                .unwrap_or(0);
-            SessionError::Manifest {
-                path: path.to_path_buf(),
-                line,
-                message: e.message().trim().to_string(),
-            }
-        })?;
+        let m = records::parse(text, path)?;
         m.validate()
             .map_err(|(needle, message)| SessionError::Manifest {
                 path: path.to_path_buf(),
