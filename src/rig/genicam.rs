@@ -12,7 +12,9 @@
 //! - freeze: a software trigger and the one frame it makes. The pixels are
 //!   copied out of Aravis's buffer at once and reduced to 8-bit grey
 //!   ([`super::pixels`]); the frame is kept on the PC (the "grabber's
-//!   memory"), and transfer hands it over;
+//!   memory"), and transfer hands it over. The camera's exposure and gain
+//!   are read again as each frame comes (a camera on automatic changes
+//!   them itself): the session records them with the frame;
 //! - live: the console's live view repeats freezes, at most one every
 //!   [`LIVE_INTERVAL`].
 //!
@@ -303,6 +305,9 @@ impl GenicamGrabber {
                 Err(status_text(status))
             };
             o.stream.push_buffer(buf);
+            if result.is_ok() {
+                read_settings(o);
+            }
             match result {
                 Ok(img) => {
                     let n = img.data().len() as u64;
@@ -338,6 +343,19 @@ fn status_text(status: BufferStatus) -> String {
         BufferStatus::SizeMismatch => "larger than the camera's payload".into(),
         BufferStatus::Aborted => "aborted".into(),
         other => format!("{other:?}"),
+    }
+}
+
+/// Reads the camera's exposure and gain again, as a frame comes: they go
+/// into the frame's record in the session, and a camera left on automatic
+/// exposure or gain (the profile sets neither) changes them itself. A
+/// value the camera does not give keeps the one read before.
+fn read_settings(o: &mut Open) {
+    if let Ok(us) = o.camera.exposure_time() {
+        o.state.exposure_us = us;
+    }
+    if let Ok(db) = o.camera.gain() {
+        o.state.gain_db = db;
     }
 }
 

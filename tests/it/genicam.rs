@@ -221,7 +221,18 @@ fn grab_saves_whole_frames_from_the_fake_camera() {
     }
     assert!(stdout.contains("lighting b (right-front)"), "{stdout}");
     let sess = vss::session::Session::inspect(&session).expect("grab made a session");
-    assert_eq!(sess.manifest().image(1).map(|r| r.camera), Some(1));
+    let rec = sess.manifest().image(1).expect("image 1 recorded");
+    assert_eq!(rec.camera, 1);
+    // Each frame's record keeps the camera's exposure and gain.
+    assert_eq!(rec.grey.len(), 5);
+    for g in &rec.grey {
+        assert_eq!(
+            (g.exposure_us, g.gain_db),
+            (Some(10_000.0), Some(0.0)),
+            "{}",
+            g.file
+        );
+    }
 }
 
 #[test]

@@ -48,6 +48,8 @@ fn image(name: &str, k: u32) -> ImageRecord {
             hash: "crc32:01234567:262144".into(),
             width: 512,
             height: 512,
+            exposure_us: Some(10_000.0),
+            gain_db: Some(0.0),
             saved: STAMP.into(),
             version: "0.1.0".into(),
         })

@@ -17,7 +17,7 @@ use crate::llv::GreyImage;
 use crate::llv::lens::CameraModel;
 use crate::profile::Profile;
 use crate::report;
-use crate::session::{CheckReport, Session, SessionError};
+use crate::session::{CheckReport, FrameSettings, Session, SessionError};
 use crate::tui::event::{Msg, SessionEntry, StoreCmd, StoreEvent};
 
 mod load;
@@ -150,6 +150,7 @@ impl Store {
         camera: u32,
         location: u32,
         image: GreyImage,
+        settings: FrameSettings,
     ) -> Result<String, StoreError> {
         // The camera's description as the profile serves it (built in or a
         // file), recorded as the image's NAMEk.cdf; a problem with it is
@@ -169,7 +170,7 @@ impl Store {
         }
         let file = s.file_name(k, Some(letter), "img");
         let stem = file.trim_end_matches(".img").to_string();
-        s.save_image(k, letter, &ImgFile::new(image).with_comment(stem))
+        s.save_frame(k, letter, &ImgFile::new(image).with_comment(stem), settings)
             .map_err(session_err(what))?;
         Ok(file)
     }
@@ -236,7 +237,8 @@ impl Store {
                 camera,
                 location,
                 image,
-            } => match self.save_frame(k, letter, camera, location, image) {
+                settings,
+            } => match self.save_frame(k, letter, camera, location, image, settings) {
                 Ok(file) => {
                     self.forget_problems(std::slice::from_ref(&file));
                     self.reply(StoreEvent::Saved(file));
