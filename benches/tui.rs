@@ -95,6 +95,7 @@ fn ready() -> (App, Engine) {
             purpose: FramePurpose::Survey { k: 1, letter },
             camera: 1,
             image,
+            settings: Default::default(),
         }));
     }
     let mut engine = Engine::default();

@@ -195,6 +195,11 @@ impl CameraState {
             num(self.gain_db, "dB", 1)
         )
     }
+
+    /// The exposure and gain as a frame's record in a session keeps them.
+    pub fn frame_settings(&self) -> crate::session::FrameSettings {
+        crate::session::FrameSettings::new(self.exposure_us, self.gain_db)
+    }
 }
 
 /// A byte stream to a device with a settable read timeout: a serial port, a

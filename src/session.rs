@@ -39,6 +39,7 @@ pub use outputs::OutputSet;
 pub use progress::{ImageProgress, OutputState, Progress, Step};
 pub use redo::RedoSummary;
 
+pub use manifest::FrameSettings;
 use manifest::{EditRecord, FileRecord, GreyRecord, ImageRecord, LightingInfo, SessionInfo};
 
 /// The largest image number a session accepts, and the most images it may
@@ -484,12 +485,27 @@ impl Session {
     }
 
     /// Saves grey image `k` under lighting `letter` as `NAMEkL.img`, then
-    /// records it. Returns the file's path.
+    /// records it, with no camera settings (an image not from a camera, or
+    /// from the serial grabber). Returns the file's path.
     pub fn save_image(
         &mut self,
         k: u32,
         letter: char,
         img: &ImgFile,
+    ) -> Result<PathBuf, SessionError> {
+        self.save_frame(k, letter, img, FrameSettings::default())
+    }
+
+    /// Saves a camera's frame as grey image `k` under lighting `letter`
+    /// (`NAMEkL.img`), then records it with the exposure and gain the
+    /// camera had when it took the frame. `vss grab` and the console both
+    /// save through here. Returns the file's path.
+    pub fn save_frame(
+        &mut self,
+        k: u32,
+        letter: char,
+        img: &ImgFile,
+        camera: FrameSettings,
     ) -> Result<PathBuf, SessionError> {
         self.writable()?;
         check_image_number(k)?;
@@ -518,6 +534,8 @@ impl Session {
             hash: stamp::hash(&bytes),
             width: u32::try_from(img.image.width()).unwrap_or(u32::MAX),
             height: u32::try_from(img.image.height()).unwrap_or(u32::MAX),
+            exposure_us: camera.exposure_us,
+            gain_db: camera.gain_db,
             saved: stamp::now_rfc3339(),
             version: env!("CARGO_PKG_VERSION").to_string(),
         };

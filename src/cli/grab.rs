@@ -229,7 +229,7 @@ fn capture_one(
     errln!();
     let cap = result?;
     let img = ImgFile::new(cap.image).with_comment(stem);
-    let path = sess.save_image(a.image, letter, &img)?;
+    let path = sess.save_frame(a.image, letter, &img, cap.settings)?;
     let on = if cap.lights_on.is_empty() {
         "ambient only".to_string()
     } else {

@@ -13,6 +13,7 @@ use super::protocol::{FrameInfo, GrabberInfo};
 use super::sim::{Faults, SimCell};
 use crate::llv::GreyImage;
 use crate::profile::{GrabberKind, Profile, RelayKind};
+use crate::session::FrameSettings;
 
 /// The cell's devices and what they are set to.
 pub struct Cell {
@@ -34,6 +35,9 @@ pub struct Capture {
     pub camera: u32,
     pub lighting: char,
     pub lights_on: Vec<String>,
+    /// The camera's exposure and gain when it took the frame (none from
+    /// the serial grabber).
+    pub settings: FrameSettings,
     /// Switch + settle + freeze + transfer.
     pub elapsed: Duration,
 }
@@ -283,8 +287,18 @@ impl Cell {
             camera,
             lighting: letter,
             lights_on: self.lights_on(),
+            settings: self.frame_settings(),
             elapsed: start.elapsed(),
         })
+    }
+
+    /// The selected camera's exposure and gain as the grabber last read
+    /// them (a GenICam grabber reads them at every freeze); none from the
+    /// serial grabber.
+    pub fn frame_settings(&self) -> FrameSettings {
+        self.grabber
+            .camera_state()
+            .map_or_else(FrameSettings::default, |s| s.frame_settings())
     }
 
     /// After the grabber vanished or stopped answering: plug the simulated

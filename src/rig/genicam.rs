@@ -12,7 +12,9 @@
 //! - freeze: a software trigger and the one frame it makes. The pixels are
 //!   copied out of Aravis's buffer at once and reduced to 8-bit grey
 //!   ([`super::pixels`]); the frame is kept on the PC (the "grabber's
-//!   memory"), and transfer hands it over;
+//!   memory"), and transfer hands it over. The camera's exposure and gain
+//!   are read again as each frame comes (a camera on automatic changes
+//!   them itself): the session records them with the frame;
 //! - live: the console's live view repeats freezes, at most one every
 //!   [`LIVE_INTERVAL`].
 //!
@@ -22,8 +24,10 @@
 //! A camera that does not answer (unplugged, powered off, the fake camera
 //! killed) or sends no frame within the timeout fails with an error that
 //! names it and counts as vanished, so the console reconnects as it does
-//! for the serial grabber. A pixel format vss cannot use is refused when
-//! the camera is opened.
+//! for the serial grabber. A pixel format vss cannot use (one the camera
+//! does not offer, or one vss cannot reduce to 8 bits) is refused when the
+//! camera is opened, before any frame, naming the camera and the formats it
+//! offers that vss reads.
 //!
 //! The one `unsafe` block of vss's own code outside the allocator test is
 //! here (`copy_frame`): Aravis hands a frame as a pointer and a length.
@@ -169,11 +173,27 @@ impl GenicamGrabber {
                 )
             })
         };
+        // The formats the camera offers, and of those the ones vss reads:
+        // named whenever a format is refused.
+        let formats = Formats::of(&camera);
+        let refuse = |what: String| {
+            self.err(
+                cam,
+                format!(
+                    "{} {what}; {} (nothing was grabbed)",
+                    identity(&camera),
+                    formats.advice(cam)
+                ),
+                false,
+            )
+        };
         if let Some(f) = &s.pixel_format {
-            set(
-                &format!("the pixel format to {f}"),
-                camera.set_pixel_format_from_string(f),
-            )?;
+            if !formats.offered.is_empty() && !formats.offered.contains(f) {
+                return Err(refuse(format!("has no pixel format {f}")));
+            }
+            camera
+                .set_pixel_format_from_string(f)
+                .map_err(|e| refuse(format!("refused the pixel format {f} ({})", text(&e))))?;
         }
         if let Some([x, y, w, h]) = s.roi {
             let n = |v: u32| i32::try_from(v).unwrap_or(i32::MAX);
@@ -207,15 +227,9 @@ impl GenicamGrabber {
                 .pixel_format_as_string()
                 .map(|s| s.to_string())
                 .unwrap_or_else(|_| format!("0x{pfnc:08X}"));
-            self.err(
-                cam,
-                format!(
-                    "sends {name} pixels, which vss cannot use — set pixel_format to one of {} \
-                     in [[grabber.camera]] entry {cam}",
-                    PIXEL_FORMATS.join(", ")
-                ),
-                false,
-            )
+            refuse(format!(
+                "is set to {name} pixels, which vss cannot reduce to 8-bit grey"
+            ))
         })?;
         set(
             "software trigger (TriggerMode On, TriggerSource Software)",
@@ -303,6 +317,9 @@ impl GenicamGrabber {
                 Err(status_text(status))
             };
             o.stream.push_buffer(buf);
+            if result.is_ok() {
+                read_settings(o);
+            }
             match result {
                 Ok(img) => {
                     let n = img.data().len() as u64;
@@ -329,6 +346,76 @@ impl GenicamGrabber {
     }
 }
 
+/// The pixel formats a camera offers (its `PixelFormat` entries that are
+/// available now) and, of those, the ones vss reads.
+struct Formats {
+    offered: Vec<String>,
+    usable: Vec<String>,
+}
+
+impl Formats {
+    /// Asks the camera; a camera that cannot say offers nothing known.
+    fn of(camera: &Camera) -> Formats {
+        let offered: Vec<String> = camera
+            .dup_available_pixel_formats_as_strings()
+            .map(|v| v.iter().map(|s| s.to_string()).collect())
+            .unwrap_or_default();
+        let usable = offered
+            .iter()
+            .filter(|f| Mono::from_name(f).is_some())
+            .cloned()
+            .collect();
+        Formats { offered, usable }
+    }
+
+    /// What to set `pixel_format` to, for camera `cam`.
+    fn advice(&self, cam: u32) -> String {
+        let key = format!("pixel_format in [[grabber.camera]] entry {cam}");
+        if !self.usable.is_empty() {
+            format!(
+                "of the formats vss can use it offers {}: set {key} to one of them",
+                self.usable.join(", ")
+            )
+        } else if !self.offered.is_empty() {
+            format!(
+                "it offers none that vss can use ({}; vss reads {}): set the camera to one \
+                 of those with its maker's tool, then {key}",
+                self.offered.join(", "),
+                PIXEL_FORMATS.join(", ")
+            )
+        } else {
+            format!(
+                "it does not say which formats it offers; vss reads {}: set {key} to one \
+                 the camera has",
+                PIXEL_FORMATS.join(", ")
+            )
+        }
+    }
+}
+
+/// "the Aravis Fake #GV01": the camera's vendor, model and serial number,
+/// as far as it says them.
+fn identity(camera: &Camera) -> String {
+    let serial = serial(camera);
+    let parts: Vec<String> = [
+        gtext(camera.vendor_name()),
+        gtext(camera.model_name()),
+        if serial.is_empty() {
+            serial
+        } else {
+            format!("#{serial}")
+        },
+    ]
+    .into_iter()
+    .filter(|p| !p.trim().is_empty())
+    .collect();
+    if parts.is_empty() {
+        "the camera".into()
+    } else {
+        format!("the {}", parts.join(" "))
+    }
+}
+
 /// What an unsuccessful buffer's status means, for the operator.
 fn status_text(status: BufferStatus) -> String {
     match status {
@@ -341,20 +428,42 @@ fn status_text(status: BufferStatus) -> String {
     }
 }
 
+/// Reads the camera's exposure and gain again, as a frame comes: they go
+/// into the frame's record in the session, and a camera left on automatic
+/// exposure or gain (the profile sets neither) changes them itself. A
+/// value the camera does not give keeps the one read before.
+fn read_settings(o: &mut Open) {
+    if let Ok(us) = o.camera.exposure_time() {
+        o.state.exposure_us = us;
+    }
+    if let Ok(db) = o.camera.gain() {
+        o.state.gain_db = db;
+    }
+}
+
+/// Aravis's text, or nothing when the camera does not give it.
+fn gtext(r: Result<aravis::glib::GString, aravis::glib::Error>) -> String {
+    r.map(|s| s.to_string()).unwrap_or_default()
+}
+
+/// The camera's serial number (older GenICam files call it DeviceID).
+fn serial(camera: &Camera) -> String {
+    gtext(
+        camera
+            .string("DeviceSerialNumber")
+            .or_else(|_| camera.string("DeviceID")),
+    )
+}
+
 /// The camera's identity and settings as it reports them now.
 fn read_state(camera: &Camera, format: Mono, id: &str) -> CameraState {
-    let s = |r: Result<aravis::glib::GString, aravis::glib::Error>| {
-        r.map(|s| s.to_string()).unwrap_or_default()
-    };
+    let s = gtext;
     let (x, y, w, h) = camera.region().unwrap_or((0, 0, 0, 0));
     CameraState {
         id: id.to_string(),
         vendor: s(camera.vendor_name()),
         model: s(camera.model_name()),
-        // Older GenICam files call it DeviceID.
-        serial: s(camera
-            .string("DeviceSerialNumber")
-            .or_else(|_| camera.string("DeviceID"))),
+        serial: serial(camera),
         pixel_format: format.name().to_string(),
         exposure_us: camera.exposure_time().unwrap_or(f64::NAN),
         gain_db: camera.gain().unwrap_or(f64::NAN),

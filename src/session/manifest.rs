@@ -10,11 +10,19 @@
 //! numbers and letters, image numbers and `planned_images` within
 //! [`MAX_IMAGE_NUMBER`], file names that stay inside the session folder), so
 //! a manifest edited into nonsense is reported with its file and line and
-//! never silently rewritten.
+//! never silently rewritten. It is read record by record (`records`): each
+//! `[[image]]` is parsed on its own, never the whole file into one TOML
+//! document, which cost 21 to 76 times the text.
+//!
+//! A grey image's record keeps the camera's exposure and gain when the
+//! frame was taken (`exposure_us`, `gain_db`: GenICam cameras); the serial
+//! grabber's frames, and manifests written before, have neither.
 
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+
+mod records;
 
 use super::{MAX_IMAGE_NUMBER, SessionError};
 use crate::llv::{Params, Segment};
@@ -22,10 +30,12 @@ use crate::llv::{Params, Segment};
 /// Version of the manifest schema this console writes.
 pub const FORMAT: u32 = 1;
 
-/// The largest manifest read: 4 MiB. TOML parsing costs 21 to 76 times the
-/// text in memory (76 for a file of nothing but one-digit array values: a
-/// 16 MiB one took 1.27 GB), so this bound keeps any manifest under about
-/// 320 MB; a real manifest takes about 4 KiB a fully processed image (see
+/// The largest manifest read: 4 MiB. Parsing a TOML record costs 21 to 76
+/// times its text in memory (76 for nothing but one-digit array values: a
+/// 16 MiB file of them took 1.27 GB). Records are parsed one at a time, so
+/// a manifest of many images costs about 2.5 times its text; but one record
+/// may be the whole file, and this bound keeps even that under about
+/// 330 MB. A real manifest takes about 4 KiB a fully processed image (see
 /// docs/reliability.md), so it holds about a thousand. Larger files are
 /// refused unread.
 pub const MAX_LEN: usize = 4 << 20;
@@ -131,8 +141,37 @@ pub struct GreyRecord {
     pub hash: String,
     pub width: u32,
     pub height: u32,
+    /// The camera's exposure time when the frame was taken (µs): written
+    /// for GenICam cameras, absent for the serial grabber (which has none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exposure_us: Option<f64>,
+    /// The camera's gain when the frame was taken (dB); absent likewise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gain_db: Option<f64>,
     pub saved: String,
     pub version: String,
+}
+
+/// What a camera was set to when it took a frame, as the grey image's
+/// record keeps it ([`GreyRecord::exposure_us`], [`GreyRecord::gain_db`]):
+/// `None` where the camera has no such setting or says nothing of it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameSettings {
+    /// Exposure time (µs).
+    pub exposure_us: Option<f64>,
+    /// Gain (dB).
+    pub gain_db: Option<f64>,
+}
+
+impl FrameSettings {
+    /// From the values a camera reports (NaN or infinite: none).
+    pub fn new(exposure_us: f64, gain_db: f64) -> FrameSettings {
+        let finite = |v: f64| v.is_finite().then_some(v);
+        FrameSettings {
+            exposure_us: finite(exposure_us),
+            gain_db: finite(gain_db),
+        }
+    }
 }
 
 /// The stage outputs of one image number.
@@ -279,20 +318,7 @@ impl Manifest {
                 ),
             });
         }
-        let m: Manifest = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|s| {
-                    let end = s.start.min(text.len());
-                    text.get(..end).map_or(0, |t| t.matches('\n').count() + 1)
-                })
-                .unwrap_or(0);
-            SessionError::Manifest {
-                path: path.to_path_buf(),
-                line,
-                message: e.message().trim().to_string(),
-            }
-        })?;
+        let m = records::parse(text, path)?;
         m.validate()
             .map_err(|(needle, message)| SessionError::Manifest {
                 path: path.to_path_buf(),
@@ -463,6 +489,8 @@ mod tests {
                     hash: "crc32:1:2".into(),
                     width: 512,
                     height: 480,
+                    exposure_us: Some(12_500.0),
+                    gain_db: Some(-1.5),
                     saved: "2026-11-22T02:30:00Z".into(),
                     version: "0.1.0".into(),
                 }],
@@ -511,6 +539,21 @@ mod tests {
     fn every_field_survives_toml_and_back() {
         let m = full();
         let text = m.to_toml().unwrap();
+        assert_eq!(Manifest::parse(&text, Path::new("cube.toml")).unwrap(), m);
+    }
+
+    #[test]
+    fn grey_records_without_camera_settings_are_written_and_read_without_them() {
+        // The serial grabber's frames, and every manifest written before
+        // exposure and gain were recorded.
+        let mut m = full();
+        m.image[0].grey[0].exposure_us = None;
+        m.image[0].grey[0].gain_db = None;
+        let text = m.to_toml().unwrap();
+        assert!(
+            !text.contains("exposure_us") && !text.contains("gain_db"),
+            "{text}"
+        );
         assert_eq!(Manifest::parse(&text, Path::new("cube.toml")).unwrap(), m);
     }
 

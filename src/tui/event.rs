@@ -11,6 +11,7 @@ use ratatui::crossterm::event::{KeyEvent, MouseEvent};
 use crate::llv::lens::CameraModel;
 use crate::llv::pipeline::StageOutputs;
 use crate::llv::{GreyImage, LlvError, Params, Segment};
+use crate::session::FrameSettings;
 use crate::session::input::PipelineInput;
 
 pub use super::workers::store::StoreError;
@@ -78,6 +79,8 @@ pub enum DeviceEvent {
         purpose: FramePurpose,
         camera: u32,
         image: GreyImage,
+        /// The camera's exposure and gain for this frame (GenICam cameras).
+        settings: FrameSettings,
     },
     CaptureFailed {
         purpose: FramePurpose,
@@ -349,6 +352,8 @@ pub enum StoreCmd {
         camera: u32,
         location: u32,
         image: GreyImage,
+        /// Recorded with the image ([`crate::session::Session::save_frame`]).
+        settings: FrameSettings,
     },
     SaveOutputs {
         k: u32,

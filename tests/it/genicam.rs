@@ -221,7 +221,80 @@ fn grab_saves_whole_frames_from_the_fake_camera() {
     }
     assert!(stdout.contains("lighting b (right-front)"), "{stdout}");
     let sess = vss::session::Session::inspect(&session).expect("grab made a session");
-    assert_eq!(sess.manifest().image(1).map(|r| r.camera), Some(1));
+    let rec = sess.manifest().image(1).expect("image 1 recorded");
+    assert_eq!(rec.camera, 1);
+    // Each frame's record keeps the camera's exposure and gain.
+    assert_eq!(rec.grey.len(), 5);
+    for g in &rec.grey {
+        assert_eq!(
+            (g.exposure_us, g.gain_db),
+            (Some(10_000.0), Some(0.0)),
+            "{}",
+            g.file
+        );
+    }
+}
+
+/// The fake camera offers BayerBG8, BayerGB8, BayerGR8, BayerRG8, Mono8,
+/// RGB8 and Mono16; vss reads Mono8 and Mono16 of those. A profile that
+/// asks for a format the camera lacks, and a camera left set to one vss
+/// cannot reduce to 8 bits, are refused before any frame: the message
+/// names the camera and the formats it offers that vss can use, and no
+/// session is made.
+#[test]
+fn a_pixel_format_the_cell_cannot_use_is_named_and_nothing_is_saved() {
+    use aravis::prelude::*;
+    let _cam = FakeCamera::start("PIXFMT1", None);
+    let tmp = tempfile::tempdir().expect("tmp");
+    let session = tmp.path().join("s/gen");
+    let refused = |p: &Profile, what: &str| {
+        let out = grab(&write_profile(tmp.path(), p), &session, "a,b");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{what}: {err}");
+        for part in [
+            "camera 1 (127.0.0.1): the Aravis ",
+            "#PIXFMT1",
+            what,
+            "of the formats vss can use it offers Mono8, Mono16: set pixel_format in \
+             [[grabber.camera]] entry 1 to one of them",
+            "nothing was grabbed",
+        ] {
+            assert!(err.contains(part), "{part:?} in {err}");
+        }
+        assert!(!session.exists(), "no session made: {:?}", files(&session));
+    };
+    // Mono12 passes the profile's check (vss reads it) but this camera has
+    // none.
+    let mono12 = genicam_profile(CameraSettings {
+        pixel_format: Some("Mono12".into()),
+        ..mono8()
+    });
+    refused(&mono12, "has no pixel format Mono12");
+    // Left at Bayer by another program; the profile keeps the camera's own.
+    let camera = aravis::Camera::new(Some("127.0.0.1")).expect("the fake camera opens");
+    camera
+        .set_pixel_format_from_string("BayerRG8")
+        .expect("the fake camera takes BayerRG8");
+    drop(camera);
+    let own = genicam_profile(CameraSettings {
+        pixel_format: None,
+        ..mono8()
+    });
+    refused(
+        &own,
+        "is set to BayerRG8 pixels, which vss cannot reduce to 8-bit grey",
+    );
+    // Set to one it offers, the same camera grabs.
+    let out = grab(
+        &write_profile(tmp.path(), &genicam_profile(mono8())),
+        &session,
+        "a",
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]

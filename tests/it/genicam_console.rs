@@ -71,27 +71,33 @@ dir = "sessions"
 cameras = 1
 "#;
 
+/// Captures image `k` on the Survey screen (going beyond the plan of one
+/// image when asked) and accepts it.
+fn survey_image(c: &mut Console, k: u32) {
+    if k > 1 {
+        // One camera: one image planned; the next ones are asked for.
+        let s = c.wait(&format!("image {k} or the end of the plan"), 20, |s| {
+            s.contains(&format!("Image {k}: camera"))
+                || s.to_lowercase().contains("survey complete")
+        });
+        if !s.contains(&format!("Image {k}: camera")) {
+            c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+            c.wait_text("beyond the plan", 10);
+            c.yes();
+        }
+    }
+    c.capture_current(k);
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    c.wait_words(&format!("image {k} accepted"), 30);
+}
+
 #[test]
 fn survey_of_four_images_under_five_lightings_at_80x24() {
     let _cam = FakeCamera::start("CONSOLE1", None);
     let mut c = Console::start_with(PROFILE, 80, 24, &[], |_| {});
     c.create_session("cube");
     for k in 1..=4u32 {
-        if k > 1 {
-            // One camera: one image planned; the next ones are asked for.
-            let s = c.wait(&format!("image {k} or the end of the plan"), 20, |s| {
-                s.contains(&format!("Image {k}: camera"))
-                    || s.to_lowercase().contains("survey complete")
-            });
-            if !s.contains(&format!("Image {k}: camera")) {
-                c.press(SURVEY, Action::Survey(SurveyAction::Enter));
-                c.wait_text("beyond the plan", 10);
-                c.yes();
-            }
-        }
-        c.capture_current(k);
-        c.press(SURVEY, Action::Survey(SurveyAction::Accept));
-        c.wait_words(&format!("image {k} accepted"), 30);
+        survey_image(&mut c, k);
     }
     // Capture screen: the camera's identity, live view on, and a key
     // answered while it runs.
@@ -143,6 +149,44 @@ fn survey_of_four_images_under_five_lightings_at_80x24() {
     let sess = vss::session::Session::inspect(&d).expect("a session");
     for k in 1..=4 {
         assert_eq!(sess.manifest().image(k).map(|r| r.camera), Some(1), "{k}");
+    }
+}
+
+/// Issue 36: exposure and gain are saved in the manifest with each frame.
+/// Image 1 is taken at the profile's 10 000 µs; the exposure is then
+/// raised by key on the Capture screen (× 1.25, and the gain by 1 dB), and
+/// every frame of image 2 records the new values.
+#[test]
+fn exposure_changed_on_the_capture_screen_is_recorded_with_later_frames() {
+    let _cam = FakeCamera::start("EXPO1", None);
+    let mut c = Console::start_with(PROFILE, 80, 24, &[], |_| {});
+    c.create_session("cube");
+    survey_image(&mut c, 1);
+    c.send("2");
+    c.wait("the camera on the Capture screen", 10, |s| {
+        s.contains("exp 10000") && s.contains("gain 0.0 dB")
+    });
+    c.send("]");
+    c.wait("exposure × 1.25", 10, |s| s.contains("exp 12500"));
+    c.send("+");
+    c.wait("gain + 1 dB", 10, |s| s.contains("gain 1.0 dB"));
+    c.send("1");
+    survey_image(&mut c, 2);
+    c.send("q");
+    c.wait_exit(15);
+
+    let sess = vss::session::Session::inspect(&c.session()).expect("a session");
+    for (k, settings) in [(1, (10_000.0, 0.0)), (2, (12_500.0, 1.0))] {
+        let rec = sess.manifest().image(k).expect("image recorded");
+        assert_eq!(rec.grey.len(), 5, "image {k}");
+        for g in &rec.grey {
+            assert_eq!(
+                (g.exposure_us, g.gain_db),
+                (Some(settings.0), Some(settings.1)),
+                "{}",
+                g.file
+            );
+        }
     }
 }
 

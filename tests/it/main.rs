@@ -48,6 +48,7 @@ mod robust_inputs;
 mod robust_report;
 mod robust_session;
 mod session_api;
+mod session_big;
 mod session_cli;
 mod session_crash;
 mod session_redo;

@@ -156,6 +156,12 @@ fn grab_and_lights_against_vss_sim() {
         .collect();
     assert_eq!(letters, ['a', 'b', 'e']);
     assert_eq!(sess.manifest().image(3).map(|r| r.camera), Some(2));
+    // The serial grabber says nothing of exposure or gain: none recorded.
+    let text = std::fs::read_to_string(session.join("cube.toml")).expect("manifest");
+    assert!(
+        !text.contains("exposure_us") && !text.contains("gain_db"),
+        "{text}"
+    );
     let check = vss()
         .args(["session", "check"])
         .arg(&session)

@@ -559,6 +559,7 @@ fn capture_k(app: &mut App, k: u32) {
             purpose: FramePurpose::Survey { k, letter },
             camera: 1,
             image: square(120 + 40 * i as u8),
+            settings: Default::default(),
         }));
     }
     run(app, cmds);

@@ -178,6 +178,7 @@ pub fn reviewed_in(v: SessionView) -> App {
             purpose: FramePurpose::Survey { k: 1, letter },
             camera: 1,
             image: square(120 + 40 * i as u8),
+            settings: Default::default(),
         }));
         assert!(
             cmds.iter()

@@ -77,6 +77,7 @@ fn drive(
                     purpose,
                     camera,
                     image: images[(l as u8 - b'a') as usize].clone(),
+                    settings: Default::default(),
                 })),
                 Cmd::Device(_) => Vec::new(),
             };

@@ -97,12 +97,13 @@ impl App {
                 purpose,
                 camera,
                 image,
+                settings,
             } => {
                 dev.transfer = None;
                 dev.settling = false;
                 match purpose {
                     FramePurpose::Survey { k, letter } => {
-                        self.ctx().survey_frame(k, letter, camera, image)
+                        self.ctx().survey_frame(k, letter, camera, image, settings)
                     }
                     FramePurpose::Live => {
                         if self.chrome.screen == crate::tui::keymap::ScreenId::Calibrate {

@@ -7,6 +7,7 @@
 use super::{CellState, Ctx, Loaded, Modal, Pending, PreviewNav, PromptPurpose, Tracker};
 use crate::formats::names::MAX_SESSION_LEN;
 use crate::llv::GreyImage;
+use crate::session::FrameSettings;
 use crate::tui::event::{Cmd, DeviceCmd, FramePurpose, LoadedImage, SessionView, StoreCmd};
 use crate::tui::keymap::SurveyAction;
 
@@ -313,6 +314,7 @@ impl Ctx<'_> {
         letter: char,
         camera: u32,
         image: GreyImage,
+        settings: FrameSettings,
     ) -> Vec<Cmd> {
         let version = self.tracker.next_version();
         let accepted = self.session.accepted(k);
@@ -343,6 +345,7 @@ impl Ctx<'_> {
             camera,
             location: self.session.work.location,
             image,
+            settings,
         })];
         if self.session.work.phase == Phase::Capturing && k == self.session.work.k {
             cmds.extend(self.capture_next());

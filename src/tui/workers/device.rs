@@ -333,21 +333,25 @@ impl Worker {
             !cancel.load(Ordering::SeqCst)
         };
         let result = match lighting {
-            Some(l) => c.capture(camera, l, &mut progress).map(|cap| cap.image),
+            Some(l) => c
+                .capture(camera, l, &mut progress)
+                .map(|cap| (cap.image, cap.settings)),
             None => c
                 .grabber
                 .select_camera(camera)
                 .and_then(|_| c.grabber.freeze())
-                .and_then(|_| c.grabber.transfer(&mut progress)),
+                .and_then(|_| c.grabber.transfer(&mut progress))
+                .map(|image| (image, c.frame_settings())),
         };
         self.cancel.store(false, Ordering::SeqCst);
         match result {
-            Ok(image) => ev(
+            Ok((image, settings)) => ev(
                 &self.ui,
                 DeviceEvent::Frame {
                     purpose,
                     camera,
                     image,
+                    settings,
                 },
             ),
             Err(e) => {

@@ -17,7 +17,7 @@ use crate::llv::GreyImage;
 use crate::llv::lens::CameraModel;
 use crate::profile::Profile;
 use crate::report;
-use crate::session::{CheckReport, Session, SessionError};
+use crate::session::{CheckReport, FrameSettings, Session, SessionError};
 use crate::tui::event::{Msg, SessionEntry, StoreCmd, StoreEvent};
 
 mod load;
@@ -217,6 +217,7 @@ impl Store {
         camera: u32,
         location: u32,
         image: GreyImage,
+        settings: FrameSettings,
     ) -> Result<String, StoreError> {
         // The camera's description as the profile serves it (built in or a
         // file), recorded as the image's NAMEk.cdf; a problem with it is
@@ -236,7 +237,7 @@ impl Store {
         }
         let file = s.file_name(k, Some(letter), "img");
         let stem = file.trim_end_matches(".img").to_string();
-        s.save_image(k, letter, &ImgFile::new(image).with_comment(stem))
+        s.save_frame(k, letter, &ImgFile::new(image).with_comment(stem), settings)
             .map_err(session_err(what))?;
         Ok(file)
     }
@@ -303,7 +304,8 @@ impl Store {
                 camera,
                 location,
                 image,
-            } => match self.save_frame(k, letter, camera, location, image) {
+                settings,
+            } => match self.save_frame(k, letter, camera, location, image, settings) {
                 Ok(file) => {
                     self.forget_problems(std::slice::from_ref(&file));
                     self.reply(StoreEvent::Saved(file));
