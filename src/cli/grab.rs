@@ -124,6 +124,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     for (letter, _) in &files {
         cell.mask_for(*letter)?;
     }
+    cell.grabber.check_camera(a.camera)?;
     let mut sess = match existing {
         Some(s) => s,
         None => Session::create(&parent, session.as_str(), &profile)

@@ -554,6 +554,10 @@ impl FrameGrabber for GenicamGrabber {
         Ok(f)
     }
 
+    fn check_camera(&mut self, cam: u32) -> Result<(), RigError> {
+        self.opened(cam).map(|_| ())
+    }
+
     fn select_camera(&mut self, cam: u32) -> Result<(), RigError> {
         self.opened(cam)?;
         if cam != self.current {

@@ -30,6 +30,13 @@ pub trait FrameGrabber: Send {
     fn freeze(&mut self) -> Result<FrameInfo, RigError>;
     /// 3: select camera `cam` (1-based).
     fn select_camera(&mut self, cam: u32) -> Result<(), RigError>;
+    /// Checks, before anything is saved, that camera `cam` can deliver
+    /// frames the cell uses. A GenICam camera is opened and its pixel
+    /// format checked; a serial grabber's cameras need nothing beyond
+    /// their count, which the caller checks from [`FrameGrabber::hello`].
+    fn check_camera(&mut self, _cam: u32) -> Result<(), RigError> {
+        Ok(())
+    }
     /// 4: load an image into the grabber's memory.
     fn load(&mut self, img: &GreyImage) -> Result<(), RigError>;
     /// 5: transfer the frozen frame to the PC. `progress(done, total)` is

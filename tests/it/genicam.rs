@@ -136,13 +136,17 @@ fn write_profile(dir: &Path, p: &Profile) -> PathBuf {
 }
 
 fn grab(profile: &Path, session: &Path, lighting: &str) -> Output {
+    grab_camera(profile, session, lighting, "1")
+}
+
+fn grab_camera(profile: &Path, session: &Path, lighting: &str, camera: &str) -> Output {
     Command::new(cargo_bin("vss"))
         .arg("--profile")
         .arg(profile)
         .args([
             "grab",
             "--camera",
-            "1",
+            camera,
             "--lighting",
             lighting,
             "--image",
@@ -284,6 +288,23 @@ fn a_pixel_format_the_cell_cannot_use_is_named_and_nothing_is_saved() {
         &own,
         "is set to BayerRG8 pixels, which vss cannot reduce to 8-bit grey",
     );
+    // Camera 2 of a cell is checked before the session is made too (it is
+    // opened only when first used).
+    let mut two = genicam_profile(mono8());
+    // The same fake camera by its device id (a second entry may not
+    // repeat the address).
+    two.grabber.cameras.push("Aravis-Fake-PIXFMT1".into());
+    two.grabber.camera.push(CameraSettings {
+        pixel_format: Some("Mono12".into()),
+        ..mono8()
+    });
+    two.survey.cameras = 2;
+    let out = grab_camera(&write_profile(tmp.path(), &two), &session, "a", "2");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("camera 2 (Aravis-Fake-PIXFMT1): "), "{err}");
+    assert!(err.contains("has no pixel format Mono12"), "{err}");
+    assert!(!session.exists(), "no session made: {:?}", files(&session));
     // Set to one it offers, the same camera grabs.
     let out = grab(
         &write_profile(tmp.path(), &genicam_profile(mono8())),
