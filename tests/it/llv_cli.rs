@@ -298,15 +298,11 @@ fn llv_of_the_largest_picture_holds_one_direction_at_a_time() {
     write_img(&dir.path().join("max1.img"), &img).unwrap();
     drop(img);
     let limit_kib = 5 * (side * side) as u64 / 1024;
-    let o = std::process::Command::new("sh")
-        .arg("-c")
-        .arg(format!("ulimit -v {limit_kib} && exec \"$@\""))
-        .arg("sh")
-        .arg(assert_cmd::cargo::cargo_bin("vss"))
-        .args(["llv", "--json", "max1.img"])
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
+    let o = crate::support::limited::vss_under(
+        dir.path(),
+        &format!("ulimit -v {limit_kib}"),
+        ["llv", "--json", "max1.img"],
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
         o.status.success(),

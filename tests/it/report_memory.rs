@@ -22,15 +22,7 @@ use vss::session::{OutputSet, Session};
 /// Runs `vss ARGS` in `cwd` after the shell commands `limits` (`ulimit …`,
 /// `trap …`); returns its output.
 fn vss_with(cwd: &Path, limits: &str, args: &[&str]) -> Output {
-    std::process::Command::new("sh")
-        .arg("-c")
-        .arg(format!("{limits} && exec \"$@\""))
-        .arg("sh")
-        .arg(assert_cmd::cargo::cargo_bin("vss"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("run vss")
+    crate::support::limited::vss_under(cwd, limits, args)
 }
 
 fn text(o: &Output) -> String {

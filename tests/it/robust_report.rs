@@ -14,15 +14,7 @@ use std::process::Output;
 /// sweep did, so an allocation from an unchecked size fails fast instead of
 /// filling the machine's memory.
 fn vss_limited(cwd: &Path, args: &[&str]) -> Output {
-    std::process::Command::new("sh")
-        .arg("-c")
-        .arg("ulimit -v 4000000 && exec \"$@\"")
-        .arg("sh")
-        .arg(assert_cmd::cargo::cargo_bin("vss"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .unwrap()
+    crate::support::limited::vss_under(cwd, "ulimit -v 4000000", args)
 }
 
 /// Asserts that `vss` ended normally and successfully: no abort (killed by a

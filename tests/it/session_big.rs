@@ -10,8 +10,9 @@
 //! and kept, to measure by hand: `/usr/bin/time -v target/debug/vss
 //! session show DIR/r4`.
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use vss::llv::Params;
 use vss::session::Manifest;
@@ -161,15 +162,8 @@ fn big_session(root: &Path, name: &str) -> (PathBuf, u32, String) {
 
 /// `vss session show DIR` with at most `mib` MiB of address space.
 fn show(dir: &Path, mib: u64) -> Output {
-    Command::new("sh")
-        .arg("-c")
-        .arg(format!("ulimit -v {} && exec \"$@\"", mib * 1024))
-        .arg("sh")
-        .arg(assert_cmd::cargo::cargo_bin("vss"))
-        .args(["session", "show"])
-        .arg(dir)
-        .output()
-        .expect("run vss")
+    let args = [OsStr::new("session"), OsStr::new("show"), dir.as_os_str()];
+    crate::support::limited::vss_under(dir, &format!("ulimit -v {}", mib * 1024), args)
 }
 
 fn text_of(o: &Output) -> String {
