@@ -200,13 +200,7 @@ pub const CONTRAST_REACH: f64 = 2.0;
 pub fn contrast(img: &GreyImage, s: &Segment) -> Option<f64> {
     let s = usable(s)?;
     let (nx, ny) = (-(s.b.y - s.a.y) / s.len, (s.b.x - s.a.x) / s.len);
-    let at = |x: f64, y: f64| -> Option<f64> {
-        let (x, y) = (x.round(), y.round());
-        (x >= 0.0 && y >= 0.0)
-            .then(|| img.get(x as usize, y as usize))
-            .flatten()
-            .map(f64::from)
-    };
+    let at = |x, y| nearest(img, x, y);
     let n = s.len.ceil().max(1.0);
     let mut d: Vec<f64> = (0..n as usize)
         .filter_map(|k| {
@@ -221,6 +215,15 @@ pub fn contrast(img: &GreyImage, s: &Segment) -> Option<f64> {
     }
     let mid = d.len() / 2;
     Some(*d.select_nth_unstable_by(mid, f64::total_cmp).1)
+}
+
+/// The grey level of the pixel nearest `(x, y)`; `None` outside `img`.
+fn nearest(img: &GreyImage, x: f64, y: f64) -> Option<f64> {
+    let (x, y) = (x.round(), y.round());
+    (x >= 0.0 && y >= 0.0)
+        .then(|| img.get(x as usize, y as usize))
+        .flatten()
+        .map(f64::from)
 }
 
 /// Upper bounds (grey levels a pixel) of the edge-slope classes of
@@ -249,12 +252,8 @@ pub fn edge_slope(img: &GreyImage, s: &Segment) -> Option<f64> {
         let (x, y) = (s.a.x + (s.b.x - s.a.x) * t, s.a.y + (s.b.y - s.a.y) * t);
         for (j, v) in p.iter_mut().enumerate() {
             let o = j as f64 - R as f64;
-            let (u, w) = ((x + o * nx).round(), (y + o * ny).round());
-            match (u >= 0.0 && w >= 0.0)
-                .then(|| img.get(u as usize, w as usize))
-                .flatten()
-            {
-                Some(g) => *v = f64::from(g),
+            match nearest(img, x + o * nx, y + o * ny) {
+                Some(g) => *v = g,
                 None => continue 'sample,
             }
         }
