@@ -154,6 +154,7 @@ fn main() {
             sy: 0.0083 * scale,
             f: 8.5,
             distortion: Some([-1.2e-3, 1.0e-4, -8.0e-5, 5.0e-5, 2.0e-5]),
+            radial: [0.0; 2],
         },
         size,
         size,

@@ -88,7 +88,7 @@ pub enum CalibError {
     NoPlace(String),
 }
 
-/// The `.cdf` with a new intrinsic calibration: `f`, `D` calibrated (`A`),
+/// The `.cdf` with a new intrinsic calibration: `f`, `D`, `K` calibrated (`A`),
 /// `C` too unless it was stated (`S`), `S` stated or, when its ratio was
 /// estimated, `A`. Every other
 /// entry of `old` (its `T`, unknown names) is kept in its place.
@@ -115,6 +115,7 @@ pub fn cdf_with_intrinsics(old: Option<&Cdf>, c: &Calibration) -> Cdf {
         ),
         ("f", Status::Calibrated, col(&[m.f])),
         ("D", Status::Calibrated, col(&d)),
+        ("K", Status::Calibrated, col(&m.radial)),
     ] {
         cdf.set(CdfParam {
             name: name.into(),
@@ -299,7 +300,7 @@ pub fn parameter_lines(c: &Calibration, pm: &str) -> Vec<String> {
         ));
     }
     if !c.full_model && !c.fixed.iter().any(|p| p.name == "s1") {
-        t.push("s1, s2     0 (thin prism not estimated; --model full)".into());
+        t.push("s1, s2, k3 0 (not estimated; --model full)".into());
     }
     if c.centre_stated {
         t.push(format!("C (stated) {:.3} {:.3} px", c.model.cx, c.model.cy));

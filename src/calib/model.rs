@@ -15,17 +15,26 @@ use nalgebra::{Matrix2, Rotation3, SMatrix, Vector2, Vector3};
 use crate::llv::lens::CameraModel;
 
 /// Intrinsic parameters in the solver's order: `Cx, Cy, f`, the radial
-/// `k1`, Weng's decentering `p1, p2` and thin prism `s1, s2`, then `sy`
-/// when the scale is estimated.
+/// `k1`, Weng's decentering `p1, p2` and thin prism `s1, s2`, the higher
+/// radial `k2, k3` (`.cdf` `K`), then `sy` when the scale is estimated.
 ///
 /// The `.cdf` stores Weng's folded terms (lens.md): `g1 = p1 + s1`,
 /// `g2 = p2 + s2`, `g3 = 2 p1`, `g4 = 2 p2`. The solver works with the
 /// unfolded ones so that the thin prism can be left out (fixed at zero)
 /// without touching the decentering: see `docs/calibration.md`.
-pub const INTRINSIC_NAMES: [&str; 9] = ["Cx", "Cy", "f", "k1", "p1", "p2", "s1", "s2", "sy"];
+pub const INTRINSIC_NAMES: [&str; N_INTRINSICS] = [
+    "Cx", "Cy", "f", "k1", "p1", "p2", "s1", "s2", "k2", "k3", "sy",
+];
 
-/// Index of the first thin-prism term in [`INTRINSIC_NAMES`].
-pub const THIN_PRISM: [usize; 2] = [6, 7];
+/// How many intrinsics the solver knows.
+pub const N_INTRINSICS: usize = 11;
+
+/// Indices in [`INTRINSIC_NAMES`] of the terms only the full model
+/// estimates: the thin prism `s1, s2` and the radial `k3`.
+pub const FULL_ONLY: [usize; 3] = [6, 7, 9];
+
+/// Index of `sy` in [`INTRINSIC_NAMES`].
+pub const SY: usize = 10;
 
 /// Weng's folded `D = (k1, g1, g2, g3, g4)` from `(k1, p1, p2, s1, s2)`.
 pub fn fold(k1: f64, p1: f64, p2: f64, s1: f64, s2: f64) -> [f64; 5] {
@@ -77,15 +86,16 @@ pub struct Projection {
     /// Observed position (px).
     pub px: Vector2<f64>,
     /// By the intrinsics, in [`INTRINSIC_NAMES`] order.
-    pub d_intrinsics: SMatrix<f64, 2, 9>,
+    pub d_intrinsics: SMatrix<f64, 2, N_INTRINSICS>,
     /// By the pose: rotation vector, then translation.
     pub d_pose: SMatrix<f64, 2, 6>,
 }
 
 /// The intrinsics as the solver's vector (`sy` last).
-pub fn intrinsics_vector(m: &CameraModel) -> [f64; 9] {
+pub fn intrinsics_vector(m: &CameraModel) -> [f64; N_INTRINSICS] {
     let d = unfold(&m.distortion.unwrap_or([0.0; 5]));
-    [m.cx, m.cy, m.f, d[0], d[1], d[2], d[3], d[4], m.sy]
+    let [k2, k3] = m.radial;
+    [m.cx, m.cy, m.f, d[0], d[1], d[2], d[3], d[4], k2, k3, m.sy]
 }
 
 /// A camera from the solver's vector (`sx` kept from `base`).
@@ -96,8 +106,9 @@ pub fn model_from(v: &[f64], base: &CameraModel, estimate_sy: bool) -> CameraMod
         cy: g(1),
         f: g(2),
         distortion: Some(fold(g(3), g(4), g(5), g(6), g(7))),
+        radial: [g(8), g(9)],
         sx: base.sx,
-        sy: if estimate_sy { g(8) } else { base.sy },
+        sy: if estimate_sy { g(SY) } else { base.sy },
     }
 }
 
@@ -161,24 +172,26 @@ pub fn project(m: &CameraModel, pose: &Pose, x: &Vector3<f64>) -> Option<Project
         .fixed_view_mut::<2, 3>(0, 0)
         .copy_from(&(ap * dp_dq * dq_dw));
     d_pose.fixed_view_mut::<2, 3>(0, 3).copy_from(&(ap * dp_dq));
-    let mut d_intrinsics = SMatrix::<f64, 2, 9>::zeros();
+    let mut d_intrinsics = SMatrix::<f64, 2, N_INTRINSICS>::zeros();
     d_intrinsics[(0, 0)] = 1.0;
     d_intrinsics[(1, 1)] = 1.0;
     d_intrinsics
         .fixed_view_mut::<2, 1>(0, 2)
         .copy_from(&(ap * (p / m.f)));
-    // By (k1, p1, p2, s1, s2) through the folding g = fold(k1, p1, p2, s1, s2).
-    let jd = SMatrix::<f64, 2, 5>::from_fn(|i, j| match j {
+    // By (k1, p1, p2, s1, s2) through the folding g = fold(k1, p1, p2, s1, s2),
+    // then by k2, k3.
+    let jd = SMatrix::<f64, 2, 7>::from_fn(|i, j| match j {
         0 => by_d[i][0],
         1 => by_d[i][1] + 2.0 * by_d[i][3],
         2 => by_d[i][2] + 2.0 * by_d[i][4],
         3 => by_d[i][1],
-        _ => by_d[i][2],
+        4 => by_d[i][2],
+        _ => by_d[i][j],
     });
     d_intrinsics
-        .fixed_view_mut::<2, 5>(0, 3)
+        .fixed_view_mut::<2, 7>(0, 3)
         .copy_from(&(ap * jd));
-    d_intrinsics[(1, 8)] = -wv / (m.sy * m.sy);
+    d_intrinsics[(1, SY)] = -wv / (m.sy * m.sy);
     Some(Projection {
         px: Vector2::new(ox, oy),
         d_intrinsics,
@@ -198,6 +211,7 @@ mod tests {
             sy: 0.0078,
             f: 12.1,
             distortion: Some([-0.00049, -0.0002, 0.00076, 0.00034, -0.00064]),
+            radial: [2.0e-5, -3.0e-7],
         }
     }
 
@@ -211,7 +225,7 @@ mod tests {
         let x = Vector3::new(120.0, 90.0, 0.0);
         let pr = project(&m, &pose, &x).unwrap();
         let base = intrinsics_vector(&m);
-        for k in 0..9 {
+        for k in 0..N_INTRINSICS {
             let h = (base[k].abs() * 1e-6).max(1e-9);
             let mut v = base;
             v[k] += h;

@@ -53,8 +53,9 @@ pub struct Args {
     /// values allowed), or `image` for the image's middle.
     #[arg(long, value_name = "X,Y|image", allow_hyphen_values = true)]
     pub centre: Option<String>,
-    /// The distortion model: `default` (radial k1, decentering p1 p2) or
-    /// `full` (also Weng's thin prism s1 s2, which trades off with C).
+    /// The distortion model: `default` (radial k1 k2, decentering p1 p2) or
+    /// `full` (also radial k3 and Weng's thin prism s1 s2, which trades off
+    /// with C).
     #[arg(long, value_enum, default_value_t = Model::Default)]
     pub model: Model,
     /// Replace the intrinsics of an existing --out file.
@@ -72,9 +73,9 @@ pub struct Args {
 /// Which distortion terms are estimated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Model {
-    /// Radial k1 and decentering p1, p2 (what real lenses pin down).
+    /// Radial k1, k2 and decentering p1, p2 (what real lenses pin down).
     Default,
-    /// Also the thin prism s1, s2.
+    /// Also radial k3 and the thin prism s1, s2.
     Full,
 }
 
@@ -224,7 +225,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     }
     let bak = calib::write_intrinsics(&out, &c)?;
     outln!(
-        "wrote {}: C{} f D calibrated, S {}{}",
+        "wrote {}: C{} f, D, K calibrated, S {}{}",
         out.display(),
         if centre.is_some() { " stated," } else { "," },
         if c.scale_estimated {

@@ -91,6 +91,7 @@ pub fn known_shape(name: &str) -> Option<(usize, usize)> {
         "S" | "C" => (2, 1),
         "f" => (1, 1),
         "D" => (5, 1),
+        "K" => (2, 1),
         "T" => (3, 4),
         _ => return None,
     })
@@ -119,7 +120,8 @@ impl Cdf {
     }
 
     /// The intrinsic camera model: `None` if `S`, `C` or `f` is missing or
-    /// `N`. `D` missing or `N` gives no distortion.
+    /// `N`. `D` missing or `N` gives no distortion; `K` missing or `N`, no
+    /// higher radial terms.
     pub fn camera_model(&self) -> Option<CameraModel> {
         let s = self.available("S")?;
         let c = self.available("C")?;
@@ -134,6 +136,10 @@ impl Cdf {
             sy: *s.get(1)?,
             f: *f.first()?,
             distortion: d,
+            radial: self
+                .available("K")
+                .and_then(|k| <[f64; 2]>::try_from(k).ok())
+                .unwrap_or([0.0; 2]),
         })
     }
 
@@ -160,7 +166,7 @@ impl Cdf {
             Some(t) => (a, t),
             None => (Status::NotAvailable, [[0.0; 4]; 3]),
         };
-        Cdf {
+        let mut cdf = Cdf {
             params: vec![
                 CdfParam {
                     name: "S".into(),
@@ -188,7 +194,20 @@ impl Cdf {
                     rows: tm.iter().map(|r| r.to_vec()).collect(),
                 },
             ],
+        };
+        // `K` only where it says something: a camera of `k1` alone keeps
+        // the 1994 file's five parameters.
+        if m.distortion.is_some() && m.radial != [0.0; 2] {
+            cdf.params.insert(
+                4,
+                CdfParam {
+                    name: "K".into(),
+                    status: a,
+                    rows: col(&m.radial),
+                },
+            );
         }
+        cdf
     }
 }
 
@@ -396,7 +415,7 @@ pub fn check_camera_area(
             super::Location::None,
             K::Range,
             format!(
-                "C, S, D: lens correction of a {width} × {height} image with this camera model \
+                "C, S, D, K: lens correction of a {width} × {height} image with this camera model \
                  leaves {:.0} % of it with pixels (at least {:.0} % are needed): check the \
                  image centre, the scale factors and the distortion coefficients",
                 share * 100.0,
@@ -506,5 +525,32 @@ D=A\n-0.000527\n0.000379\n0.001330\n-0.000703\n-0.001406\nT=A\n\
         let d = Cdf::from_camera(&m, c.extrinsic());
         assert_eq!(d.camera_model(), Some(m));
         assert_eq!(d.extrinsic(), c.extrinsic());
+        // The spec's example has no `K`: no higher radial terms, and none
+        // written back.
+        assert_eq!(m.radial, [0.0; 2]);
+        assert!(d.get("K").is_none());
+    }
+
+    #[test]
+    fn k_holds_the_higher_radial_terms() {
+        let c = parse_cdf(SPEC, Path::new("cam1.cdf")).unwrap();
+        let m = CameraModel {
+            radial: [2.5e-5, -1.0e-7],
+            ..c.camera_model().unwrap()
+        };
+        let text = format_cdf(&Cdf::from_camera(&m, c.extrinsic()));
+        assert!(text.contains("K=A\n0.000025"), "{text}");
+        let back = parse_cdf(&text, Path::new("k.cdf")).unwrap();
+        assert_eq!(back.camera_model(), Some(m));
+        // `K=N` means none; a `K` of the wrong shape is refused.
+        let n = text.replace("K=A", "K=N");
+        let back = parse_cdf(&n, Path::new("n.cdf")).unwrap();
+        assert_eq!(back.camera_model().unwrap().radial, [0.0; 2]);
+        let short = text.replace("\n-0.0000001\n", "\n");
+        assert_ne!(short, text);
+        let e = parse_cdf(&short, Path::new("s.cdf"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("s.cdf") && e.contains('K'), "{e}");
     }
 }

@@ -1,5 +1,8 @@
-//! Lens correction (spec/lens.md): Weng's camera model with one radial and
-//! the folded decentering/thin-prism terms, in millimetres on the image plane.
+//! Lens correction (spec/lens.md): Weng's camera model with the radial
+//! and the folded decentering/thin-prism terms, in millimetres on the image
+//! plane. Beside the spec's one radial term `k1` (`.cdf` `D`), the model has
+//! the `r⁴` and `r⁶` terms `k2, k3` (`.cdf` `K`, zero when absent): a real
+//! lens's radial distortion is not one power of `r` (docs/calibration.md).
 //!
 //! The undistortion map ([`LensMap`]: for every pixel of the corrected image,
 //! where it was observed) depends only on the camera and the image size, so
@@ -32,6 +35,10 @@ pub struct CameraModel {
     /// Distortion `(k1, g1, g2, g3, g4)`; `None` when the `.cdf` says `N`
     /// (lens correction is then the identity).
     pub distortion: Option<[f64; 5]>,
+    /// The higher radial terms `(k2, k3)` of `r⁴` and `r⁶` (`.cdf` `K`;
+    /// zeros when the file has none). They apply only with `distortion`.
+    #[serde(default)]
+    pub radial: [f64; 2],
 }
 
 impl CameraModel {
@@ -50,31 +57,38 @@ impl CameraModel {
         let Some([k1, g1, g2, g3, g4]) = self.distortion else {
             return (0.0, 0.0);
         };
+        let [k2, k3] = self.radial;
         let r2 = u * u + v * v;
-        let du = (g1 + g3) * u * u + g4 * u * v + g1 * v * v + k1 * u * r2;
-        let dv = g2 * u * u + g3 * u * v + (g2 + g4) * v * v + k1 * v * r2;
+        let k = k1 * r2 + (k2 + k3 * r2) * r2 * r2;
+        let du = (g1 + g3) * u * u + g4 * u * v + g1 * v * v + k * u;
+        let dv = g2 * u * u + g3 * u * v + (g2 + g4) * v * v + k * v;
         (du, dv)
     }
 
     /// The derivatives of [`delta`](Self::delta) at `(u, v)`: by `(u, v)`
     /// (`[[∂δu/∂u, ∂δu/∂v], [∂δv/∂u, ∂δv/∂v]]`) and by the coefficients
-    /// `(k1, g1, g2, g3, g4)`, for the calibration's solver (`crate::calib`).
-    pub fn delta_derivatives(&self, u: f64, v: f64) -> ([[f64; 2]; 2], [[f64; 5]; 2]) {
+    /// `(k1, g1, g2, g3, g4, k2, k3)`, for the calibration's solver.
+    pub fn delta_derivatives(&self, u: f64, v: f64) -> ([[f64; 2]; 2], [[f64; 7]; 2]) {
         let [k1, g1, g2, g3, g4] = self.distortion.unwrap_or([0.0; 5]);
+        let [k2, k3] = self.radial;
         let r2 = u * u + v * v;
+        let (r4, r6) = (r2 * r2, r2 * r2 * r2);
+        // The radial factor k(r²) and its derivative by r².
+        let k = k1 * r2 + k2 * r4 + k3 * r6;
+        let dk = k1 + 2.0 * k2 * r2 + 3.0 * k3 * r4;
         let by_uv = [
             [
-                2.0 * (g1 + g3) * u + g4 * v + k1 * (r2 + 2.0 * u * u),
-                g4 * u + 2.0 * g1 * v + 2.0 * k1 * u * v,
+                2.0 * (g1 + g3) * u + g4 * v + k + 2.0 * dk * u * u,
+                g4 * u + 2.0 * g1 * v + 2.0 * dk * u * v,
             ],
             [
-                2.0 * g2 * u + g3 * v + 2.0 * k1 * u * v,
-                g3 * u + 2.0 * (g2 + g4) * v + k1 * (r2 + 2.0 * v * v),
+                2.0 * g2 * u + g3 * v + 2.0 * dk * u * v,
+                g3 * u + 2.0 * (g2 + g4) * v + k + 2.0 * dk * v * v,
             ],
         ];
         let by_d = [
-            [u * r2, r2, 0.0, u * u, u * v],
-            [v * r2, 0.0, r2, u * v, v * v],
+            [u * r2, r2, 0.0, u * u, u * v, u * r4, u * r6],
+            [v * r2, 0.0, r2, u * v, v * v, v * r4, v * r6],
         ];
         (by_uv, by_d)
     }
@@ -124,7 +138,8 @@ impl CameraModel {
 
     /// True when lens correction would change nothing.
     pub fn is_identity(&self) -> bool {
-        self.distortion.is_none_or(|d| d.iter().all(|&c| c == 0.0))
+        self.distortion
+            .is_none_or(|d| d.iter().chain(&self.radial).all(|&c| c == 0.0))
     }
 }
 
@@ -197,6 +212,7 @@ mod tests {
             sy: 0.0083,
             f: 8.5,
             distortion: Some([-2.0e-3, 2.0e-4, -1.5e-4, 1.0e-4, 5.0e-5]),
+            radial: [3.0e-5, -2.0e-7],
         }
     }
 

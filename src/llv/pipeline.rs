@@ -710,6 +710,7 @@ mod tests {
             sy: 0.01,
             f: 8.0,
             distortion: Some([-0.02, 0.0, 0.0, 0.0, 0.0]),
+            radial: [0.0; 2],
         };
         let map = LensMap::new(&model, 96, 80);
         let input = Input {

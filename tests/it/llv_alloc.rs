@@ -79,6 +79,7 @@ fn camera(n: usize) -> LensMap {
         // Pincushion: the corners sample outside the grabbed image, so the
         // corrected images carry a validity mask (whose buffer is reused).
         distortion: Some([1.2e-3, 1.0e-4, -8.0e-5, 5.0e-5, 2.0e-5]),
+        radial: [0.0; 2],
     };
     LensMap::new(&m, n, n)
 }

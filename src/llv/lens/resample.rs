@@ -366,6 +366,7 @@ mod tests {
             sy: 0.0083 * s,
             f: 8.5,
             distortion: Some([c(3e-3), c(3e-4), c(3e-4), c(2e-4), c(2e-4)]),
+            radial: [0.0; 2],
         }
     }
 

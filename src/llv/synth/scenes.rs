@@ -52,6 +52,7 @@ fn model(w: usize, h: usize, f: f64, dc: (f64, f64), d: Option<[f64; 5]>) -> Cam
         sy: 0.0078 * 512.0 / h.max(1) as f64,
         f,
         distortion: d,
+        radial: [0.0; 2],
     }
 }
 

@@ -450,6 +450,7 @@ pub fn scene(index: usize, size: usize, seed: u64) -> YardScene {
         sy: sx,
         f: 8.0,
         distortion: Some([k1, g[0], g[1], g[2], g[3]]),
+        radial: [0.0; 2],
     };
     let light = Light {
         spot: (r.range(0.2, 0.8) * w, r.range(0.2, 0.8) * w),

@@ -60,6 +60,7 @@ fn hand_made() -> YardScene {
             sy: 0.08,
             f: 8.0,
             distortion: Some([1e-3, 0.0, 0.0, 0.0, 0.0]),
+            radial: [0.0; 2],
         },
         kinds: vec!["hand-made"],
     }
