@@ -30,6 +30,7 @@
 
 pub mod detect;
 pub mod extrinsic;
+pub mod found;
 mod lm;
 pub mod model;
 pub mod plate;
@@ -40,7 +41,8 @@ mod zhang;
 
 use std::path::Path;
 
-pub use detect::{Corner, DetectError, Detection, Detector};
+pub use detect::Detector;
+pub use found::{Corner, DetectError, Detection};
 pub use plate::{Plate, PlateError, PlateKind};
 pub use solve::{
     CENTRE_SE, COVERAGE, Calibration, CrossCheck, Estimate, FEW_VIEWS, Options, PARALLEL_DEPTH,

@@ -31,7 +31,7 @@ use std::collections::{HashMap, VecDeque};
 
 use nalgebra::Matrix3;
 
-use super::detect::{Corner, DetectError, Detection};
+use super::found::{Corner, DetectError, Detection, MAX_EDGE_WIDTH};
 use super::plate::{Plate, PlateCorner};
 use super::zhang;
 use crate::llv::GreyImage;
@@ -50,8 +50,6 @@ const MIN_CONTRAST: f64 = 12.0;
 /// shadow with a quarter of the contrast has a sixteenth; the saddles noise
 /// and JPEG blocks leave along a side are about a fiftieth).
 const WEAK: f32 = 0.05;
-/// Edges wider than this (px, 10–90 % of the step) make a blurred board.
-pub const MAX_EDGE_WIDTH: f64 = 6.0;
 
 /// One candidate: position (px) and response.
 #[derive(Clone, Copy, Debug)]

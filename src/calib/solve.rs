@@ -21,7 +21,7 @@
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use super::CalibError;
-use super::detect::Corner;
+use super::found::Corner;
 use super::lm::{self, Normal as _};
 use super::model::{self, FULL_ONLY, INTRINSIC_NAMES, N_INTRINSICS, Pose, SY};
 use super::zhang;

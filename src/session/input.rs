@@ -393,7 +393,7 @@ impl Session {
         let set = OutputSet {
             lines_raw: (from == Stage::Lines).then_some(out.lines_raw.as_slice()),
             lines: Some(&out.lines),
-            timings: super::redo::timings(&out.timings),
+            timings: super::manifest::TimingsRecord::from(&out.timings),
             ..Default::default()
         };
         self.save_output_set(k, &set, params)

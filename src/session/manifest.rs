@@ -216,6 +216,17 @@ pub struct TimingsRecord {
     pub connect_us: u64,
 }
 
+impl From<&crate::llv::pipeline::Timings> for TimingsRecord {
+    fn from(t: &crate::llv::pipeline::Timings) -> Self {
+        TimingsRecord {
+            lens_us: t.lens_us,
+            edges_us: t.edges_us,
+            lines_us: t.lines_us,
+            connect_us: t.connect_us,
+        }
+    }
+}
+
 /// Per-line attributes in file order: mean response, RMS residual, and the
 /// indices (0-based) of the lines flagged as shadows.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]

@@ -18,7 +18,7 @@ use super::manifest::{Counts, TimingsRecord};
 use super::{OutputSet, Session, SessionError};
 use crate::llv::edit::EditOp;
 use crate::llv::params::Stage;
-use crate::llv::pipeline::{StageOutputs, Timings};
+use crate::llv::pipeline::StageOutputs;
 use crate::llv::{Params, Segment};
 
 /// What a redo did.
@@ -58,15 +58,6 @@ impl fmt::Display for RedoSummary {
     }
 }
 
-pub(super) fn timings(t: &Timings) -> TimingsRecord {
-    TimingsRecord {
-        lens_us: t.lens_us,
-        edges_us: t.edges_us,
-        lines_us: t.lines_us,
-        connect_us: t.connect_us,
-    }
-}
-
 /// How an edit reads in the log: `connect 3 7`, `extend 1 2`, `delete 4 5`.
 pub fn describe(op: &EditOp) -> String {
     match op {
@@ -96,7 +87,7 @@ impl Session {
             edges_v: Some(&out.edges_v),
             lines_raw: Some(&out.lines_raw),
             lines: Some(&out.lines),
-            timings: timings(&out.timings),
+            timings: TimingsRecord::from(&out.timings),
         };
         self.save_output_set(k, &set, params)
     }
