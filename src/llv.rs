@@ -19,6 +19,7 @@ pub mod params;
 pub mod photometric;
 pub mod pipeline;
 pub mod refine;
+pub mod rng;
 pub mod shadow;
 pub mod synth;
 

@@ -58,7 +58,7 @@ impl CameraModel {
 
     /// The derivatives of [`delta`](Self::delta) at `(u, v)`: by `(u, v)`
     /// (`[[∂δu/∂u, ∂δu/∂v], [∂δv/∂u, ∂δv/∂v]]`) and by the coefficients
-    /// `(k1, g1, g2, g3, g4)`, for the calibration's solver (`crate::calib`).
+    /// `(k1, g1, g2, g3, g4)`, for the calibration's solver (`vss::calib`).
     pub fn delta_derivatives(&self, u: f64, v: f64) -> ([[f64; 2]; 2], [[f64; 5]; 2]) {
         let [k1, g1, g2, g3, g4] = self.distortion.unwrap_or([0.0; 5]);
         let r2 = u * u + v * v;

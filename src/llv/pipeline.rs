@@ -35,12 +35,6 @@ pub struct Timings {
     pub connect_us: u64,
 }
 
-impl Timings {
-    pub fn total_us(&self) -> u64 {
-        self.lens_us + self.edges_us + self.lines_us + self.connect_us
-    }
-}
-
 /// Everything one run produced.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StageOutputs {
@@ -598,22 +592,6 @@ fn check_input(input: &Input) -> Result<(usize, usize), LlvError> {
         });
     }
     Ok(size)
-}
-
-/// Line extraction and CONNECT from saved edge points alone (`vss llv
-/// --from-edges`): the outputs have no images or responses.
-pub fn lines_from_edges(edges_h: EdgePoints, edges_v: EdgePoints, p: &Params) -> StageOutputs {
-    let mut ws = Workspace::new();
-    // Without images nothing can fail.
-    let _ = ws.run_saved(
-        Saved::Edges {
-            h: edges_h,
-            v: edges_v,
-        },
-        p,
-        None,
-    );
-    ws.take_outputs()
 }
 
 /// Runs the whole pipeline once (a fresh [`Workspace`]).

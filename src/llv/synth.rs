@@ -19,7 +19,6 @@ mod geom;
 mod raster;
 pub mod real;
 mod render;
-pub mod rng;
 mod scenes;
 mod score;
 pub mod straight;

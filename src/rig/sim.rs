@@ -17,7 +17,7 @@ use std::thread::JoinHandle;
 use serialport::TTYPort;
 
 use super::RigError;
-use crate::llv::synth::rng::SplitMix64;
+use crate::llv::rng::SplitMix64;
 use crate::profile::Profile;
 
 mod board;

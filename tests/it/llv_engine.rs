@@ -5,7 +5,7 @@
 //! number; and two threads give what one does.
 
 use vss::llv::pipeline::{self, Input, StageOutputs};
-use vss::llv::synth::rng::SplitMix64;
+use vss::llv::rng::SplitMix64;
 use vss::llv::{GreyImage, Params};
 
 fn image(w: usize, h: usize, f: impl Fn(usize, usize) -> f64) -> GreyImage {

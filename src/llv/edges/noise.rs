@@ -273,7 +273,7 @@ fn median_bin(hist: &[u16], n: usize) -> f32 {
 mod tests {
     use super::*;
     use crate::llv::edges::response;
-    use crate::llv::synth::rng::SplitMix64;
+    use crate::llv::rng::SplitMix64;
     use crate::llv::{GreyImage, ScanDir};
 
     fn noisy(w: usize, h: usize, sigma: impl Fn(usize, usize) -> f64, seed: u64) -> GreyImage {

@@ -240,7 +240,7 @@ mod tests {
     use super::super::{CameraModel, correct};
     use super::*;
     use crate::llv::GreyImage;
-    use crate::llv::synth::rng::SplitMix64;
+    use crate::llv::rng::SplitMix64;
 
     /// Today's straightforward implementation, kept as the reference: a
     /// per-pixel source index (`u32::MAX` outside) and 1/256 px offsets,

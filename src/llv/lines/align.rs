@@ -276,7 +276,7 @@ mod tests {
         .unwrap();
         let s = line(31.5, 5.0, 31.5, 58.0);
         assert_eq!(aligned_fraction(std::slice::from_ref(&step), &s), Some(1.0));
-        let mut r = crate::llv::synth::rng::SplitMix64::new(3);
+        let mut r = crate::llv::rng::SplitMix64::new(3);
         let tex = GreyImage::new(
             w,
             h,
@@ -319,7 +319,7 @@ mod tests {
         // A vertical step on rows 0..16 only; below it, texture: the line
         // as a whole is not beyond chance, and its edge part is kept.
         let (w, h) = (64, 64);
-        let mut r = crate::llv::synth::rng::SplitMix64::new(5);
+        let mut r = crate::llv::rng::SplitMix64::new(5);
         let px: Vec<u8> = (0..w * h)
             .map(|i| {
                 let (x, y) = (i % w, i / w);

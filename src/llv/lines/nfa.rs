@@ -265,7 +265,7 @@ mod tests {
     #[test]
     fn the_table_matches_a_simulation() {
         use crate::llv::edges::kernel;
-        use crate::llv::synth::rng::SplitMix64;
+        use crate::llv::rng::SplitMix64;
         let mut rng = SplitMix64::new(11);
         for a in [3usize, 5, 7] {
             let k = kernel(a);

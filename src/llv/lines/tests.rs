@@ -1,6 +1,6 @@
 use super::super::edges::{PeakScratch, Starts};
 use super::*;
-use crate::llv::EdgePoint;
+use crate::llv::{EdgePoint, GreyImage};
 use source::{PointBufs, ResponseBufs};
 
 fn points(dir: ScanDir, pts: &[(f32, f32)]) -> EdgePoints {
@@ -69,8 +69,46 @@ fn gaps_short_lines_and_scan_parallel_lines() {
     assert!(extract(&EdgePoints::default(), &p).is_empty());
 }
 
-/// A noisy synthetic view (one of the test scenes), its horizontal or
-/// vertical response, noise map and peak map at the tracking threshold.
+/// A noisy 160 × 160 view of two dark convex polygons on a light ground (a
+/// quadrilateral and a triangle: edges in six directions), each pixel the
+/// mean of 4 × 4 samples, plus Gaussian noise of σ `noise` grey levels.
+/// Drawn here, not by the synthetic scenes (`vss::synth`), which are
+/// outside the core.
+fn polygons_image(noise: f64) -> GreyImage {
+    let shapes: [&[(f64, f64)]; 2] = [
+        &[(22.0, 30.0), (92.0, 18.5), (104.0, 77.0), (31.0, 96.0)],
+        &[(70.0, 140.0), (141.0, 96.0), (137.0, 148.0)],
+    ];
+    // Inside a convex polygon listed clockwise on the screen (y down):
+    // left of no edge.
+    let inside = |pts: &[(f64, f64)], x: f64, y: f64| {
+        (0..pts.len()).all(|i| {
+            let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+            (b.0 - a.0) * (y - a.1) - (b.1 - a.1) * (x - a.0) >= 0.0
+        })
+    };
+    let mut rng = crate::llv::rng::SplitMix64::new(9);
+    let (w, h) = (160, 160);
+    let mut data = Vec::with_capacity(w * h);
+    for y in 0..h {
+        for x in 0..w {
+            let mut dark = 0;
+            for s in 0..16 {
+                let (sx, sy) = (
+                    x as f64 + (s % 4) as f64 / 4.0 - 0.375,
+                    y as f64 + (s / 4) as f64 / 4.0 - 0.375,
+                );
+                dark += usize::from(shapes.iter().any(|p| inside(p, sx, sy)));
+            }
+            let v = 190.0 - 120.0 * dark as f64 / 16.0 + noise * rng.gauss();
+            data.push(v.round().clamp(0.0, 255.0) as u8);
+        }
+    }
+    GreyImage::new(w, h, data).expect("160 × 160")
+}
+
+/// [`polygons_image`]'s horizontal or vertical response, noise map and peak
+/// map at the tracking threshold.
 fn scene_parts(
     dir: ScanDir,
     noise: f64,
@@ -82,14 +120,7 @@ fn scene_parts(
     Starts,
 ) {
     use crate::llv::edges::{ResponseScratch, detect_into, response_into};
-    use crate::llv::synth;
-    let (scene, cam, lights) = synth::test_scenes(1, 160, 160, 5).remove(0);
-    let o = synth::RenderOptions {
-        noise_sigma: noise,
-        seed: 9,
-        ..Default::default()
-    };
-    let img = synth::render(&scene, &cam, &lights, &o);
+    let img = polygons_image(noise);
     let mut r = crate::llv::edges::Response::default();
     response_into(&img, dir, 4, &mut r, &mut ResponseScratch::default()).unwrap();
     let p = crate::llv::Params::default();

@@ -13,13 +13,13 @@ use serde::Serialize;
 
 pub mod yard;
 
-use super::rng::mix;
 use super::score::{Metrics, Tally};
 use super::straight::Straightness;
 use super::{Camera, PointLight, RenderOptions, Scene};
 use crate::llv::lens::LensMap;
 use crate::llv::pipeline::{self, Input};
 use crate::llv::refine;
+use crate::llv::rng::mix;
 use crate::llv::{
     EdgePoints, GreyImage, LlvError, Params, Point, Segment, connect, corners, lines,
 };

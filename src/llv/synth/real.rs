@@ -736,7 +736,7 @@ mod tests {
     #[test]
     fn grid_agrees_with_every_pair() {
         // Random segments: the grid's answer is the brute-force one.
-        let mut r = crate::llv::synth::rng::SplitMix64::new(7);
+        let mut r = crate::llv::rng::SplitMix64::new(7);
         let mut mk = |n: usize| -> Vec<Segment> {
             (0..n)
                 .map(|_| {

@@ -14,9 +14,9 @@
 //! the exact inverse of what lens correction computes.
 
 use super::raster::Prepared;
-use super::rng::SplitMix64;
 use super::{Camera, PointLight, RenderOptions, Scene};
 use crate::llv::GreyImage;
+use crate::llv::rng::SplitMix64;
 
 /// Samples per side in an edge pixel.
 const SS: usize = 16;

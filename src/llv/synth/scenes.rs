@@ -3,10 +3,10 @@
 //! the accuracy tests.
 
 use super::geom::{self, Polyhedron, V3};
-use super::rng::{SplitMix64, mix};
 use super::score;
 use super::{Camera, PointLight, RenderOptions, Scene};
 use crate::llv::lens::CameraModel;
+use crate::llv::rng::{SplitMix64, mix};
 use crate::llv::{Point, Segment};
 
 /// Names of the cell's lights, in the order of [`cell_lights`] (the same as in

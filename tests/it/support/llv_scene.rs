@@ -8,7 +8,7 @@
 #![allow(dead_code)]
 
 use vss::llv::GreyImage;
-use vss::llv::synth::rng::SplitMix64;
+use vss::llv::rng::SplitMix64;
 
 /// Approximately normal (Irwin–Hall of 4), unit variance: test noise.
 fn normal(rng: &mut SplitMix64) -> f64 {

@@ -12,11 +12,11 @@ use std::fmt;
 
 use serde::Serialize;
 
-use super::super::rng::mix;
 use super::super::score::{Metrics, Tally};
 use super::super::yard::{YardNoise, YardScene, YardTruth, truth, yard_scenes};
 use super::run_one;
 use crate::llv::lens::LensMap;
+use crate::llv::rng::mix;
 use crate::llv::{GreyImage, LlvError, Params};
 
 /// A noise level: Gaussian σ, or the family's signal-dependent noise.
