@@ -2,7 +2,9 @@
 //!
 //! The pieces, from the bottom up:
 //! - [`llv`]: the low-level vision core (lens correction, Lee edges, line
-//!   extraction, CONNECT, manual edits, synthetic scenes). Pure: no I/O.
+//!   extraction, CONNECT, manual edits). Pure: no I/O.
+//! - [`synth`]: synthetic scenes with their true edges, and the scorers
+//!   (synthetic truth, labelled photographs) `vss selftest` and the tests use.
 //! - [`formats`]: the cell's file formats (`.img`, `.cdf`, `.lex`/`.ldr`,
 //!   `.hpo`/`.vpo`, parameter files, `.ses`) and the VSS file-name scheme.
 //! - [`profile`]: TOML profiles (LLV parameters, hardware, lights).
@@ -20,5 +22,6 @@ pub mod profile;
 pub mod report;
 pub mod rig;
 pub mod session;
+pub mod synth;
 pub mod text;
 pub mod tui;

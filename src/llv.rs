@@ -21,7 +21,6 @@ pub mod pipeline;
 pub mod refine;
 pub mod rng;
 pub mod shadow;
-pub mod synth;
 
 pub use image::GreyImage;
 pub use params::Params;

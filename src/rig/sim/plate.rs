@@ -24,7 +24,7 @@ use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use super::SimOptions;
 use crate::calib::Plate;
 use crate::llv::rng::{SplitMix64, mix};
-use crate::llv::synth::{self, RenderOptions};
+use crate::synth::{self, RenderOptions};
 
 /// Grey level of the plate and of its dark squares.
 pub const LIGHT: f64 = 200.0;

@@ -25,7 +25,7 @@ use super::render::Index;
 use super::{Facet, YardScene};
 use crate::llv::{Point, Segment};
 
-pub use crate::llv::synth::{TRUTH_MARGIN as MARGIN, TRUTH_MIN_PIECE as MIN_PIECE};
+pub use crate::synth::{TRUTH_MARGIN as MARGIN, TRUTH_MIN_PIECE as MIN_PIECE};
 
 /// Offset (px) to each side of an edge where the front facet is looked up.
 const EPS: f64 = 0.01;

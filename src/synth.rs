@@ -33,8 +33,8 @@ pub use truth::{
     MARGIN as TRUTH_MARGIN, MIN_PIECE as TRUTH_MIN_PIECE, visible_edges as true_edges,
 };
 
-use super::lens::CameraModel;
-use super::{GreyImage, Point};
+use crate::llv::lens::CameraModel;
+use crate::llv::{GreyImage, Point};
 
 /// What the cameras look at: objects standing on an optional floor plate, in
 /// front of a uniform background (what a ray sees when it hits nothing).

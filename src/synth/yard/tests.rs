@@ -211,8 +211,8 @@ fn the_family_has_close_parallel_low_contrast_and_cut_edges() {
             let m = crate::llv::Point::new((e.a.x + e.b.x) / 2.0, (e.a.y + e.b.y) / 2.0);
             if t.edges.iter().enumerate().any(|(j, f)| {
                 j != i
-                    && crate::llv::synth::score::angle_diff_deg(e, f) < 3.0
-                    && (4.0..=8.0).contains(&crate::llv::synth::score::line_distance(f, m))
+                    && crate::synth::score::angle_diff_deg(e, f) < 3.0
+                    && (4.0..=8.0).contains(&crate::synth::score::line_distance(f, m))
                     && f.a.dist(m).min(f.b.dist(m)) < f.length()
             }) {
                 close += 1;
