@@ -17,7 +17,9 @@ pub mod calib;
 pub mod cli;
 pub mod formats;
 pub mod fsutil;
-pub mod llv;
+/// The low-level vision core: the `vss-llv` crate of the workspace
+/// (crates/vss-llv), which depends on no other crate of it.
+pub use vss_llv as llv;
 pub mod profile;
 pub mod report;
 pub mod rig;

@@ -239,8 +239,8 @@ pub(super) fn masked(smask: &[bool], map: &LensMap, mask: &mut [bool], out: &mut
 mod tests {
     use super::super::{CameraModel, correct};
     use super::*;
-    use crate::llv::GreyImage;
-    use crate::llv::rng::SplitMix64;
+    use crate::GreyImage;
+    use crate::rng::SplitMix64;
 
     /// Today's straightforward implementation, kept as the reference: a
     /// per-pixel source index (`u32::MAX` outside) and 1/256 px offsets,

@@ -7,7 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Point, Segment};
-use crate::llv::fit::Line;
+use crate::fit::Line;
 
 /// One manual operation; indices refer to the line set it is applied to.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]

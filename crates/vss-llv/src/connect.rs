@@ -653,7 +653,7 @@ mod tests {
     /// neighbours a pixel or two off) and random short strays, over a
     /// `size`-px square moved to `origin`.
     fn scene(seed: u64, size: f64, origin: f64) -> Vec<Segment> {
-        let mut rng = crate::llv::rng::SplitMix64::new(seed);
+        let mut rng = crate::rng::SplitMix64::new(seed);
         let mut out = Vec::new();
         for _ in 0..40 {
             let (x, y) = (rng.range(0.0, size), rng.range(0.0, size));

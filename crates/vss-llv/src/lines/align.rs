@@ -40,7 +40,7 @@
 //! faint edge in noise (10 grey levels at a blur of σ 1.5 px has a slope
 //! of 2.7) dips below it at single pixels but not on average.
 
-use crate::llv::{GreyImage, Point, Segment};
+use crate::{GreyImage, Point, Segment};
 
 /// Largest angle (degrees) between the gradient and the line's normal at an
 /// aligned pixel.
@@ -276,7 +276,7 @@ mod tests {
         .unwrap();
         let s = line(31.5, 5.0, 31.5, 58.0);
         assert_eq!(aligned_fraction(std::slice::from_ref(&step), &s), Some(1.0));
-        let mut r = crate::llv::rng::SplitMix64::new(3);
+        let mut r = crate::rng::SplitMix64::new(3);
         let tex = GreyImage::new(
             w,
             h,
@@ -319,7 +319,7 @@ mod tests {
         // A vertical step on rows 0..16 only; below it, texture: the line
         // as a whole is not beyond chance, and its edge part is kept.
         let (w, h) = (64, 64);
-        let mut r = crate::llv::rng::SplitMix64::new(5);
+        let mut r = crate::rng::SplitMix64::new(5);
         let px: Vec<u8> = (0..w * h)
             .map(|i| {
                 let (x, y) = (i % w, i / w);

@@ -3,7 +3,7 @@
 //! small, flat and invalid images.
 
 use super::*;
-use crate::llv::rng::SplitMix64;
+use crate::rng::SplitMix64;
 
 fn img_from(w: usize, h: usize, f: impl Fn(usize, usize) -> u8) -> GreyImage {
     let mut d = Vec::with_capacity(w * h);

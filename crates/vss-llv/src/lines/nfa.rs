@@ -2,7 +2,7 @@
 //! "Meaningful alignments", IJCV 40, 2000; the test LSD uses): a segment is
 //! kept when noise alone would give fewer than `ε` segments as good in an
 //! image, `ε = 10^log_nfa`. No threshold depends on the scene: the noise is
-//! measured ([`NoiseMap`](crate::llv::edges::NoiseMap)), the rest is
+//! measured ([`NoiseMap`](crate::edges::NoiseMap)), the rest is
 //! counting.
 //!
 //! The event on one scan line of the segment's span: "there is a peak of
@@ -264,8 +264,8 @@ mod tests {
     /// (smaller than the one that made it) agrees within its sampling error.
     #[test]
     fn the_table_matches_a_simulation() {
-        use crate::llv::edges::kernel;
-        use crate::llv::rng::SplitMix64;
+        use crate::edges::kernel;
+        use crate::rng::SplitMix64;
         let mut rng = SplitMix64::new(11);
         for a in [3usize, 5, 7] {
             let k = kernel(a);

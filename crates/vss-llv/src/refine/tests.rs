@@ -175,7 +175,7 @@ fn where_the_edge_fades_its_blocks_count_for_less() {
     let mut total = 0.0;
     let seeds = 24;
     for seed in 0..seeds {
-        let mut rng = crate::llv::rng::SplitMix64::new(seed);
+        let mut rng = crate::rng::SplitMix64::new(seed);
         let data: Vec<u8> = step
             .data()
             .iter()

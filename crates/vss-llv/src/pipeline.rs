@@ -681,7 +681,7 @@ mod tests {
     fn rerun_with_lens_and_ambient_matches_a_full_run() {
         let imgs = [square(96, 80), square(96, 80)];
         let ambient = GreyImage::filled(96, 80, 30).unwrap();
-        let model = crate::llv::lens::CameraModel {
+        let model = crate::lens::CameraModel {
             cx: 48.0,
             cy: 40.0,
             sx: 0.01,

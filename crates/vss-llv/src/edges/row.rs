@@ -248,7 +248,7 @@ mod tests {
 
     #[test]
     fn rows_equal_the_tap_by_tap_sum_for_every_length() {
-        let mut rng = crate::llv::rng::SplitMix64::new(11);
+        let mut rng = crate::rng::SplitMix64::new(11);
         // Extremes too: 0/255 steps give the largest sums.
         let src: Vec<u8> = (0..300)
             .map(|i| match i % 50 {

@@ -357,7 +357,7 @@ mod tests {
 
     #[test]
     fn the_sum_is_of_the_magnitudes_times_the_gains() {
-        let mut rng = crate::llv::rng::SplitMix64::new(0x9E37_79B9_7F4A_7C15);
+        let mut rng = crate::rng::SplitMix64::new(0x9E37_79B9_7F4A_7C15);
         let mut next = || (rng.next_u64() % 200_001) as i32 - 100_000;
         for _ in 0..200 {
             let r: Vec<i32> = (0..4).map(|_| next()).collect();
@@ -654,8 +654,8 @@ mod calibration {
     //! a-contrario table says they are on one image (module doc: a sum of
     //! magnitudes is stricter on noise than one image).
     use super::*;
-    use crate::llv::lines::nfa;
-    use crate::llv::rng::SplitMix64;
+    use crate::lines::nfa;
+    use crate::rng::SplitMix64;
 
     fn noise_image(w: usize, h: usize, sigma: f64, seed: u64) -> GreyImage {
         let mut rng = SplitMix64::new(seed);

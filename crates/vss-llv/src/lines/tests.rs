@@ -1,6 +1,6 @@
 use super::super::edges::{PeakScratch, Starts};
 use super::*;
-use crate::llv::{EdgePoint, GreyImage};
+use crate::{EdgePoint, GreyImage};
 use source::{PointBufs, ResponseBufs};
 
 fn points(dir: ScanDir, pts: &[(f32, f32)]) -> EdgePoints {
@@ -87,7 +87,7 @@ fn polygons_image(noise: f64) -> GreyImage {
             (b.0 - a.0) * (y - a.1) - (b.1 - a.1) * (x - a.0) >= 0.0
         })
     };
-    let mut rng = crate::llv::rng::SplitMix64::new(9);
+    let mut rng = crate::rng::SplitMix64::new(9);
     let (w, h) = (160, 160);
     let mut data = Vec::with_capacity(w * h);
     for y in 0..h {
@@ -113,17 +113,17 @@ fn scene_parts(
     dir: ScanDir,
     noise: f64,
 ) -> (
-    crate::llv::edges::Response,
+    crate::edges::Response,
     NoiseMap,
     PeakMap,
     EdgePoints,
     Starts,
 ) {
-    use crate::llv::edges::{ResponseScratch, detect_into, response_into};
+    use crate::edges::{ResponseScratch, detect_into, response_into};
     let img = polygons_image(noise);
-    let mut r = crate::llv::edges::Response::default();
+    let mut r = crate::edges::Response::default();
     response_into(&img, dir, 4, &mut r, &mut ResponseScratch::default()).unwrap();
-    let p = crate::llv::Params::default();
+    let p = crate::Params::default();
     let (mut nm, mut map, mut seeds, mut starts) = (
         NoiseMap::default(),
         PeakMap::default(),
@@ -194,7 +194,7 @@ fn reading_peaks_where_tracks_look_equals_listing_them_all() {
                             } else {
                                 (c.u as f32, v as f32)
                             };
-                            all.points.push(crate::llv::EdgePoint {
+                            all.points.push(crate::EdgePoint {
                                 x,
                                 y,
                                 response: c.response,

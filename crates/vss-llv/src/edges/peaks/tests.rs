@@ -1,6 +1,6 @@
 use super::*;
-use crate::llv::GreyImage;
-use crate::llv::edges::response;
+use crate::GreyImage;
+use crate::edges::response;
 
 fn params() -> EdgeParams {
     EdgeParams::default()
@@ -101,7 +101,7 @@ fn starts_are_the_points_pixels() {
 /// that are no multiple of sixteen.
 #[test]
 fn wide_candidates_equal_the_plain_ones() {
-    use crate::llv::rng::SplitMix64;
+    use crate::rng::SplitMix64;
     let mut rng = SplitMix64::new(3);
     for (w, h) in [(16, 16), (37, 53), (130, 70), (200, 131)] {
         let mut img = image(w, h, |x, y| {
@@ -151,7 +151,7 @@ fn wide_candidates_equal_the_plain_ones() {
 /// for both directions.
 #[test]
 fn the_peak_map_holds_the_plain_peaks() {
-    use crate::llv::rng::SplitMix64;
+    use crate::rng::SplitMix64;
     let mut rng = SplitMix64::new(5);
     for (w, h) in [(16, 16), (37, 53), (130, 70), (200, 131)] {
         let mut img = image(w, h, |x, y| if x * 2 + y > w { 150 } else { 70 });

@@ -38,8 +38,8 @@
 mod lanes;
 
 use super::{NoiseMap, Response, key};
-use crate::llv::params::EdgeParams;
-use crate::llv::{EdgePoint, EdgePoints, ScanDir};
+use crate::params::EdgeParams;
+use crate::{EdgePoint, EdgePoints, ScanDir};
 #[doc(hidden)]
 pub use lanes::plain_only;
 use lanes::{key_row, row_masks, simd};

@@ -272,9 +272,9 @@ fn median_bin(hist: &[u16], n: usize) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::llv::edges::response;
-    use crate::llv::rng::SplitMix64;
-    use crate::llv::{GreyImage, ScanDir};
+    use crate::edges::response;
+    use crate::rng::SplitMix64;
+    use crate::{GreyImage, ScanDir};
 
     fn noisy(w: usize, h: usize, sigma: impl Fn(usize, usize) -> f64, seed: u64) -> GreyImage {
         let mut rng = SplitMix64::new(seed);
@@ -318,7 +318,7 @@ mod tests {
 
     /// The estimate the module doc describes, tile by tile with a sort: the
     /// reference for the row-wise histograms.
-    fn reference(r: &crate::llv::edges::Response) -> Vec<f32> {
+    fn reference(r: &crate::edges::Response) -> Vec<f32> {
         let m = NoiseMap::estimate(r);
         let (w, h) = (r.width, r.height);
         let mut out = Vec::new();

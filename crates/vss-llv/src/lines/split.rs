@@ -121,7 +121,7 @@ mod tests {
     use super::*;
 
     fn chain(f: impl Fn(f64) -> f64, n: usize, noise: f64) -> Vec<TrackPoint> {
-        let mut r = crate::llv::rng::SplitMix64::new(5);
+        let mut r = crate::rng::SplitMix64::new(5);
         (0..n)
             .map(|i| TrackPoint {
                 u: f(i as f64) + noise * r.gauss(),

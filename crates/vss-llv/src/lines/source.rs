@@ -5,9 +5,9 @@
 //! Both work in scan coordinates `(u, v)`: `u` along the scan, `v` the scan
 //! line (for `EdgeH` that is `(x, y)`; for `EdgeV`, `(y, x)`).
 
-use crate::llv::edges::peaks::subpixel;
-use crate::llv::edges::{NONE, NoiseMap, PeakMap, Response, key};
-use crate::llv::{EdgePoints, ScanDir};
+use crate::edges::peaks::subpixel;
+use crate::edges::{NONE, NoiseMap, PeakMap, Response, key};
+use crate::{EdgePoints, ScanDir};
 
 /// A point the tracker may take: its position, signed response (grey
 /// levels), noise sigmas (NaN where the noise is unknown) and identity.

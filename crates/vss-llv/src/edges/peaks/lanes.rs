@@ -5,9 +5,9 @@
 //! them; elsewhere, and as the tests' reference, the same test in plain
 //! code.
 
-use crate::llv::edges::SUM_MAX;
+use crate::edges::SUM_MAX;
 
-/// `|s|` of every sum of `row` into `out` (as long), saturating: [`NONE`](crate::llv::edges::NONE)
+/// `|s|` of every sum of `row` into `out` (as long), saturating: [`NONE`](crate::edges::NONE)
 /// gives `i16::MAX`. Plain code the compiler vectorises (AVX2 at run time).
 #[multiversion::multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt", "x86_64+sse4.1"))]
 pub(super) fn key_row(row: &[i16], out: &mut [i16]) {
@@ -16,13 +16,13 @@ pub(super) fn key_row(row: &[i16], out: &mut [i16]) {
     }
 }
 
-/// The largest key a real sum has ([`SUM_MAX`]); `i16::MAX` is [`NONE`](crate::llv::edges::NONE)'s.
+/// The largest key a real sum has ([`SUM_MAX`]); `i16::MAX` is [`NONE`](crate::edges::NONE)'s.
 pub(super) const REAL: i16 = SUM_MAX as i16;
 
 /// The peak test of one padded row, for positions `x` in `0..sign.len()`
 /// (a multiple of 64): with `k = mid[x]`, position `x` is a peak along the
 /// scan when `k > lo[x]`, `k ≥ hi[x]` and `k` is a real magnitude (not
-/// [`NONE`](crate::llv::edges::NONE)'s); an edge point's candidate when also `k > thr[x]`, a peak a
+/// [`NONE`](crate::edges::NONE)'s); an edge point's candidate when also `k > thr[x]`, a peak a
 /// track may take when `k > trk[x]`, positive or negative by `sign[x]`.
 /// `bits` gets the three masks, each `sign.len() / 64` words. Thirty-two
 /// positions an iteration with AVX2 where the processor has it (`pulp`,
