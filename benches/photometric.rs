@@ -9,8 +9,8 @@ use divan::{Bencher, black_box};
 use vss::llv::edges::{NoiseMap, PeakMap, PeakScratch, Response, Starts, detect_into};
 use vss::llv::photometric::{PhotoScratch, combined_response, combined_response_into};
 use vss::llv::pipeline::{Input, Workspace};
-use vss::llv::synth::{self, PointLight, RenderOptions};
 use vss::llv::{EdgePoints, GreyImage, Params, ScanDir};
+use vss::synth::{self, PointLight, RenderOptions};
 
 fn main() {
     divan::main();

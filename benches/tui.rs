@@ -27,9 +27,9 @@ use ratatui::backend::{CrosstermBackend, TestBackend};
 use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::layout::Rect;
 use ratatui::{Terminal, TerminalOptions, Viewport};
-use vss::llv::synth::{self, RenderOptions};
 use vss::llv::{GreyImage, params::PARAMS};
 use vss::profile::Profile;
+use vss::synth::{self, RenderOptions};
 use vss::tui::app::App;
 use vss::tui::event::{
     Cmd, DeviceEvent, FramePurpose, Msg, PipelineResult, SessionView, StoreEvent,

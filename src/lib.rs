@@ -2,7 +2,9 @@
 //!
 //! The pieces, from the bottom up:
 //! - [`llv`]: the low-level vision core (lens correction, Lee edges, line
-//!   extraction, CONNECT, manual edits, synthetic scenes). Pure: no I/O.
+//!   extraction, CONNECT, manual edits). Pure: no I/O.
+//! - [`synth`]: synthetic scenes with their true edges, and the scorers
+//!   (synthetic truth, labelled photographs) `vss selftest` and the tests use.
 //! - [`formats`]: the cell's file formats (`.img`, `.cdf`, `.lex`/`.ldr`,
 //!   `.hpo`/`.vpo`, parameter files, `.ses`) and the VSS file-name scheme.
 //! - [`profile`]: TOML profiles (LLV parameters, hardware, lights).
@@ -15,10 +17,13 @@ pub mod calib;
 pub mod cli;
 pub mod formats;
 pub mod fsutil;
-pub mod llv;
+/// The low-level vision core: the `vss-llv` crate of the workspace
+/// (crates/vss-llv), which depends on no other crate of it.
+pub use vss_llv as llv;
 pub mod profile;
 pub mod report;
 pub mod rig;
 pub mod session;
+pub mod synth;
 pub mod text;
 pub mod tui;

@@ -1,15 +1,15 @@
 //! `vss selftest`: renders the two families of synthetic scenes with known
 //! edges (cubes: polyhedra under point lights; yard: layered welding-yard
-//! parts, `llv::synth::yard`), runs the LLV pipeline with the profile's
+//! parts, `synth::yard`), runs the LLV pipeline with the profile's
 //! parameters and prints, per family and noise level, recall, precision, F,
 //! endpoint distances, angle error and the breakdowns of the scorer — for
 //! the cubes also with whole-pixel positions — and a lens check per family.
 //!
 //! `--export DIR` writes the same images, their truth and vss's segments
 //! and times for other detectors to run on; `--score DIR` scores every
-//! detector found there with the same scorer (`llv::synth::compare`).
+//! detector found there with the same scorer (`synth::compare`).
 //!
-//! Real photographs (`llv::synth::real`): `--score-real PHOTOS` runs vss
+//! Real photographs (`synth::real`): `--score-real PHOTOS` runs vss
 //! on every photograph with a `NAME_gt.txt` and scores it by the
 //! length-based rule of the photographs' README; with `--dir DIR` it scores
 //! instead every detector's `NAME.DET.seg` in DIR. `--export-real PHOTOS
@@ -22,10 +22,10 @@ use std::process::ExitCode;
 use anyhow::Context;
 
 use super::Global;
-use crate::llv::synth::compare::{self, ExportConfig};
-use crate::llv::synth::eval::yard::{Level, YardConfig, YardReport, evaluate_yard};
-use crate::llv::synth::eval::{EvalConfig, EvalReport, evaluate};
-use crate::llv::synth::real;
+use crate::synth::compare::{self, ExportConfig};
+use crate::synth::eval::yard::{Level, YardConfig, YardReport, evaluate_yard};
+use crate::synth::eval::{EvalConfig, EvalReport, evaluate};
+use crate::synth::real;
 
 mod tables;
 

@@ -17,7 +17,7 @@ use std::thread::JoinHandle;
 use serialport::TTYPort;
 
 use super::RigError;
-use crate::llv::synth::rng::SplitMix64;
+use crate::llv::rng::SplitMix64;
 use crate::profile::Profile;
 
 mod board;
@@ -447,7 +447,7 @@ impl SimCell {
 pub fn cell_profile(width: u32, height: u32) -> Profile {
     use crate::profile::{Light, Lighting};
     let positions = render::default_light_positions();
-    let names = crate::llv::synth::CELL_LIGHT_NAMES;
+    let names = crate::synth::CELL_LIGHT_NAMES;
     let mut p = Profile {
         name: "simulated cell".into(),
         ..Profile::default()
@@ -488,7 +488,7 @@ pub fn cell_profile(width: u32, height: u32) -> Profile {
 /// The `.cdf` of simulated camera `cam` (1-based) at this image size:
 /// intrinsics, lens distortion and pose as the simulator renders them.
 pub fn camera_cdf(cam: u32, width: u32, height: u32) -> Option<crate::formats::cdf::Cdf> {
-    let cams = crate::llv::synth::cell_cameras(width as usize, height as usize);
+    let cams = crate::synth::cell_cameras(width as usize, height as usize);
     let c = cams.get(cam.checked_sub(1)? as usize)?;
     Some(crate::formats::cdf::Cdf::from_camera(
         &c.model,

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use super::{OutputSet, Session, SessionError};
 use crate::formats::img::ImgFile;
-use crate::llv::synth::rng::SplitMix64;
+use crate::llv::rng::SplitMix64;
 use crate::llv::{EdgePoint, EdgePoints, GreyImage, Params, Point, ScanDir, Segment};
 
 /// Image size of the torture survey: big enough that a write takes a while.

@@ -2,7 +2,7 @@
 //! within 0.01 (F, recall, precision; px; degrees) of what the engine
 //! measures, so that a regression fails: 12 scenes of 512 × 512
 //! per noise level, blur σ = 1, the default profile's LLV parameters, scored
-//! with the matching rule of the LLV core (`vss::llv::synth::score`).
+//! with the matching rule of the LLV core (`vss::synth::score`).
 //!
 //! The scenes are rendered and the pipeline run once for the whole file (a
 //! `OnceLock`); each test asserts one floor and prints the figures it saw.
@@ -10,8 +10,8 @@
 use std::sync::OnceLock;
 
 use super::default_params;
-use vss::llv::synth::Metrics;
-use vss::llv::synth::eval::{EvalConfig, EvalReport, NoiseResult, evaluate};
+use vss::synth::Metrics;
+use vss::synth::eval::{EvalConfig, EvalReport, NoiseResult, evaluate};
 
 fn report() -> &'static EvalReport {
     static REPORT: OnceLock<EvalReport> = OnceLock::new();

@@ -1,7 +1,7 @@
 //! The accuracy floors on real photographs: the 51 York Urban photographs
 //! of `../shared/data/yud-tune` (the tuning half; Cho et al.'s ground
 //! truth), scored by the rule of that folder's README
-//! (`vss::llv::synth::real`: 2 px, 5°, length-based, pooled), with the
+//! (`vss::synth::real`: 2 px, 5°, length-based, pooled), with the
 //! default profile's parameters (tuned on these photographs,
 //! docs/accuracy.md). Each floor is within 0.01 of what the engine
 //! measures. A missing folder fails: the floors are only worth anything
@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use super::default_params;
-use vss::llv::synth::real::{RealEvaluation, evaluate_real, photographs};
+use vss::synth::real::{RealEvaluation, evaluate_real, photographs};
 
 fn folder() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/yud-tune")
@@ -95,7 +95,7 @@ const BY_CONTRAST: [f64; 4] = [0.535, 0.645, 0.765, 0.850];
 /// `benches/opencv_lines.py real` (docs/accuracy.md).
 #[test]
 fn york_urban_tune_false_length_on_flat_structure() {
-    use vss::llv::synth::real::SLOPE_BOUNDS;
+    use vss::synth::real::SLOPE_BOUNDS;
     let (_, _, c) = scores();
     let u = c.unmatched_per_photo();
     eprintln!(
@@ -132,7 +132,7 @@ const FLAT_CEILING: f64 = 50.0;
 fn three_lightings_of_each_photograph_against_the_best_one() {
     use vss::llv::GreyImage;
     use vss::llv::pipeline::{Input, run};
-    use vss::llv::synth::real::{RealTally, read_photo, read_truth, score_real};
+    use vss::synth::real::{RealTally, read_photo, read_truth, score_real};
     let relit = |img: &GreyImage, gain: &dyn Fn(usize) -> f64| {
         let (w, h) = img.size();
         let d = img.data();

@@ -1,4 +1,4 @@
-//! Accuracy floors on the yard family (welding-yard parts, `llv::synth::yard`),
+//! Accuracy floors on the yard family (welding-yard parts, `synth::yard`),
 //! the family the engine is not tuned on: 6 scenes of 512 × 512 (one of each
 //! kind of object), every noise level, the default profile; and the export /
 //! score path that puts other detectors beside vss.
@@ -12,8 +12,8 @@ use std::sync::OnceLock;
 
 use super::default_params;
 use assert_cmd::Command;
-use vss::llv::synth::Metrics;
-use vss::llv::synth::eval::yard::{Level, YardConfig, YardReport, evaluate_yard};
+use vss::synth::Metrics;
+use vss::synth::eval::yard::{Level, YardConfig, YardReport, evaluate_yard};
 
 fn report() -> &'static YardReport {
     static REPORT: OnceLock<YardReport> = OnceLock::new();
@@ -221,7 +221,7 @@ fn export_then_score_gives_selftests_figures_for_vss() {
     assert!(!dir.path().join("cubes/sd").exists());
     // The lens folders carry the .cdf that corrects their images.
     let cdf = vss::formats::cdf::read_cdf(&dir.path().join("yard/lens-s2/s00.cdf")).unwrap();
-    let scene = &vss::llv::synth::yard::yard_scenes(1, 128, 1)[0];
+    let scene = &vss::synth::yard::yard_scenes(1, 128, 1)[0];
     assert_eq!(cdf.camera_model(), Some(scene.lens));
 
     let json = run_ok(&[

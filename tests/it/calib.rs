@@ -286,7 +286,7 @@ fn bad_sets_of_views_are_refused_with_what_to_do() {
     assert!(matches!(e, CalibError::TooFewViews { usable: 2 }), "{e}");
     assert!(e.to_string().contains("at least 3"), "{e}");
     // Face-on views, the plate turned in its plane only.
-    let cams = vss::llv::synth::cell_cameras(512, 512);
+    let cams = vss::synth::cell_cameras(512, 512);
     let bg = vec![60.0f32; 512 * 512];
     let (gw, gh) = p.grid_size();
     let faces: Vec<(String, GreyImage)> = (0..4)

@@ -7,8 +7,8 @@
 
 use vss::llv::auto::{self, Target};
 use vss::llv::pipeline::{self, Input};
-use vss::llv::synth::{self, RenderOptions};
 use vss::llv::{GreyImage, Params, Segment};
+use vss::synth::{self, RenderOptions};
 
 fn scene(k: u64) -> (GreyImage, Vec<Segment>) {
     let (scene, cam, lights) = synth::test_scenes(1, 320, 320, 0xA070 + k).pop().unwrap();

@@ -6,7 +6,7 @@ use std::path::Path;
 use assert_cmd::Command;
 use vss::formats::img::{ImgFile, write_img};
 use vss::formats::lines::read_lines;
-use vss::llv::synth::{self, PointLight, RenderOptions};
+use vss::synth::{self, PointLight, RenderOptions};
 
 /// Writes `cube1a.img` … `cube1d.img` (four lights) and `cube1e.img`
 /// (ambient only) of one synthetic view.

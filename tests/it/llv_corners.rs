@@ -13,8 +13,8 @@
 //! `cargo test --test it llv_corners:: -- --nocapture` prints the figures.
 
 use vss::llv::pipeline::{self, Input};
-use vss::llv::synth::{self, RenderOptions};
 use vss::llv::{GreyImage, Params, Point, Segment};
+use vss::synth::{self, RenderOptions};
 
 const SCENES: usize = 12;
 const SIZE: usize = 320;

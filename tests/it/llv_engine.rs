@@ -5,7 +5,7 @@
 //! number; and two threads give what one does.
 
 use vss::llv::pipeline::{self, Input, StageOutputs};
-use vss::llv::synth::rng::SplitMix64;
+use vss::llv::rng::SplitMix64;
 use vss::llv::{GreyImage, Params};
 
 fn image(w: usize, h: usize, f: impl Fn(usize, usize) -> f64) -> GreyImage {
@@ -152,14 +152,14 @@ fn a_thin_ring_of_valid_pixels_runs() {
 /// outputs as one, for one image and for several lightings.
 #[test]
 fn two_threads_give_what_one_does() {
-    let (scene, cam, lights) = vss::llv::synth::test_scenes(1, 256, 256, 11).remove(0);
-    let o = vss::llv::synth::RenderOptions {
+    let (scene, cam, lights) = vss::synth::test_scenes(1, 256, 256, 11).remove(0);
+    let o = vss::synth::RenderOptions {
         noise_sigma: 4.0,
         ..Default::default()
     };
     let imgs: Vec<GreyImage> = lights
         .iter()
-        .map(|l| vss::llv::synth::render(&scene, &cam, std::slice::from_ref(l), &o))
+        .map(|l| vss::synth::render(&scene, &cam, std::slice::from_ref(l), &o))
         .collect();
     let mut p = Params::default();
     for n in [1, imgs.len()] {

@@ -13,8 +13,8 @@
 //! stray-point check and run with `--ignored`.
 
 use vss::llv::pipeline::{self, Input};
+use vss::llv::rng::SplitMix64;
 use vss::llv::shadow::{ShadowParams, flag_shadows};
-use vss::llv::synth::rng::SplitMix64;
 use vss::llv::{GreyImage, Params, Point, Segment};
 
 const W: usize = 256;

@@ -15,8 +15,8 @@
 //! Run with `cargo test --test it photometric:: -- --nocapture` for the figures.
 
 use vss::llv::pipeline::{self, Input, StageOutputs};
-use vss::llv::synth::{self, Camera, PointLight, RenderOptions, Scene, Tally};
 use vss::llv::{GreyImage, Params, Point, Segment};
+use vss::synth::{self, Camera, PointLight, RenderOptions, Scene, Tally};
 
 const SCENES: usize = 12;
 const SIZE: usize = 320;

@@ -4,9 +4,9 @@
 //! workpiece differently, and a seeded run repeats exactly.
 
 use vss::llv::GreyImage;
-use vss::llv::synth;
 use vss::rig::Cell;
 use vss::rig::sim::cell_profile;
+use vss::synth;
 
 const SIZE: u32 = 128;
 

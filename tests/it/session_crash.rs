@@ -10,7 +10,7 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 use vss::formats::{edgefile, img, lines};
-use vss::llv::synth::rng::SplitMix64;
+use vss::llv::rng::SplitMix64;
 use vss::session::Session;
 use vss::session::torture::{below, consistent_edges, consistent_image, consistent_lines};
 

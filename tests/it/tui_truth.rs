@@ -9,8 +9,8 @@ use std::sync::mpsc::{Receiver, channel};
 
 use assert_cmd::Command;
 use vss::llv::GreyImage;
-use vss::llv::synth::{self, RenderOptions};
 use vss::profile::Profile;
+use vss::synth::{self, RenderOptions};
 use vss::tui::app::{App, Phase};
 use vss::tui::event::{Cmd, DeviceCmd, DeviceEvent, Msg, PipelineResult, StoreCmd};
 use vss::tui::keymap::{Action, Scope, ScreenId, SurveyAction};

@@ -4,10 +4,10 @@
 
 use std::fmt::Write;
 
-use crate::llv::synth::Metrics;
-use crate::llv::synth::compare::FamilyScores;
-use crate::llv::synth::eval::EvalReport;
-use crate::llv::synth::eval::yard::YardReport;
+use crate::synth::Metrics;
+use crate::synth::compare::FamilyScores;
+use crate::synth::eval::EvalReport;
+use crate::synth::eval::yard::YardReport;
 
 /// The breakdown columns' header: strong recall, close recall, off-angle.
 const BREAKDOWN: &str = "strong R close R off-angle";

@@ -5,7 +5,7 @@
 
 use std::time::Duration;
 
-use crate::llv::synth::rng::SplitMix64;
+use crate::llv::rng::SplitMix64;
 
 /// The faults asked for; the default is a clean line.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -23,7 +23,8 @@ use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 
 use super::SimOptions;
 use crate::calib::Plate;
-use crate::llv::synth::{self, RenderOptions, rng::SplitMix64};
+use crate::llv::rng::{SplitMix64, mix};
+use crate::synth::{self, RenderOptions};
 
 /// Grey level of the plate and of its dark squares.
 pub const LIGHT: f64 = 200.0;
@@ -69,7 +70,7 @@ impl PlateTarget {
                 }))
             }
             Mode::Held => {
-                let seed = synth::rng::mix(o.seed ^ u64::from(cam) << 40, shot);
+                let seed = mix(o.seed ^ u64::from(cam) << 40, shot);
                 Some(held_pose(&self.plate, c, seed))
             }
         }

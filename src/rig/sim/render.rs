@@ -1,11 +1,11 @@
 //! What a simulated camera sees: the cell scene of the synthetic generator
-//! (`llv::synth::cell_scene`, a cube, a box and an L-bracket on a floor
+//! (`synth::cell_scene`, a cube, a box and an L-bracket on a floor
 //! plate) through one of the four cell cameras with its own lens distortion,
 //! under the point lights whose relays are on. Noise is added per frame by
 //! the caller, so this noise-free render can be cached.
 
 use super::SimOptions;
-use crate::llv::synth::{self, PointLight, RenderOptions};
+use crate::synth::{self, PointLight, RenderOptions};
 
 /// Where lights stand when the profile does not say (mm, world frame): the
 /// synthetic cell's four lights, in the order of `synth::CELL_LIGHT_NAMES`.

@@ -1,5 +1,5 @@
 //! A realistic test image for benchmarks and allocation tests, until the
-//! synthetic scenes of `llv::synth` are available everywhere: anti-aliased
+//! synthetic scenes of `synth` are available everywhere: anti-aliased
 //! convex polygons of different brightness on a shaded ground, slightly
 //! blurred by the anti-aliasing ramp, with seeded noise. Shared by the
 //! tests (`support::llv_scene`), `benches/llv.rs` and `examples/llv_count.rs`
@@ -8,7 +8,7 @@
 #![allow(dead_code)]
 
 use vss::llv::GreyImage;
-use vss::llv::synth::rng::SplitMix64;
+use vss::llv::rng::SplitMix64;
 
 /// Approximately normal (Irwin–Hall of 4), unit variance: test noise.
 fn normal(rng: &mut SplitMix64) -> f64 {
