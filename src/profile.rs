@@ -520,19 +520,6 @@ pub fn locate(name_or_path: &str) -> Result<Origin, ProfileError> {
     })
 }
 
-/// The profile file a name or path names ([`locate`]); the built-in
-/// profile has none, so `default` is an error unless a file takes its
-/// place.
-pub fn resolve(name_or_path: &str) -> Result<PathBuf, ProfileError> {
-    match locate(name_or_path)? {
-        Origin::File(p) => Ok(p),
-        Origin::Builtin => Err(ProfileError::NotFound {
-            name: name_or_path.to_string(),
-            tried: "the built-in default has no file".into(),
-        }),
-    }
-}
-
 /// A profile's text and the name its errors use, wherever it was found:
 /// what `vss params import` edits.
 pub fn text_of(origin: &Origin) -> Result<(String, PathBuf), ProfileError> {
