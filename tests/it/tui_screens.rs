@@ -27,24 +27,10 @@ use vss::tui::keymap::{
 use vss::tui::mode::Look;
 use vss::tui::widgets::preview::PreviewMode;
 
-const PROFILE: &str = r#"
-name = "screen test cell"
-[[lights]]
-name = "left"
-relay = 0
-[[lights]]
-name = "right"
-relay = 1
-[[lighting]]
-letter = "a"
-on = ["left"]
-[[lighting]]
-letter = "b"
-on = ["right"]
-[[lighting]]
-letter = "c"
-on = []
-"#;
+const PROFILE: &str = concat!(
+    "name = \"screen test cell\"\n",
+    crate::support::fixtures::two_lights!()
+);
 
 pub fn profile() -> Profile {
     Profile::from_toml(PROFILE, Path::new("test.toml")).unwrap()
