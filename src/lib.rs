@@ -11,10 +11,13 @@
 //! - [`rig`]: the frame grabber and relay-board drivers, and the simulated cell.
 //! - [`session`]: a survey on disk; [`report`]: PostScript and SVG.
 //! - [`cli`]: headless subcommands; [`tui`]: the operator console.
-//! - [`text`]: the one sanitiser of text shown to a person.
+//! - [`text`]: the one sanitiser of text shown to a person; [`dirs`]: the
+//!   XDG config and state folders; [`clock`]: UTC time stamps.
 
 pub mod calib;
 pub mod cli;
+pub mod clock;
+pub mod dirs;
 pub mod formats;
 pub mod fsutil;
 /// The low-level vision core: the `vss-llv` crate of the workspace

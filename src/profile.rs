@@ -443,42 +443,15 @@ impl Profile {
 }
 
 /// The folders a profile name is looked up in, in order: `./profiles`,
-/// then `vss/profiles` in the XDG config folder (`$XDG_CONFIG_HOME`, else
-/// `~/.config`). The name `default` is not looked up in `./profiles`
+/// then `vss/profiles` in the XDG config folder ([`crate::dirs::config_home`]:
+/// `$XDG_CONFIG_HOME`, else `~/.config`). The name `default` is not looked up in `./profiles`
 /// ([`locate`]).
 pub fn search_dirs() -> Vec<PathBuf> {
     let mut dirs = vec![PathBuf::from("profiles")];
-    // The XDG base directory rule, which is all a Linux cell PC needs; an
-    // empty or relative value is to be ignored, as the specification says.
-    let config = std::env::var_os("XDG_CONFIG_HOME")
-        .map(PathBuf::from)
-        .filter(|p| p.is_absolute())
-        .or_else(|| {
-            std::env::var_os("HOME")
-                .map(PathBuf::from)
-                .filter(|p| p.is_absolute())
-                .map(|h| h.join(".config"))
-        });
-    if let Some(c) = config {
+    if let Some(c) = crate::dirs::config_home() {
         dirs.push(c.join("vss").join("profiles"));
     }
     dirs
-}
-
-/// The XDG state folder: `$XDG_STATE_HOME`, else `~/.local/state`. A
-/// relative (or empty) value is invalid and ignored, as the XDG base
-/// directory specification says: a relative path would put the state in
-/// whatever folder vss runs in. `None` without an absolute `HOME` either.
-pub fn state_home() -> Option<PathBuf> {
-    std::env::var_os("XDG_STATE_HOME")
-        .map(PathBuf::from)
-        .filter(|p| p.is_absolute())
-        .or_else(|| {
-            std::env::var_os("HOME")
-                .map(PathBuf::from)
-                .filter(|p| p.is_absolute())
-                .map(|h| h.join(".local/state"))
-        })
 }
 
 /// Finds a profile: an existing path as given, else `NAME.toml` in each of
@@ -518,19 +491,6 @@ pub fn locate(name_or_path: &str) -> Result<Origin, ProfileError> {
         name: crate::text::sanitize(name_or_path),
         tried: tried.join(", "),
     })
-}
-
-/// The profile file a name or path names ([`locate`]); the built-in
-/// profile has none, so `default` is an error unless a file takes its
-/// place.
-pub fn resolve(name_or_path: &str) -> Result<PathBuf, ProfileError> {
-    match locate(name_or_path)? {
-        Origin::File(p) => Ok(p),
-        Origin::Builtin => Err(ProfileError::NotFound {
-            name: name_or_path.to_string(),
-            tried: "the built-in default has no file".into(),
-        }),
-    }
 }
 
 /// A profile's text and the name its errors use, wherever it was found:

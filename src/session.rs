@@ -127,10 +127,6 @@ pub enum SessionError {
     PathTooLong { dir: PathBuf, len: usize },
     #[error("image number {0} is out of range: image numbers run from 1 to {MAX_IMAGE_NUMBER}")]
     BadImage(u32),
-    #[error(
-        "{0} planned images are more than a session holds: image numbers run from 1 to {MAX_IMAGE_NUMBER}"
-    )]
-    TooManyImages(u32),
     #[error("image {image} of session {session}: {what}")]
     Missing {
         session: String,
@@ -264,18 +260,6 @@ impl Session {
         Self::open_with(dir, Some(true))
     }
 
-    /// Opens `parent/name` if it is a session, else creates it.
-    pub fn open_or_create(
-        parent: &Path,
-        name: &str,
-        profile: &Profile,
-    ) -> Result<Session, SessionError> {
-        match Self::open_existing(parent, name)? {
-            Some(s) => Ok(s),
-            None => Self::create(parent, name, profile),
-        }
-    }
-
     /// Opens `parent/name` for writing if it is a session; `None` when there
     /// is none yet (and nothing is made).
     pub fn open_existing(parent: &Path, name: &str) -> Result<Option<Session>, SessionError> {
@@ -370,9 +354,6 @@ impl Session {
     pub fn manifest(&self) -> &Manifest {
         &self.manifest
     }
-    pub fn is_read_only(&self) -> bool {
-        self.lock.is_none()
-    }
     /// Records a camera calibration accepted while this session is open
     /// (the `.cdf` it wrote, when, its views and fit) in the manifest.
     pub fn record_calibration(
@@ -425,16 +406,6 @@ impl Session {
             ext: ext.to_string(),
         }
         .file_name()
-    }
-
-    /// Sets how many images the survey plans (at most [`MAX_IMAGE_NUMBER`]).
-    pub fn set_planned_images(&mut self, n: u32) -> Result<(), SessionError> {
-        self.writable()?;
-        if n > MAX_IMAGE_NUMBER {
-            return Err(SessionError::TooManyImages(n));
-        }
-        self.manifest.session.planned_images = n.max(1);
-        self.commit()
     }
 
     /// Records which camera at which location took image `k`, and copies

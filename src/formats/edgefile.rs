@@ -333,24 +333,6 @@ fn open_header(path: &Path) -> Result<(std::fs::File, u64, Header, Vec<u8>), For
     Ok((f, len, h, rest))
 }
 
-/// Reads only the header of an edge file (for `vss info`): direction, size
-/// and count, checked against the file size; no point is read.
-pub fn read_edges_header(path: &Path) -> Result<EdgePoints, FormatError> {
-    let (_, _, h, _) = open_header(path)?;
-    Ok(EdgePoints {
-        dir: h.dir,
-        width: h.width,
-        height: h.height,
-        points: Vec::new(),
-    })
-}
-
-/// The number of points an edge file's header promises (checked against
-/// the file's size), without reading them.
-pub fn read_edges_count(path: &Path) -> Result<usize, FormatError> {
-    open_header(path).map(|(_, _, h, _)| h.count)
-}
-
 /// Writes a `.hpo`/`.vpo` file atomically; non-finite values, a width or
 /// height over [`MAX_SIDE`] and more than [`MAX_POINTS`] points (which
 /// [`read_edges`] would refuse) are refused.

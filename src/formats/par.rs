@@ -451,16 +451,6 @@ pub fn from_params(p: &Params, set: ParamSet) -> ParFile {
     }
 }
 
-/// Applies the entries of a set that name LLV parameters to `p`, checking
-/// each against its range. Returns notes on the entries it ignored.
-pub fn apply_to_params(
-    f: &ParFile,
-    p: &mut Params,
-    path: &Path,
-) -> Result<Vec<String>, FormatError> {
-    apply(f, None, p, path)
-}
-
 /// Parses `.par` text and applies it to `base` (errors name the value line).
 pub fn import_params(
     text: &str,

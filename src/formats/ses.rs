@@ -5,9 +5,7 @@
 
 use std::path::Path;
 
-use super::{
-    FormatError, FormatErrorKind as K, Location, numbered_lines, read_text, shorten, write_bytes,
-};
+use super::{FormatError, FormatErrorKind as K, numbered_lines, read_text, shorten};
 
 /// Most lighting configurations: they are lettered `a`–`z`.
 pub const MAX_LIGHTINGS: u32 = 26;
@@ -114,16 +112,9 @@ pub fn read_ses(path: &Path) -> Result<Ses, FormatError> {
     parse_ses(&read_text(path)?, path)
 }
 
-/// Writes a `.ses` file atomically; see [`Ses::check`].
-pub fn write_ses(path: &Path, s: &Ses) -> Result<(), FormatError> {
-    if let Some(m) = s.check() {
-        return Err(FormatError::new(path, Location::None, K::Range, m));
-    }
-    write_bytes(path, format_ses(s).as_bytes())
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::Location;
     use super::*;
 
     #[test]

@@ -102,11 +102,6 @@ impl<W: Write> PsWriter<W> {
         self.page(|o| o.write_all(body))
     }
 
-    /// Number of pages written so far.
-    pub fn page_count(&self) -> usize {
-        self.written
-    }
-
     /// `img2ps`: grey images with their captions, up to six per page (two
     /// columns, three rows), as many pages as needed
     /// ([`grey_pages_count`]).

@@ -55,7 +55,7 @@ pub fn on_disk(path: &Path) -> String {
             format!(
                 "{} on disk is the OLD report, untouched, written {}",
                 path.display(),
-                crate::session::stamp::rfc3339(secs)
+                crate::clock::rfc3339(secs)
             )
         }
         Err(_) => format!("there is no {} yet", path.display()),

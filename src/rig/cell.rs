@@ -162,10 +162,6 @@ impl Cell {
         self.sim.as_ref()
     }
 
-    pub fn sim_mut(&mut self) -> Option<&mut SimCell> {
-        self.sim.as_mut()
-    }
-
     pub fn profile(&self) -> &Profile {
         &self.profile
     }

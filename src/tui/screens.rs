@@ -98,18 +98,6 @@ impl App {
     pub fn ascii(&self) -> bool {
         self.chrome.look.mode == PreviewMode::Ascii
     }
-
-    /// The preview mode as the operator would ask for it.
-    pub fn look_name(&self) -> &'static str {
-        use super::widgets::preview::PreviewMode as M;
-        match (self.chrome.look.mode, self.chrome.look.colour) {
-            (M::Ascii, true) => "ascii, 16 colours",
-            (M::Ascii, false) => "ascii",
-            (M::Braille, _) => "braille",
-            (M::Blocks, true) => "blocks",
-            (M::Blocks, false) => "blocks, no colour",
-        }
-    }
 }
 
 /// A bordered block with a title; plain ASCII borders in ASCII mode.

@@ -4,6 +4,8 @@
 //! photographs it is tuned on (`../shared/data/yud-tune`). Each floor is within
 //! 0.01 of what the engine measures, so that a regression fails.
 
+#[path = "../it/support/bin.rs"]
+mod bin;
 mod cubes;
 mod real;
 mod yard;

@@ -11,7 +11,7 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use super::default_params;
-use assert_cmd::Command;
+use crate::bin::vss;
 use vss::synth::Metrics;
 use vss::synth::eval::yard::{Level, YardConfig, YardReport, evaluate_yard};
 
@@ -145,10 +145,6 @@ fn lens_correction_scores_as_the_undistorted_scene() {
 }
 
 // The export / score path.
-
-fn vss() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_vss"))
-}
 
 fn run_ok(args: &[&str]) -> Vec<u8> {
     let out = vss().args(args).output().unwrap();

@@ -2,11 +2,7 @@
 //! for scripts, and a clear refusal of bad arguments. Small scenes keep it
 //! quick; the floors themselves are in `tests/accuracy/` (`cargo test --test accuracy`).
 
-use assert_cmd::Command;
-
-fn vss() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_vss"))
-}
+use crate::support::vss;
 
 #[test]
 fn selftest_prints_both_position_kinds_and_the_lens_check() {

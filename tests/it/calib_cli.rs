@@ -8,14 +8,10 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
-use assert_cmd::cargo::cargo_bin;
+use crate::support::vss;
 use vss::formats::cdf::{Status, read_cdf};
 use vss::profile::{GrabberKind, Profile, RelayKind};
 use vss::rig::sim::cell_profile;
-
-fn vss() -> Command {
-    Command::new(cargo_bin("vss"))
-}
 
 fn repo(p: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(p)

@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use assert_cmd::cargo::cargo_bin;
+use crate::support::vss;
 use vss::calib::{self, CalibError, DetectError, Detector, Options, Plate, View};
 use vss::formats::imageio;
 use vss::llv::GreyImage;
@@ -268,10 +268,6 @@ fn too_few_or_alike_views_are_refused_with_what_to_do() {
         ),
         "{e}"
     );
-}
-
-fn vss() -> Command {
-    Command::new(cargo_bin("vss"))
 }
 
 fn write_board(dir: &Path) -> PathBuf {

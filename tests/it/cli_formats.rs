@@ -4,13 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
+use crate::support::vss;
 use vss::formats::img::{ImgFile, encode_img, write_img};
 use vss::llv::GreyImage;
-
-fn vss() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_vss"))
-}
 
 fn profile() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("profiles/default.toml")

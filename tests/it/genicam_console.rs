@@ -19,9 +19,10 @@ use vss::tui::workers::device;
 
 /// One fake camera (its frames cut to 256 × 256), four lights and five
 /// lightings (the last ambient), one camera in the survey.
-const PROFILE: &str = r#"
-name = "fake GigE Vision camera"
-
+const PROFILE: &str = concat!(
+    "name = \"fake GigE Vision camera\"\n",
+    crate::support::fixtures::five_lightings!(),
+    r#"
 [grabber]
 kind = "genicam"
 cameras = ["127.0.0.1"]
@@ -37,39 +38,11 @@ packet_size = 16000
 [relay]
 settle_ms = 5
 
-[[lights]]
-name = "lf"
-relay = 0
-[[lights]]
-name = "rf"
-relay = 1
-[[lights]]
-name = "lb"
-relay = 2
-[[lights]]
-name = "rb"
-relay = 3
-
-[[lighting]]
-letter = "a"
-on = ["lf"]
-[[lighting]]
-letter = "b"
-on = ["rf"]
-[[lighting]]
-letter = "c"
-on = ["lb"]
-[[lighting]]
-letter = "d"
-on = ["rb"]
-[[lighting]]
-letter = "e"
-on = []
-
 [survey]
 dir = "sessions"
 cameras = 1
-"#;
+"#
+);
 
 /// Captures image `k` on the Survey screen (going beyond the plan of one
 /// image when asked) and accepts it.

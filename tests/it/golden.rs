@@ -11,7 +11,7 @@
 //!   lightings, rendered by the simulator's own code, through camera 1's
 //!   lens (`--cdf`).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use assert_cmd::Command;
 
@@ -20,19 +20,10 @@ use vss::llv::GreyImage;
 use vss::profile::Profile;
 use vss::rig::sim::{Scene, SimOptions};
 
+use crate::support::golden::{dir as golden_dir, regen};
 use crate::support::llv_scene;
 
 const OUTPUTS: [&str; 4] = ["hpo", "vpo", "lex", "ldr"];
-
-fn golden_dir(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/golden")
-        .join(name)
-}
-
-fn regen() -> bool {
-    std::env::var_os("VSS_REGEN").is_some_and(|v| v == "1")
-}
 
 /// Runs `vss llv ARGS --out DIR` in `dir` and compares (or, with
 /// `VSS_REGEN=1`, rewrites) `STEM.{hpo,vpo,lex,ldr}` against `tests/golden/NAME/`.

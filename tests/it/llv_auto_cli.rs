@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-use assert_cmd::Command;
+use crate::support::vss;
+use assert_cmd::assert::OutputAssertExt;
 use vss::formats::img::{ImgFile, write_img};
 use vss::formats::lines::read_lines;
 use vss::synth::{self, PointLight, RenderOptions};
@@ -35,10 +36,6 @@ fn write_view(dir: &Path) {
     }
     let amb = synth::render(&scene, &cam, &[], &o(9));
     write_img(&dir.join("cube1e.img"), &ImgFile::new(amb)).unwrap();
-}
-
-fn vss() -> Command {
-    Command::cargo_bin("vss").unwrap()
 }
 
 #[test]

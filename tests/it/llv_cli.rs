@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-use assert_cmd::Command;
+use crate::support::vss;
+use assert_cmd::assert::OutputAssertExt;
 use vss::formats::img::{ImgFile, write_img};
 use vss::llv::GreyImage;
 
@@ -20,10 +21,6 @@ fn rect(x: usize, y: usize, hi: u8, lo: u8) -> u8 {
     } else {
         lo
     }
-}
-
-fn vss() -> Command {
-    Command::cargo_bin("vss").unwrap()
 }
 
 #[test]

@@ -8,13 +8,10 @@
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
+use crate::support::vss;
+use assert_cmd::assert::OutputAssertExt;
 use vss::formats::FormatErrorKind as K;
 use vss::formats::imageio::read_any_noted;
-
-fn vss() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_vss"))
-}
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -54,6 +54,7 @@ mod session_crash;
 mod session_redo;
 mod tui_device;
 mod tui_flow;
+mod tui_golden;
 mod tui_harness;
 mod tui_pty;
 mod tui_pty_builtin;

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::support::vss;
 use assert_cmd::cargo::cargo_bin;
 use vss::formats::img::read_img;
 use vss::profile::{GrabberKind, Profile, RelayKind};
@@ -24,10 +25,6 @@ fn write_profile(dir: &Path, name: &str, p: &Profile) -> PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, toml::to_string(p).expect("profile to toml")).expect("write profile");
     path
-}
-
-fn vss() -> Command {
-    Command::new(cargo_bin("vss"))
 }
 
 /// `vss sim` in the background, and the two device paths it printed.

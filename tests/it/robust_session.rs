@@ -229,7 +229,10 @@ fn a_displaced_writer_cannot_save_and_no_record_is_lost() {
         !a.dir().join("tw3a.img").exists(),
         "the refused image was written"
     );
-    assert!(a.set_planned_images(9).is_err(), "any write is refused");
+    assert!(
+        a.set_image_info(1, 1, 1, None).is_err(),
+        "any write is refused"
+    );
     b.save_image(4, 'a', &grey(4)).expect("b saves 4");
     drop(a);
     drop(b);

@@ -6,9 +6,10 @@
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 use std::time::Duration;
 
+use crate::support::vss;
 use vss::formats::{edgefile, img, lines};
 use vss::llv::rng::SplitMix64;
 use vss::session::Session;
@@ -34,10 +35,6 @@ on = ["right"]
 letter = "c"
 on = ["left", "right"]
 "#;
-
-fn vss() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_vss"))
-}
 
 /// Every session file is whole; returns how many were verified.
 fn verify_files(dir: &Path) -> usize {

@@ -15,28 +15,12 @@ use vss::tui::keymap::{Action, KEYMAP, Key, ModalAction, Scope, ScreenId, Survey
 
 /// A small, quick simulated cell: 128 × 128 images, short settle, three
 /// lightings (c ambient), four cameras.
-pub const PROFILE: &str = r#"
-name = "pty test cell"
-
+pub const PROFILE: &str = concat!(
+    "name = \"pty test cell\"\n",
+    crate::support::fixtures::two_lights!(),
+    r#"
 [relay]
 settle_ms = 5
-
-[[lights]]
-name = "left"
-relay = 0
-[[lights]]
-name = "right"
-relay = 1
-
-[[lighting]]
-letter = "a"
-on = ["left"]
-[[lighting]]
-letter = "b"
-on = ["right"]
-[[lighting]]
-letter = "c"
-on = []
 
 [survey]
 dir = "sessions"
@@ -47,47 +31,20 @@ width = 128
 height = 128
 seed = 7
 noise = 1.0
-"#;
+"#
+);
 
 /// The default cell's five lightings (four lights, then ambient) at 128 ×
 /// 128, with each camera's `.cdf` beside the profile so lens correction
 /// runs; `lens` sets `lens.enabled`.
 pub fn five_lightings(lens: bool) -> String {
     format!(
-        r#"
-name = "five lightings"
-
+        concat!(
+            "name = \"five lightings\"\n",
+            crate::support::fixtures::five_lightings!(),
+            r#"
 [relay]
 settle_ms = 5
-
-[[lights]]
-name = "lf"
-relay = 0
-[[lights]]
-name = "rf"
-relay = 1
-[[lights]]
-name = "lb"
-relay = 2
-[[lights]]
-name = "rb"
-relay = 3
-
-[[lighting]]
-letter = "a"
-on = ["lf"]
-[[lighting]]
-letter = "b"
-on = ["rf"]
-[[lighting]]
-letter = "c"
-on = ["lb"]
-[[lighting]]
-letter = "d"
-on = ["rb"]
-[[lighting]]
-letter = "e"
-on = []
 
 [survey]
 dir = "sessions"
@@ -103,6 +60,8 @@ noise = 1.0
 [llv.lens]
 enabled = {lens}
 "#
+        ),
+        lens = lens
     )
 }
 

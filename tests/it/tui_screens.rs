@@ -27,27 +27,15 @@ use vss::tui::keymap::{
 use vss::tui::mode::Look;
 use vss::tui::widgets::preview::PreviewMode;
 
-const PROFILE: &str = r#"
-name = "screen test cell"
-[[lights]]
-name = "left"
-relay = 0
-[[lights]]
-name = "right"
-relay = 1
-[[lighting]]
-letter = "a"
-on = ["left"]
-[[lighting]]
-letter = "b"
-on = ["right"]
-[[lighting]]
-letter = "c"
-on = []
-"#;
+const PROFILE: &str = concat!(
+    "name = \"screen test cell\"\n",
+    crate::support::fixtures::two_lights!()
+);
 
+/// The profile, named by a fixed absolute path that is never made (the
+/// console shows it; a relative one would show the checkout's folder).
 pub fn profile() -> Profile {
-    Profile::from_toml(PROFILE, Path::new("test.toml")).unwrap()
+    Profile::from_toml(PROFILE, Path::new("/srv/vss/profiles/screen-test.toml")).unwrap()
 }
 
 pub fn colour() -> Look {
@@ -142,11 +130,19 @@ pub fn view() -> SessionView {
     }
 }
 
-/// Runs a pipeline request in the test, as the worker would.
+/// Runs a pipeline request in the test, as the worker would, with the
+/// stage times pinned (lens 1.0 ms, edges 2.0, lines 3.0, connect 0.4) so
+/// that a drawing does not depend on the machine (`tui_golden`).
 pub fn run(app: &mut App, cmds: Vec<Cmd>) {
     for c in cmds {
         if let Cmd::Pipeline(req) = c {
-            let out = pipeline::run(&req.input.input(None), &req.params).unwrap();
+            let mut out = pipeline::run(&req.input.input(None), &req.params).unwrap();
+            out.timings = pipeline::Timings {
+                lens_us: 1000,
+                edges_us: 2000,
+                lines_us: 3000,
+                connect_us: 400,
+            };
             app.update(Msg::Pipeline(PipelineResult {
                 generation: req.generation,
                 image_key: req.image_key,

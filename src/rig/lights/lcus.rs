@@ -52,7 +52,7 @@ const MAX_STATE_LEN: u64 = 4096;
 /// The state file of the LCUS board on `port` (see the module doc), or
 /// `None` when neither `XDG_STATE_HOME` nor `HOME` is set.
 pub fn lcus_state_file(port: &str) -> Option<PathBuf> {
-    let base = crate::profile::state_home()?;
+    let base = crate::dirs::state_home()?;
     let name: String = port
         .chars()
         .map(|c| {
@@ -164,7 +164,7 @@ impl<P: Link> LcusBoard<P> {
     fn remember(&mut self, mask: u32) -> Result<(), RigError> {
         let last = LastSet {
             mask,
-            when: crate::session::stamp::now_rfc3339(),
+            when: crate::clock::now_rfc3339(),
         };
         self.sent = Some(mask);
         self.last = Some(last.clone());

@@ -16,11 +16,7 @@ pub struct LogFile {
 
 /// The log file while no session is open.
 pub fn state_path() -> Option<PathBuf> {
-    Some(
-        crate::profile::state_home()?
-            .join("vss")
-            .join("console.log"),
-    )
+    Some(crate::dirs::state_home()?.join("vss").join("console.log"))
 }
 
 impl LogFile {
@@ -54,7 +50,7 @@ impl LogFile {
         writeln!(
             f,
             "--- vss console {} (process {}) ---",
-            crate::session::stamp::now_rfc3339(),
+            crate::clock::now_rfc3339(),
             std::process::id()
         )?;
         f.sync_data()?;

@@ -1,0 +1,69 @@
+//! Profile fragments several test modules build their cells from, as
+//! macros that expand to string literals so that a module can `concat!`
+//! them into a `const` with its own name, `[relay]`, `[survey]` and
+//! `[sim]` tables.
+
+/// Two lights, `left` (relay 0) and `right` (relay 1), and three lightings:
+/// `a` left, `b` right, `c` none (the ambient image).
+macro_rules! two_lights {
+    () => {
+        r#"
+[[lights]]
+name = "left"
+relay = 0
+[[lights]]
+name = "right"
+relay = 1
+
+[[lighting]]
+letter = "a"
+on = ["left"]
+[[lighting]]
+letter = "b"
+on = ["right"]
+[[lighting]]
+letter = "c"
+on = []
+"#
+    };
+}
+
+/// The default cell's four lights (`lf`, `rf`, `lb`, `rb` on relays 0–3)
+/// and five lightings: `a`–`d` one light each, `e` none (ambient).
+macro_rules! five_lightings {
+    () => {
+        r#"
+[[lights]]
+name = "lf"
+relay = 0
+[[lights]]
+name = "rf"
+relay = 1
+[[lights]]
+name = "lb"
+relay = 2
+[[lights]]
+name = "rb"
+relay = 3
+
+[[lighting]]
+letter = "a"
+on = ["lf"]
+[[lighting]]
+letter = "b"
+on = ["rf"]
+[[lighting]]
+letter = "c"
+on = ["lb"]
+[[lighting]]
+letter = "d"
+on = ["rb"]
+[[lighting]]
+letter = "e"
+on = []
+"#
+    };
+}
+
+#[allow(unused_imports)] // each test module uses some of them
+pub(crate) use {five_lightings, two_lights};
