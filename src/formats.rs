@@ -19,6 +19,7 @@ pub mod img;
 pub mod lines;
 pub mod names;
 pub mod par;
+pub mod pixels;
 pub mod ses;
 
 /// Where in a file an error was found.

@@ -15,7 +15,6 @@ pub mod cell;
 pub mod genicam;
 pub mod grabber;
 pub mod lights;
-pub mod pixels;
 pub mod protocol;
 pub mod replay;
 #[cfg(test)]

@@ -454,13 +454,13 @@ fn check_genicam(g: &super::GrabberConfig, cx: &Ctx<'_, '_>) -> Result<(), Profi
     }
     for (i, s) in g.camera.iter().enumerate() {
         if let Some(f) = &s.pixel_format
-            && !crate::rig::pixels::PIXEL_FORMATS.contains(&f.as_str())
+            && !crate::formats::pixels::PIXEL_FORMATS.contains(&f.as_str())
         {
             return Err(cx.at(
                 &[K("grabber"), K("camera"), I(i), K("pixel_format")],
                 format!(
                     "pixel format \"{f}\" cannot be used; vss reads {}",
-                    crate::rig::pixels::PIXEL_FORMATS.join(", ")
+                    crate::formats::pixels::PIXEL_FORMATS.join(", ")
                 ),
             ));
         }

@@ -38,9 +38,9 @@ use aravis::prelude::*;
 use aravis::{Buffer, BufferPayloadType, BufferStatus, Camera, Stream};
 
 use super::grabber::{FrameGrabber, WireStats};
-use super::pixels::{Mono, PIXEL_FORMATS, to_grey8};
 use super::protocol::{FrameInfo, GrabberInfo, GrabberStatus, crc32};
 use super::{CameraState, RigError};
+use crate::formats::pixels::{Mono, PIXEL_FORMATS, to_grey8};
 use crate::llv::GreyImage;
 use crate::profile::{CameraSettings, GrabberConfig};
 
