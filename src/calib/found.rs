@@ -78,7 +78,7 @@ pub struct Corner {
 /// The grid found in one view.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Detection {
-    /// Every corner of [`Plate::corners`], in that order.
+    /// Every corner of [`Plate::corners`](super::plate::Plate::corners), in that order.
     pub corners: Vec<Corner>,
     /// The plate's cells as found (image corners), for drawing.
     pub cells: Vec<[[f64; 2]; 4]>,

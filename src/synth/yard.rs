@@ -37,7 +37,7 @@
 //! - truth: boundaries between facets with a contrast each; faint ones and
 //!   those in the 8-px border band are don't-care (`score::Tally::add_with`).
 //!
-//! Deterministic for a seed; 0.06–0.13 s per 512² scene with its truth.
+//! Deterministic for a seed.
 
 mod build;
 mod poly;

@@ -21,22 +21,17 @@
 //!    larger inward move is a crossing or T-junction, not a corner).
 //!    Without the first test, two close parallel edges meeting a third (a
 //!    plate seen edge-on against an upright) had their ends moved to a point
-//!    between them, tilting both: on the cubes at noise σ 10 the mean
-//!    endpoint distance from the true lines is 0.094 px with the test and
-//!    0.108 without, the angle error 0.188° against 0.197°, F, recall and
-//!    precision the same at every level (0.5 px: F 0.977 at σ 10; 2 px: as
-//!    without).
+//!    between them, tilting both (docs/llv.md, "Measurements behind the
+//!    design").
 //! 3. Otherwise the cluster falls back to pairs: every pair of endpoints of
 //!    non-parallel lines within `radius`, whose intersection lies within
 //!    `radius` of both and is a corner move for both, ordered by the total
 //!    distance the two endpoints move (then by index, so the result is
 //!    deterministic); each endpoint moves at most once.
 //!
-//! Measured on twelve noisy synthetic scenes (`tests/it/llv_corners.rs`,
-//! with a stray-point check in the line extractor): with a radius of 5 px
-//! the mean distance of endpoints near corners from the true corner falls
-//! from 2.63 px to 2.19 px while precision and recall rise slightly; 8 px
-//! still gains but starts pairing lines of neighbouring corners.
+//! The radius (5 px) brings endpoints near corners closer to the true corner
+//! without pairing lines of neighbouring corners (docs/llv.md, "Measurements
+//! behind the design").
 //!
 //! Nearly parallel lines are left alone: their intersection is far away or
 //! ill-defined, and joining colinear pieces is CONNECT's job (§4).

@@ -36,9 +36,8 @@
 //!   point; where the edge turns the track ends after `max_gap` lines of
 //!   them). The second bound is the track's own scatter: a faint edge in
 //!   strong noise has points 0.5 px and more off its line, and a fixed
-//!   1.5 px ended it at the first wide one (on the tuning scenes at σ 10:
-//!   recall 0.972 → 0.974, F 0.983 → 0.984; σ 2 and 5 the same to the last
-//!   digit, as their tracks scatter by under 0.5 px).
+//!   1.5 px ended it at the first wide one (docs/llv.md, "Measurements
+//!   behind the design").
 //! - **Splitting** (`split.rs`): where two straight pieces fit the points
 //!   significantly better than one line, the track is cut there.
 //! - **Validation** (`nfa.rs`): a piece is kept when its number of false

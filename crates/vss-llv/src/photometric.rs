@@ -34,10 +34,9 @@
 //! `τ_i = edges.noise_factor × m_i` off each term (`Σ max(0, |r_i| − τ_i)`,
 //! the optimum of the weights `w_i ∈ {−1, 0, 1}`) and modelled the combined
 //! response's noise from the τ's. On real photographs the τ, read from
-//! textured images, took faint edges away: with each tune photograph lit
-//! three ways, the combination lost 0.03 recall to the best single image
-//! (F 0.726 against 0.740), and on the synthetic lightings it let more noise
-//! through than this rule (docs/accuracy.md, "Not done"). `edges.noise_factor`
+//! textured images, took faint edges away on real photographs lit several
+//! ways, and on the synthetic lightings it let more noise through than this
+//! rule (docs/llv.md, "Measurements behind the design"). `edges.noise_factor`
 //! is kept so that older profiles and sessions read; it has no effect.
 //!
 //! Peaks, subpixel positions and the adaptive threshold then run unchanged

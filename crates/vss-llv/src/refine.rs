@@ -38,33 +38,13 @@
 //!   strongest edge at the line (the derivative of profiles summed on
 //!   eight scan lines).
 //!
-//! How it was chosen, on the cube family only (`vss selftest --family
-//! cubes`, endpoints px / angle °), sampling bilinearly along the normal:
-//! - Without it: σ 2 0.031 / 0.063, σ 5 0.055 / 0.101, σ 10 0.095 / 0.150.
-//! - Every segment refitted, 8-px blocks, `A` = 3: 0.028 / 0.060, 0.052 /
-//!   0.099, 0.094 / 0.172 — the direction of short segments got worse.
-//! - Segments of 6 blocks and more only: 0.027 / 0.058, 0.051 / 0.097,
-//!   0.082 / 0.137, and F at σ 10 0.981 → 0.982. (`A` = 4: σ 2 0.032;
-//!   4-px blocks: σ 5 0.058; 4 blocks at least: σ 10 0.088; before
-//!   CONNECT instead of after: σ 2 0.034; a reach of 1.0 px or 1.5, the
-//!   nearest peak or the strongest: the same.)
-//! - Bilinear samples cost 300 µs an image on the bench scene (a third of
-//!   the pipeline). Samples on scan lines, interpolated along them only,
-//!   cost about 1.0 M instructions (11 %) and give 0.030 / 0.062, 0.054 /
-//!   0.101, 0.086 / 0.144: most of the gain.
-//!
-//! Then, on the yard family (not used to choose), endpoints fell at every
-//! level (σ 0/2/5/10/sd: 0.094 / 0.136 / 0.178 / 0.278 / 0.179 → 0.089 /
-//! 0.117 / 0.151 / 0.254 / 0.155 px) and so did the angles (0.182 / 0.239
-//! / 0.300 / 0.434 / 0.282 → 0.181 / 0.229 / 0.275 / 0.426 / 0.266°).
-//!
-//! The weights were chosen on that argument alone: the cubes
-//! have one contrast along each edge and cannot show them (endpoints σ 2 /
-//! 5 / 10 0.030 / 0.054 / 0.084 → 0.031 / 0.054 / 0.084 px). The yard's
-//! edges fade along their length: σ 0/2/5/10/sd 0.089 / 0.117 / 0.151 /
-//! 0.254 / 0.155 → 0.089 / 0.116 / 0.148 / 0.234 / 0.152 px, angles at
-//! σ 10 0.426 → 0.404°. (The derivative itself as the weight, looked at
-//! beside them: 0.244 px at σ 10.)
+//! How it was chosen: on the cube family, then checked on the yard family
+//! (docs/llv.md, "Measurements behind the design"): only segments of
+//! `MIN_BLOCKS` blocks and more are refitted (the direction of short ones
+//! got worse), samples on scan lines interpolated along them only keep most
+//! of the gain at a third of the cost of bilinear ones, and the squared
+//! derivative as weight helps where edges fade along their length (the
+//! yard's), not where they do not (the cubes').
 //!
 //! The refit needs the image: lines made from edge files alone (`vss llv
 //! --from-edges`, and a session image without frames) are not refitted;

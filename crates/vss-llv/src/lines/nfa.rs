@@ -22,10 +22,10 @@
 //! but a track is not placed at random: it takes the nearest peak, and
 //! where it crosses a strong edge that edge gives it two or three points
 //! of 8 σ and more. Without the rule, those few points alone made any
-//! track through flat ground significant — 20-px tracks crossing cube
-//! edges at 30–60° on the tuning scenes (σ 2, `track_sigmas` 1: precision
-//! 0.996 → 0.954). A true edge has its points on most of its lines at its
-//! own level, so the rule costs it nothing there.
+//! track through flat ground significant (tracks crossing cube edges at
+//! 30–60°; docs/llv.md, "Measurements behind the design"). A true edge has
+//! its points on most of its lines at its own level, so the rule costs it
+//! nothing there.
 
 /// Noise sigmas of the table's levels.
 const TABLE_Z: [f64; 9] = [1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0];
