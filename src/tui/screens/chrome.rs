@@ -27,16 +27,26 @@ pub fn wrap(text: &str, width: usize) -> Vec<String> {
         .collect()
 }
 
-fn newest(app: &App) -> Option<String> {
-    app.chrome
-        .log
-        .last()
-        .map(|e| format!("{} {}", e.time, e.text))
+/// The message line's text: the message shown ([`Chrome::shown_message`]),
+/// with how many newer ones wait in the log while it is held.
+///
+/// [`Chrome::shown_message`]: crate::tui::app::Chrome::shown_message
+fn newest(app: &App) -> Option<(String, crate::tui::app::Level)> {
+    app.chrome.shown_message().map(|(e, newer)| {
+        let more = if newer > 0 {
+            format!(" (+{newer} newer in the log)")
+        } else {
+            String::new()
+        };
+        (format!("{} {}{more}", e.time, e.text), e.level)
+    })
 }
 
 /// Rows the newest message needs (1 to [`MESSAGE_ROWS`]).
 pub fn message_rows(app: &App, width: u16) -> u16 {
-    newest(app).map_or(1, |m| wrap(&m, width as usize).len().clamp(1, MESSAGE_ROWS)) as u16
+    newest(app).map_or(1, |(m, _)| {
+        wrap(&m, width as usize).len().clamp(1, MESSAGE_ROWS)
+    }) as u16
 }
 
 pub fn top_bar(app: &App, area: Rect, buf: &mut Buffer) {
@@ -87,10 +97,9 @@ pub fn message(app: &App, area: Rect, buf: &mut Buffer) {
         return;
     }
     let t = app.theme();
-    let Some(e) = app.chrome.log.last() else {
+    let Some((text, level)) = newest(app) else {
         return;
     };
-    let text = format!("{} {}", e.time, e.text);
     let mut rows = wrap(&text, area.width as usize);
     let max = area.height as usize;
     if rows.len() > max {
@@ -104,7 +113,7 @@ pub fn message(app: &App, area: Rect, buf: &mut Buffer) {
     }
     let lines: Vec<Line> = rows
         .into_iter()
-        .map(|r| Line::styled(r, t.level(e.level)))
+        .map(|r| Line::styled(r, t.level(level)))
         .collect();
     Paragraph::new(lines).render(area, buf);
 }
@@ -560,8 +569,12 @@ pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
                         .map(|r| Line::styled(r, t.level(e.level))),
                 );
             };
+            let shown = app.chrome.shown_message().map(|(e, _)| e);
+            if let Some(e) = shown {
+                entry(e, "on the message line,");
+            }
             let last = app.chrome.log.last();
-            if let Some(e) = last {
+            if let Some(e) = last.filter(|e| Some(*e) != shown) {
                 entry(e, "newest,");
             }
             // An error that a later note pushed off the message row.
@@ -571,7 +584,7 @@ pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
                 .entries()
                 .rev()
                 .find(|e| e.level != crate::tui::app::Level::Info);
-            if let Some(e) = trouble.filter(|e| Some(*e) != last) {
+            if let Some(e) = trouble.filter(|e| Some(*e) != last && Some(*e) != shown) {
                 entry(e, "last problem,");
             }
             if let Some(f) = app.chrome.log.file() {
