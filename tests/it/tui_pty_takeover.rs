@@ -110,3 +110,33 @@ fn a_holder_that_does_not_answer_is_signalled_after_the_wait() {
     c.send("q");
     c.wait_exit(10);
 }
+
+/// The name `id -un` gives this test's user (from `/etc/passwd`).
+fn user_name() -> String {
+    let out = std::process::Command::new("id")
+        .arg("-un")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "id -un: {out:?}");
+    String::from_utf8(out.stdout).unwrap().trim().to_string()
+}
+
+/// A console started without `USER` and `LOGNAME` (`env -u`, a service)
+/// names its user in the lock from `/etc/passwd`, not "uid N", and a
+/// second console says so.
+#[test]
+fn the_lock_names_the_user_without_user_in_the_environment() {
+    let name = user_name();
+    let mut a = Console::start(80, 24, &[("USER", ""), ("LOGNAME", "")]);
+    a.create_session("cube");
+    let holder = read_holder(&a.session().join("cube.lock")).expect("a holds the lock");
+    assert_eq!(holder.user, name, "{holder:?}");
+    let mut b = a.another(80, 24);
+    let s = b.wait_words("in use by", 10);
+    // "(in use by NAME)", wrapped in the session list's column.
+    assert!(s.contains(&format!(" {name})")), "{s}");
+    b.send("q");
+    b.wait_exit(10);
+    a.send("q");
+    a.wait_exit(10);
+}
