@@ -262,8 +262,9 @@ fn lock_names_a_live_holder_and_yields_only_when_it_is_gone() {
     assert!(!text(&o).contains("in use"), "{}", text(&o));
     assert!(vss(&["session", "check", "held"], d).status.success());
     // A live holder and --take-over: asked through the folder, as the
-    // console asks (one function); the helper does not answer, so it is
-    // signalled after the wait, and the redo goes on.
+    // console asks (one function); the helper does not watch for requests
+    // (it is signalled after the wait, unless it let the lock go between
+    // two saves first), and the redo goes on.
     let mut child = Command::new(env!("CARGO_BIN_EXE_vss"))
         .args(["session", "torture", "held", "--limit", "1000000"])
         .current_dir(d)
