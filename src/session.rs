@@ -19,6 +19,7 @@ pub mod outputs;
 pub mod progress;
 pub mod redo;
 pub mod stamp;
+pub mod takeover;
 #[doc(hidden)]
 pub mod torture;
 

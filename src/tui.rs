@@ -203,7 +203,7 @@ fn run_loop(
                 // Every message of the run also goes to the log file.
                 workers.dispatch(app.take_log_lines().into_iter().collect());
             }
-            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Timeout) => dirty |= app.release_held(Instant::now()),
             Err(RecvTimeoutError::Disconnected) => break,
         }
     }

@@ -9,9 +9,16 @@
 //! surveying the same session is not written under, and every frame lands
 //! in the manifest with the camera and its `.cdf`. The image number, camera
 //! and lightings are checked before a new session is made, so a refused
-//! grab leaves nothing behind. A lock whose holder is gone (a grab killed
-//! mid-frame) or on another host is taken over with `--take-over`, or when
-//! the person at the terminal says yes; a live holder here never.
+//! grab leaves nothing behind. A locked session is taken over with
+//! `--take-over`, or when the person at the terminal says yes, by the rule
+//! the console follows ([`crate::session::takeover`]): a live holder on
+//! this host (a console, another grab) is asked through the session folder
+//! and signalled only when it does not answer.
+//!
+//! A grab asked to leave its session (`NAME.lock.leave`, checked between
+//! lightings and every 0.2 s of a transfer) stops the frame under way —
+//! nothing of it is saved, the lightings saved before stay recorded —
+//! releases the lock and exits non-zero, naming who took the session.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -45,15 +52,20 @@ pub struct Args {
     /// Overwrite images that exist already.
     #[arg(long)]
     pub yes: bool,
-    /// Take the session over when the lock's holder is gone (a killed
-    /// grab, a console that crashed) or ran on another host. Without it, a
-    /// terminal is asked; a live holder on this host is never displaced.
+    /// Take the session over from the lock's holder: a holder that is gone
+    /// (a killed grab, a crashed console) or on another host at once; a
+    /// live vss on this host is asked to leave (a console saves and
+    /// releases it), and signalled only if it does not within 5 s. Without
+    /// it, a terminal is asked.
     #[arg(long)]
     pub take_over: bool,
     /// Faults injected into an embedded simulated grabber (testing).
     #[arg(long, value_name = "SPEC", hide = true)]
     pub sim_faults: Option<String>,
 }
+
+/// How often a transfer looks for a request to leave the session.
+const LEAVE_POLL: std::time::Duration = std::time::Duration::from_millis(200);
 
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     let profile = g.load_profile()?;
@@ -153,19 +165,36 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        capture_one(&mut cell, &mut sess, &a, *letter, &stem, &cancel).with_context(|| {
-            format!(
-                "capturing {stem} (camera {}, lighting {letter}) failed; nothing of it was saved",
-                a.camera
-            )
-        })?;
+        let mut asked = left_for(&sess);
+        if asked.is_none() {
+            let captured = capture_one(
+                &mut cell, &mut sess, &a, *letter, &stem, &cancel, &mut asked,
+            );
+            if asked.is_none() {
+                captured.with_context(|| {
+                    format!(
+                        "capturing {stem} (camera {}, lighting {letter}) failed; nothing of it \
+                         was saved",
+                        a.camera
+                    )
+                })?;
+            }
+        }
+        if let Some(by) = asked {
+            drop(sess);
+            bail!(
+                "session {} was taken over by {by}: {stem} was not captured (nothing of it \
+                 saved), the lightings saved before are kept; the lock is released",
+                a.session.display()
+            );
+        }
     }
     Ok(ExitCode::SUCCESS)
 }
 
-/// Opens the session if it exists, taking over a lock whose holder is gone
-/// (or on another host) with `--take-over` or when a person at a terminal
-/// says so — the same rule as the console and `vss session redo`.
+/// Opens the session if it exists, taking over its lock with `--take-over`
+/// or when a person at a terminal says so — the same function as the
+/// console and `vss session redo`.
 fn open_existing(
     parent: &Path,
     session: &SessionName,
@@ -173,10 +202,12 @@ fn open_existing(
 ) -> anyhow::Result<Option<Session>> {
     let context = || format!("cannot open the session {}", a.session.display());
     match Session::open_existing(parent, session.as_str()) {
-        Err(e @ SessionError::Locked { stale, foreign, .. }) if stale || foreign => {
+        Err(e @ SessionError::Locked { .. }) => {
             if a.take_over || ask_take_over(&e)? {
                 let dir = parent.join(session.as_str());
-                let s = Session::open_take_over(&dir).with_context(context)?;
+                let mut say = |text: String| errln!("{text}");
+                let s = crate::session::takeover::open_taking_over(&dir, &mut say)
+                    .with_context(context)?;
                 errln!("took over the lock of {}", dir.display());
                 Ok(Some(s))
             } else {
@@ -206,6 +237,19 @@ take the session over? [y/N] "
     Ok(matches!(answer.trim(), "y" | "Y" | "yes" | "YES" | "Yes"))
 }
 
+/// Who asked this grab to leave its session, if anyone did and the
+/// request checks out ([`Session::leave_requested`]); a request that does
+/// not is said and ignored.
+fn left_for(sess: &Session) -> Option<String> {
+    match sess.leave_requested()? {
+        Ok(asker) => Some(asker.to_string()),
+        Err(why) => {
+            errln!("vss: a request to leave the session was ignored: {why}");
+            None
+        }
+    }
+}
+
 fn capture_one(
     cell: &mut Cell,
     sess: &mut Session,
@@ -213,10 +257,13 @@ fn capture_one(
     letter: char,
     stem: &str,
     cancel: &AtomicBool,
+    asked: &mut Option<String>,
 ) -> anyhow::Result<()> {
     let camera = a.camera;
     let mut err = std::io::stderr();
     let mut last_pct = u64::MAX;
+    let mut checked = std::time::Instant::now();
+    let watched: &Session = sess;
     let mut progress = |done: usize, total: usize| {
         let pct = (done as u64 * 100) / (total.max(1) as u64);
         if pct != last_pct {
@@ -224,7 +271,12 @@ fn capture_one(
             let _ = write!(err, "\r{stem}: {done}/{total} bytes ({pct}%)");
             let _ = err.flush();
         }
-        !cancel.load(Ordering::SeqCst)
+        // A request to leave stops the transfer, as Ctrl-C does.
+        if asked.is_none() && checked.elapsed() >= LEAVE_POLL {
+            checked = std::time::Instant::now();
+            *asked = left_for(watched);
+        }
+        !cancel.load(Ordering::SeqCst) && asked.is_none()
     };
     let result = cell.capture(camera, letter, &mut progress);
     errln!();

@@ -44,7 +44,9 @@ pub enum Cmd {
         /// First stage to re-run.
         #[arg(long, value_name = "STAGE", value_enum, default_value_t = FromStage::Edges)]
         from: FromStage,
-        /// Take over the lock of a console that is gone.
+        /// Take the session over: a lock whose holder is gone at once, a
+        /// live vss on this host asked to leave (as the console asks) and
+        /// signalled only if it does not within 5 s.
         #[arg(long)]
         take_over: bool,
     },
@@ -304,7 +306,8 @@ fn check(dir: &Path, strict: bool) -> anyhow::Result<ExitCode> {
 fn redo(g: &Global, dir: &Path, k: u32, stage: Stage, take_over: bool) -> anyhow::Result<ExitCode> {
     let profile = g.load_profile()?;
     let mut s = if take_over {
-        Session::open_take_over(dir)?
+        let mut say = |text: String| errln!("{text}");
+        crate::session::takeover::open_taking_over(dir, &mut say)?
     } else {
         Session::open(dir)?
     };

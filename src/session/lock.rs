@@ -377,6 +377,12 @@ fn hostname() -> String {
         .unwrap_or_else(|| "unknown-host".to_string())
 }
 
+/// The largest `/etc/passwd` read for the user's name.
+const MAX_PASSWD_LEN: u64 = 16 << 20;
+
+/// Who runs this process: `USER` or `LOGNAME`, else the name
+/// `/etc/passwd` gives the uid (a console started by a service or `env -u
+/// USER` has neither variable), else "uid N".
 fn username() -> String {
     for var in ["USER", "LOGNAME"] {
         if let Ok(u) = std::env::var(var)
@@ -385,18 +391,22 @@ fn username() -> String {
             return u;
         }
     }
-    fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find_map(|l| l.strip_prefix("Uid:"))
-                .and_then(|rest| {
-                    rest.split_whitespace()
-                        .next()
-                        .map(|uid| format!("uid {uid}"))
-                })
-        })
-        .unwrap_or_else(|| "unknown-user".to_string())
+    let uid = rustix::process::getuid().as_raw();
+    passwd_name(Path::new("/etc/passwd"), uid).unwrap_or_else(|| format!("uid {uid}"))
+}
+
+/// The name the passwd file at `path` gives `uid` (its first entry for
+/// it), read through the bounded reader; none when the file does not read
+/// or has no entry.
+fn passwd_name(path: &Path, uid: u32) -> Option<String> {
+    let bytes = crate::fsutil::read_input(path, MAX_PASSWD_LEN).ok()?;
+    String::from_utf8_lossy(&bytes).lines().find_map(|l| {
+        let mut f = l.split(':');
+        let name = f.next()?;
+        let _password = f.next()?;
+        let id: u32 = f.next()?.trim().parse().ok()?;
+        (id == uid && !name.is_empty()).then(|| name.to_string())
+    })
 }
 
 /// Start time (field 22 of `/proc/PID/stat`) of a live, non-zombie process.
@@ -416,6 +426,25 @@ fn proc_start(pid: u32) -> Option<u64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_user_is_named_from_the_passwd_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("passwd");
+        fs::write(
+            &p,
+            "root:x:0:0:root:/root:/bin/sh\n# note\n\nbad line\nop:x:1000:1000::/home/op:/bin/sh\nop2:x:1000:1000::/:/bin/sh\n",
+        )
+        .unwrap();
+        assert_eq!(passwd_name(&p, 0).as_deref(), Some("root"));
+        assert_eq!(
+            passwd_name(&p, 1000).as_deref(),
+            Some("op"),
+            "the first entry"
+        );
+        assert_eq!(passwd_name(&p, 7), None, "no entry: the caller says uid 7");
+        assert_eq!(passwd_name(&dir.path().join("none"), 0), None);
+    }
 
     #[test]
     fn second_holder_is_refused_and_release_frees() {

@@ -24,6 +24,8 @@ use serde::{Deserialize, Serialize};
 
 mod records;
 
+pub use records::MAX_RECORD_LEN;
+
 use super::{MAX_IMAGE_NUMBER, SessionError};
 use crate::llv::{Params, Segment};
 

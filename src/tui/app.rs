@@ -159,9 +159,27 @@ impl App {
 
     /// Applies one message; returns the work it asks of the workers.
     pub fn update(&mut self, msg: Msg) -> Vec<Cmd> {
+        let by_operator = match &msg {
+            Msg::Key(k) => k.kind == KeyEventKind::Press,
+            Msg::Pointer(_) => true,
+            _ => false,
+        };
+        let before = self.chrome.log.pushed();
         let cmds = self.apply(msg);
         self.close_stale_question();
+        let now = std::time::Instant::now();
+        if by_operator {
+            self.chrome.hold_answer(before, now);
+        } else {
+            self.chrome.release_held(now);
+        }
         cmds
+    }
+
+    /// Lets the answer held on the message line go once its time is over
+    /// (the shell calls it while idle); whether the screen changes.
+    pub fn release_held(&mut self, now: std::time::Instant) -> bool {
+        self.chrome.release_held(now)
     }
 
     /// Closes a question that no longer applies, saying so: "quit anyway?"

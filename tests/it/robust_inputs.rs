@@ -424,7 +424,17 @@ fn any_manifest_within_the_bound_reads_within_512_mib() {
     let max = vss::session::manifest::MAX_LEN;
     costly_manifest(root, "edge", max - 16);
     let (ok, out) = vss_limited(root, 512, &["session", "show", "edge"]);
-    // The values are not light names: refused, but read and parsed.
+    // One piece of 4 MiB outside the image records: refused before it is
+    // parsed (its tree took 325 MB), naming its size and the cap.
+    let cap = vss::session::manifest::MAX_RECORD_LEN;
+    assert!(
+        !ok && out.contains(&format!("takes {} bytes, more than the {cap}", max - 16)),
+        "{out}"
+    );
+    // Within the cap, the same values are read and parsed, and refused:
+    // they are not light names.
+    costly_manifest(root, "edge", cap);
+    let (ok, out) = vss_limited(root, 512, &["session", "show", "edge"]);
     assert!(!ok && out.contains("expected a string"), "{out}");
     costly_manifest(root, "over", 16 << 20);
     let (ok, out) = vss_limited(root, 512, &["session", "show", "over"]);

@@ -7,7 +7,7 @@
 //! record, and after the records, still name their line in the file.
 //!
 //! With `VSS_BIG_SESSION_DIR=DIR` the session is also written to `DIR/r4`
-//! and kept, to measure by hand: `/usr/bin/time -v target/debug/vss
+//! (and the one-record manifest to `DIR/huge`) and kept, to measure by hand: `/usr/bin/time -v target/debug/vss
 //! session show DIR/r4`.
 
 use std::ffi::OsStr;
@@ -18,7 +18,7 @@ use vss::llv::Params;
 use vss::session::Manifest;
 use vss::session::manifest::{
     CalibrationRecord, Counts, EditRecord, FileRecord, GreyRecord, ImageRecord, LightingInfo,
-    LineAttributes, MAX_LEN, OutputRecord, SessionInfo, TimingsRecord,
+    LineAttributes, MAX_LEN, MAX_RECORD_LEN, OutputRecord, SessionInfo, TimingsRecord,
 };
 
 const STAMP: &str = "2026-12-04T19:30:00Z";
@@ -270,4 +270,122 @@ fn errors_in_a_big_manifest_name_their_line() {
         "line {line}: {out}"
     );
     assert!(out.contains("unknown field `colour`"), "{out}");
+}
+
+/// Image 1 as a real cell could make it at its largest: 26 lightings,
+/// every parameter changed from the profile's, 100 lines' attributes and
+/// ten hand edits.
+fn largest_real_image() -> ImageRecord {
+    let mut r = image("big", 1);
+    let grey = r.grey[0].clone();
+    r.grey = ('a'..='z')
+        .map(|l| GreyRecord {
+            letter: l,
+            file: format!("big1{l}.img"),
+            ..grey.clone()
+        })
+        .collect();
+    let out = r.outputs.as_mut().expect("outputs");
+    out.lex_attributes = Some(attributes(100));
+    out.ldr_attributes = Some(attributes(100));
+    let mut p = Params::default();
+    for d in vss::llv::params::PARAMS {
+        let v = if p.get(d.key) == Some(d.max) {
+            d.min
+        } else {
+            d.max
+        };
+        p.set(d.key, v).expect("a value in range");
+    }
+    out.params = p;
+    r.edit = vec![r.edit[0].clone(); 10];
+    r
+}
+
+/// Issue 34: a 4 MiB manifest of one `[[image]]` record (its line
+/// attributes a million numbers) took 325 MB to read (77 times the file):
+/// a record is now refused past [`MAX_RECORD_LEN`], with the record's line,
+/// its size and the cap, in the address space a one-image manifest needs
+/// plus 16 MiB (the old build does not fit). The cap is at least 16 times
+/// the largest record a real image makes (12 822 bytes: about 20 times).
+#[test]
+fn a_manifest_of_one_huge_record_is_refused() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let one = |m: &Manifest| {
+        let mut m = m.clone();
+        m.image.clear();
+        m
+    };
+    let real = {
+        let mut m = one(&manifest("big", 1));
+        let bare = m.to_toml().expect("toml").len();
+        m.image = vec![largest_real_image()];
+        m.to_toml().expect("toml").len() - bare
+    };
+    assert!(
+        MAX_RECORD_LEN >= 16 * real,
+        "the largest real record takes {real} bytes"
+    );
+    println!("largest real record: {real} bytes, cap {MAX_RECORD_LEN}");
+    // As many lines' attributes as the manifest's bound holds.
+    let huge = |n: usize| {
+        let mut m = one(&manifest("huge", 1));
+        let mut r = image("huge", 1);
+        r.outputs.as_mut().expect("outputs").lex_attributes = Some(attributes(n));
+        m.image = vec![r];
+        m.to_toml().expect("toml")
+    };
+    let (l1, l2) = (huge(1000).len(), huge(2000).len());
+    let per = (l2 - l1) / 1000;
+    let mut n = 1000 + (MAX_LEN - l1) / per;
+    let text = loop {
+        let text = huge(n);
+        if text.len() <= MAX_LEN {
+            break text;
+        }
+        n -= 1 + (text.len() - MAX_LEN) / per;
+    };
+    assert!(text.len() > MAX_LEN / 16 * 15, "{} bytes", text.len());
+    let dir = tmp.path().join("huge");
+    std::fs::create_dir_all(&dir).expect("folder");
+    std::fs::write(dir.join("huge.toml"), &text).expect("manifest");
+    if let Some(keep) = std::env::var_os("VSS_BIG_SESSION_DIR") {
+        let kept = Path::new(&keep).join("huge");
+        std::fs::create_dir_all(&kept).expect("VSS_BIG_SESSION_DIR");
+        std::fs::write(kept.join("huge.toml"), &text).expect("kept manifest");
+    }
+    let small = tmp.path().join("one");
+    std::fs::create_dir_all(&small).expect("folder");
+    std::fs::write(
+        small.join("one.toml"),
+        manifest("one", 1).to_toml().unwrap(),
+    )
+    .unwrap();
+    let allowed = least_mib(&small) + 16;
+    let o = show(&dir, allowed);
+    let out = text_of(&o);
+    assert!(
+        o.status.code().is_some(),
+        "vss was killed ({:?}) in {allowed} MiB: {}",
+        o.status,
+        &out[..out.len().min(500)]
+    );
+    assert!(!o.status.success(), "{out}");
+    let line = text.lines().position(|l| l == "[[image]]").expect("record") + 1;
+    assert!(
+        out.contains(&format!("huge.toml:{line}:")),
+        "line {line}: {out}"
+    );
+    // The record: from its header to the next table's (the calibration).
+    let start = text.find("[[image]]").unwrap();
+    let end = text[start..]
+        .find("\n[[calibration]]")
+        .map_or(text.len(), |e| start + e + 1);
+    let len = end - start;
+    assert!(
+        out.contains(&format!(
+            "takes {len} bytes, more than the {MAX_RECORD_LEN}"
+        )),
+        "{len}: {out}"
+    );
 }

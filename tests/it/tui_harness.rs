@@ -143,8 +143,13 @@ impl Console {
         // tester's own state folder.
         cmd.env("XDG_STATE_HOME", cwd.join("state"));
         cmd.env_remove("NO_COLOR");
+        // An empty value unsets the variable, as `env -u` does.
         for (k, v) in env {
-            cmd.env(k, v);
+            if v.is_empty() {
+                cmd.env_remove(k);
+            } else {
+                cmd.env(k, v);
+            }
         }
         let child = pair.slave.spawn_command(cmd).unwrap();
         drop(pair.slave);

@@ -94,3 +94,32 @@ fn slash_searches_the_help_the_log_and_the_file_list() {
     c.send("q");
     c.wait_exit(15);
 }
+
+/// A text is found in an entry's whole text, not row by row: the help's
+/// last paragraph (pages below the window) wraps at 80 columns between
+/// "row or a" and "line", and `/` finds "row or a line" and scrolls it
+/// into view.
+#[test]
+fn slash_finds_a_text_wrapped_over_two_rows_below_the_window() {
+    let mut c = Console::start(80, 24, &[]);
+    c.press(Scope::Global, Action::Global(GlobalAction::Help));
+    let s = c.wait_text("help: rows 1", 5);
+    assert!(!s.contains("Shift+drag"), "the paragraph is below:\n{s}");
+    find(&mut c, "row or a line");
+    let s = wait_words(&c, "match 1 of 1", 5);
+    assert!(s.contains("Shift+drag selects text"), "{s}");
+    // The text found is split over two rows: no row of the window holds
+    // it whole (the hint row below it says what is searched for).
+    let window: Vec<&str> = s.lines().filter(|l| l.starts_with('│')).collect();
+    assert!(
+        window.iter().all(|l| !l.contains("row or a line")),
+        "the text is on one row, the test tests nothing:\n{s}"
+    );
+    assert!(flat(&window.join("\n")).contains("row or a line"), "{s}");
+    search(&mut c, SearchAction::Clear);
+    c.wait("the search ended", 5, |s| !s.contains("match 1 of 1"));
+    c.send("\x1b");
+    c.wait("the help closed", 5, |s| !s.contains("help: rows"));
+    c.send("q");
+    c.wait_exit(15);
+}

@@ -110,3 +110,96 @@ fn a_holder_that_does_not_answer_is_signalled_after_the_wait() {
     c.send("q");
     c.wait_exit(10);
 }
+
+/// The name `id -un` gives this test's user (from `/etc/passwd`).
+fn user_name() -> String {
+    let out = std::process::Command::new("id")
+        .arg("-un")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "id -un: {out:?}");
+    String::from_utf8(out.stdout).unwrap().trim().to_string()
+}
+
+/// A console started without `USER` and `LOGNAME` (`env -u`, a service)
+/// names its user in the lock from `/etc/passwd`, not "uid N", and a
+/// second console says so.
+#[test]
+fn the_lock_names_the_user_without_user_in_the_environment() {
+    let name = user_name();
+    let mut a = Console::start(80, 24, &[("USER", ""), ("LOGNAME", "")]);
+    a.create_session("cube");
+    let holder = read_holder(&a.session().join("cube.lock")).expect("a holds the lock");
+    assert_eq!(holder.user, name, "{holder:?}");
+    let mut b = a.another(80, 24);
+    let s = b.wait_words("in use by", 10);
+    // "(in use by NAME)", wrapped in the session list's column.
+    assert!(s.contains(&format!(" {name})")), "{s}");
+    b.send("q");
+    b.wait_exit(10);
+    a.send("q");
+    a.wait_exit(10);
+}
+
+/// `vss grab --take-over` on a session a live console holds takes it over
+/// the way the console does (one function): the console is asked through
+/// the folder, saves, leaves and says who took it; the grab captures; the
+/// manifest records every image, the console's and the grab's.
+#[test]
+fn grab_take_over_asks_a_console_that_holds_the_session() {
+    let mut c = Console::start(80, 24, &[]);
+    c.survey(2);
+    let lock = c.session().join("cube.lock");
+    let console_pid = read_holder(&lock).expect("the console holds the lock").pid;
+    let grab = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_vss"))
+            .current_dir(c.dir.path())
+            .env("XDG_STATE_HOME", c.dir.path().join("state"))
+            .args(["--profile", "cell.toml", "grab", "--camera", "1"])
+            .args([
+                "--lighting",
+                "a,b,c",
+                "--image",
+                "3",
+                "--session",
+                "sessions/cube",
+            ])
+            .args(extra)
+            .stdin(std::process::Stdio::null())
+            .output()
+            .unwrap()
+    };
+    // Without --take-over (and no terminal): refused, nothing asked.
+    let out = grab(&[]);
+    assert!(!out.status.success(), "{out:?}");
+    assert_eq!(read_holder(&lock).map(|h| h.pid), Some(console_pid));
+    let t0 = Instant::now();
+    let out = grab(&["--take-over"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains(&format!("asking process {console_pid}")),
+        "{err}"
+    );
+    // Answered by the request, not by the signal after 5 s.
+    assert!(!err.contains("did not release"), "{err}");
+    assert!(t0.elapsed() < Duration::from_secs(10), "{:?}", t0.elapsed());
+    let s = c.wait_words("was taken over by process", 10);
+    assert!(s.contains("choose a session"), "back to the list:\n{s}");
+    assert_eq!(c.exit_code(), None, "the console runs on");
+    assert!(!lock.exists(), "the grab released the lock");
+    assert!(!leave_path(&lock).exists(), "the request is removed");
+    let s = vss::session::Session::inspect(&c.session()).unwrap();
+    let m = s.manifest();
+    for k in 1..=2 {
+        let r = m.image(k).unwrap_or_else(|| panic!("image {k} recorded"));
+        assert_eq!(r.grey.len(), 3, "image {k}: {r:?}");
+        assert!(r.outputs.is_some(), "image {k} accepted: {r:?}");
+    }
+    let r = m.image(3).expect("the grab's image recorded");
+    let letters: String = r.grey.iter().map(|g| g.letter).collect();
+    assert_eq!(letters, "abc", "{r:?}");
+    c.send("q");
+    c.wait_exit(10);
+    assert_eq!(c.exit_code(), Some(0));
+}

@@ -532,3 +532,33 @@ fn too_small_a_terminal_says_so() {
     assert!(s.contains("terminal too small"), "{s}");
     assert!(s.contains("40 × 10"), "{s}");
 }
+
+/// The answer to a key is not replaced on the message line by a background
+/// message that comes right after it: the background message goes to the
+/// log (the line says how many newer ones wait there), and shows on the
+/// line after the operator's next key.
+#[test]
+fn the_answer_to_a_key_is_not_replaced_by_a_background_message() {
+    let mut app = App::new(&profile(), colour());
+    // No session open: Accept is refused, and says why.
+    survey(&mut app, SurveyAction::Accept);
+    let answer = app.chrome.log.last().unwrap().text.clone();
+    let (s, _) = draw(&app, 80, 24);
+    let message: String = s.lines().skip(20).collect::<Vec<_>>().join(" ");
+    assert!(message.contains(&answer[..answer.len().min(30)]), "{s}");
+    app.update(Msg::Device(DeviceEvent::Note("the lights answered".into())));
+    let (s, _) = draw(&app, 80, 24);
+    assert!(
+        s.contains(&answer[..answer.len().min(30)]),
+        "the answer stays:\n{s}"
+    );
+    assert!(!s.contains("the lights answered"), "{s}");
+    let words = s.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(words.contains("(+1 newer in the log)"), "{s}");
+    assert_eq!(app.chrome.log.last().unwrap().text, "the lights answered");
+    // A key that answers nothing (the cursor down): the newest shows.
+    survey(&mut app, SurveyAction::Down);
+    let (s, _) = draw(&app, 80, 24);
+    assert!(s.contains("the lights answered"), "{s}");
+    assert!(!s.contains("newer in the log"), "{s}");
+}

@@ -25,6 +25,17 @@ use toml_parser::lexer::TokenKind;
 use super::{ImageRecord, Manifest};
 use crate::session::SessionError;
 
+/// The most bytes one `[[image]]` record may take, and the part outside
+/// the records (root keys, `[session]`, `[[lighting]]`,
+/// `[[calibration]]`) together. A record's tree costs up to 77 times its
+/// text (a 4 MiB manifest of one record took 325 MB), so the cap bounds a
+/// read at the text plus about 20 MB. The largest record vss writes for a
+/// real image — 26 lightings, every parameter changed, 100 lines'
+/// attributes, 10 hand edits — takes 12 822 bytes (`session_big`), so the
+/// cap is a margin of 20 times over it: room for some 5 000 lines'
+/// attributes or 1 900 edits.
+pub const MAX_RECORD_LEN: usize = 256 << 10;
+
 /// One `[[image]]` record's text on its own: a document with one image.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -158,6 +169,27 @@ fn header<I: Iterator<Item = toml_parser::lexer::Token>>(
 /// checked for sense); errors name `path` and the line in the whole file.
 pub(super) fn parse(text: &str, path: &Path) -> Result<Manifest, SessionError> {
     let pieces = cut(text);
+    let too_big = |r: &Range<usize>, what: &str, len: usize| SessionError::Manifest {
+        path: path.to_path_buf(),
+        line: line_of(text, r.start),
+        message: format!(
+            "{what} takes {len} bytes, more than the {MAX_RECORD_LEN} one may take \
+             (a real one takes about 13 KiB); nothing of the manifest was read"
+        ),
+    };
+    if let Some(r) = pieces.images.iter().find(|r| r.len() > MAX_RECORD_LEN) {
+        return Err(too_big(r, "this [[image]] record", r.len()));
+    }
+    let rest_len: usize = pieces.rest.iter().map(|r| r.len()).sum();
+    if rest_len > MAX_RECORD_LEN
+        && let Some(first) = pieces.rest.first()
+    {
+        return Err(too_big(
+            first,
+            "the part outside the [[image]] records (session, lightings, calibrations)",
+            rest_len,
+        ));
+    }
     // The rest, made one text; `map` gives each of its pieces' offsets.
     let mut rest = String::with_capacity(pieces.rest.iter().map(|r| r.len()).sum());
     let mut map = Vec::with_capacity(pieces.rest.len());

@@ -2,7 +2,9 @@
 //! and how its pane is shown and scrolled, the help and message windows,
 //! the open question or text field, and whether to quit.
 
-use super::log::Log;
+use std::time::{Duration, Instant};
+
+use super::log::{Log, LogEntry};
 use super::modal::Modal;
 use crate::tui::keymap::{GlobalAction, ScreenId, ViewerAction};
 use crate::tui::mode::Look;
@@ -22,6 +24,20 @@ pub enum Overlay {
     Help { scroll: usize },
     /// The newest message in full.
     Message { scroll: usize },
+}
+
+/// How long the answer to a key stays on the message line at least, unless
+/// the operator presses another key: time to read its three rows.
+pub const HOLD: Duration = Duration::from_secs(3);
+
+/// The answer to the operator's last key, held on the message line while
+/// background messages (progress, saves, device notes) go to the log.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Held {
+    /// The log entry's number ([`Log::nth_pushed`]).
+    pub seq: usize,
+    /// When background messages may take the line again.
+    pub until: Instant,
 }
 
 /// What a search looks through.
@@ -75,6 +91,8 @@ pub struct Chrome {
     pub search: Option<Search>,
     /// The terminal's size (columns, rows), from the last resize.
     pub size: (u16, u16),
+    /// The answer to the last key, held on the message line.
+    pub held: Option<Held>,
     pub quit: bool,
 }
 
@@ -90,8 +108,49 @@ impl Chrome {
             modal: None,
             search: None,
             size: (80, 24),
+            held: None,
             quit: false,
         }
+    }
+
+    /// The message the message line shows, and how many newer ones are in
+    /// the log only: the answer to the last key while it is held, else
+    /// the newest message.
+    pub fn shown_message(&self) -> Option<(&LogEntry, usize)> {
+        if let Some(h) = self.held
+            && let Some(e) = self.log.nth_pushed(h.seq)
+        {
+            return Some((e, self.log.pushed() - 1 - h.seq));
+        }
+        self.log.last().map(|e| (e, 0))
+    }
+
+    /// After the operator's key: the last message it produced is held on
+    /// the message line; a key that produced none lets the line show the
+    /// newest again. `before` is [`Log::pushed`] before the key. While the
+    /// message window (`!`) is open, what it shows stays.
+    pub fn hold_answer(&mut self, before: usize, now: Instant) {
+        if matches!(self.overlay, Some(Overlay::Message { .. })) {
+            return;
+        }
+        let after = self.log.pushed();
+        self.held = (after > before).then(|| Held {
+            seq: after - 1,
+            until: now + HOLD,
+        });
+    }
+
+    /// Lets the held answer go once its time is over (not while the
+    /// message window shows it); whether the message line changes.
+    pub fn release_held(&mut self, now: Instant) -> bool {
+        let Some(h) = self.held else {
+            return false;
+        };
+        if now < h.until || matches!(self.overlay, Some(Overlay::Message { .. })) {
+            return false;
+        }
+        self.held = None;
+        self.log.pushed() > h.seq + 1
     }
 
     pub fn cycle_log(&mut self) {

@@ -72,6 +72,17 @@ impl Log {
         self.entries.back()
     }
 
+    /// How many entries were pushed in the run (the next one's number).
+    pub fn pushed(&self) -> usize {
+        self.pushed
+    }
+
+    /// The entry pushed `n`-th (from 0), while it is kept.
+    pub fn nth_pushed(&self, n: usize) -> Option<&LogEntry> {
+        let first = self.pushed - self.entries.len();
+        n.checked_sub(first).and_then(|i| self.entries.get(i))
+    }
+
     pub fn len(&self) -> usize {
         self.entries.len()
     }

@@ -1,9 +1,11 @@
 //! `/`: search the help window, the message log or the Session screen's
 //! file list (what is in front), as lazygit, k9s and helix do. The text is
 //! typed in a field (case ignored); Enter shows the first match, `n` and
-//! `N` the next and previous, `Esc` ends the search. The rows searched are
-//! the rows drawn (the drawing's own functions make them, at the terminal's
-//! width), so a match shown is a row the operator sees; matching rows are
+//! `N` the next and previous, `Esc` ends the search. What is searched is
+//! each entry's whole text (a message, a key's description, a file's
+//! state), whether it is scrolled out of view, wrapped over several rows or
+//! cut at the terminal's width; the drawing's own functions make the
+//! entries with their rows, so the match is scrolled into view and its rows
 //! marked where they are drawn, and the hint row says "match 2 of 5".
 
 use super::chrome::{Search, SearchTarget};
@@ -44,28 +46,30 @@ impl App {
         }
     }
 
-    /// The rows `target` is drawn as, top down, at the terminal's size.
-    pub fn search_rows(&self, target: SearchTarget) -> Vec<String> {
+    /// The entries of `target` (a message, a key, a file) with the row
+    /// each begins at and its rows, top down, at the terminal's size: a match is looked
+    /// for in an entry's whole text, not in the rows it is drawn as.
+    pub fn search_items(&self, target: SearchTarget) -> Vec<(String, usize, usize)> {
+        use crate::tui::screens::chrome;
         let (w, _) = self.chrome.size;
         let inner = w.saturating_sub(2) as usize;
-        let text = |l: &ratatui::text::Line| l.spans.iter().map(|s| s.content.as_ref()).collect();
-        match target {
-            SearchTarget::Help => crate::tui::screens::chrome::help_lines(self, inner)
-                .iter()
-                .map(text)
-                .collect(),
-            SearchTarget::Log => crate::tui::screens::chrome::log_rows(self, inner)
-                .iter()
-                .map(text)
-                .collect(),
+        let items = match target {
+            SearchTarget::Help => chrome::help_items(self, inner),
+            SearchTarget::Log => chrome::log_items(self, inner),
             SearchTarget::Files => {
                 let panel = crate::tui::screens::panel_width(ScreenId::Session).min(w / 2);
-                crate::tui::screens::session::file_rows(self, w.saturating_sub(panel + 2) as usize)
-                    .iter()
-                    .map(text)
-                    .collect()
+                crate::tui::screens::session::file_items(self, w.saturating_sub(panel + 2) as usize)
             }
-        }
+        };
+        let mut row = 0;
+        items
+            .into_iter()
+            .map(|i| {
+                let first = row;
+                row += i.rows.len();
+                (i.text, first, i.rows.len())
+            })
+            .collect()
     }
 
     pub(super) fn search(&mut self, a: SearchAction) {
@@ -127,7 +131,11 @@ impl App {
             current: 0,
             count: 0,
         };
-        if !self.search_rows(target).iter().any(|r| s.matches(r)) {
+        if !self
+            .search_items(target)
+            .iter()
+            .any(|(text, ..)| s.matches(text))
+        {
             return Err(format!("no match for \"{query}\" in {}", target.name()));
         }
         if target == SearchTarget::Log {
@@ -143,8 +151,13 @@ impl App {
         let Some(s) = self.chrome.search.clone() else {
             return;
         };
-        let rows = self.search_rows(s.target);
-        let mut hits: Vec<usize> = (0..rows.len()).filter(|&i| s.matches(&rows[i])).collect();
+        let items = self.search_items(s.target);
+        let total = items.last().map_or(0, |&(_, first, n)| first + n);
+        let mut hits: Vec<(usize, usize)> = items
+            .into_iter()
+            .filter(|(text, ..)| s.matches(text))
+            .map(|(_, first, n)| (first, n))
+            .collect();
         if s.target == SearchTarget::Log {
             // The newest first, as the log is read.
             hits.reverse();
@@ -155,7 +168,7 @@ impl App {
             search.count = count;
             search.current = current;
         }
-        let Some(&row) = hits.get(current) else {
+        let Some(&(row, n)) = hits.get(current) else {
             return;
         };
         match s.target {
@@ -168,9 +181,9 @@ impl App {
             SearchTarget::Files => self.screens.files.scroll = row,
             SearchTarget::Log => {
                 // The pane shows the rows up to `total - scroll`, its last
-                // row a "more" marker when scrolled: the match goes just
-                // above it.
-                self.chrome.log_scroll = (rows.len() - row).saturating_sub(2);
+                // row a "more" marker when scrolled: the match's last row
+                // goes just above it.
+                self.chrome.log_scroll = total.saturating_sub(row + n).saturating_sub(1);
             }
         }
     }

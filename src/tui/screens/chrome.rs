@@ -27,16 +27,26 @@ pub fn wrap(text: &str, width: usize) -> Vec<String> {
         .collect()
 }
 
-fn newest(app: &App) -> Option<String> {
-    app.chrome
-        .log
-        .last()
-        .map(|e| format!("{} {}", e.time, e.text))
+/// The message line's text: the message shown ([`Chrome::shown_message`]),
+/// with how many newer ones wait in the log while it is held.
+///
+/// [`Chrome::shown_message`]: crate::tui::app::Chrome::shown_message
+fn newest(app: &App) -> Option<(String, crate::tui::app::Level)> {
+    app.chrome.shown_message().map(|(e, newer)| {
+        let more = if newer > 0 {
+            format!(" (+{newer} newer in the log)")
+        } else {
+            String::new()
+        };
+        (format!("{} {}{more}", e.time, e.text), e.level)
+    })
 }
 
 /// Rows the newest message needs (1 to [`MESSAGE_ROWS`]).
 pub fn message_rows(app: &App, width: u16) -> u16 {
-    newest(app).map_or(1, |m| wrap(&m, width as usize).len().clamp(1, MESSAGE_ROWS)) as u16
+    newest(app).map_or(1, |(m, _)| {
+        wrap(&m, width as usize).len().clamp(1, MESSAGE_ROWS)
+    }) as u16
 }
 
 pub fn top_bar(app: &App, area: Rect, buf: &mut Buffer) {
@@ -87,10 +97,9 @@ pub fn message(app: &App, area: Rect, buf: &mut Buffer) {
         return;
     }
     let t = app.theme();
-    let Some(e) = app.chrome.log.last() else {
+    let Some((text, level)) = newest(app) else {
         return;
     };
-    let text = format!("{} {}", e.time, e.text);
     let mut rows = wrap(&text, area.width as usize);
     let max = area.height as usize;
     if rows.len() > max {
@@ -104,7 +113,7 @@ pub fn message(app: &App, area: Rect, buf: &mut Buffer) {
     }
     let lines: Vec<Line> = rows
         .into_iter()
-        .map(|r| Line::styled(r, t.level(e.level)))
+        .map(|r| Line::styled(r, t.level(level)))
         .collect();
     Paragraph::new(lines).render(area, buf);
 }
@@ -126,7 +135,7 @@ pub fn log_pane(app: &App, area: Rect, buf: &mut Buffer) {
     let h = inner.height as usize;
     let w = inner.width as usize;
     let want = app.chrome.log_scroll.saturating_add(h);
-    let rows = marked(app, SearchTarget::Log, newest_rows(app, w, want));
+    let rows = marked(app, SearchTarget::Log, newest_items(app, w, want));
     let total = rows.len();
     let scroll = app.chrome.log_scroll.min(total.saturating_sub(h));
     let end = total - scroll;
@@ -140,51 +149,74 @@ pub fn log_pane(app: &App, area: Rect, buf: &mut Buffer) {
     Paragraph::new(shown).render(inner, buf);
 }
 
-/// The log's rows at `width`, oldest first: at least the newest `want`
-/// (all of them for `usize::MAX`).
-fn newest_rows(app: &App, width: usize, want: usize) -> Vec<Line<'static>> {
-    let t = app.theme();
-    let mut rows: Vec<Line> = Vec::new();
-    for e in app.chrome.log.entries().rev() {
-        let mut wrapped: Vec<Line> = wrap(&format!("{} {}", e.time, e.text), width)
+/// A unit `/` searches: its whole text (neither wrapped nor cut) and the
+/// rows it is drawn as, so that a text split over two rows, or cut at the
+/// terminal's width, is found and its rows shown.
+pub struct Item {
+    pub text: String,
+    pub rows: Vec<Line<'static>>,
+}
+
+impl Item {
+    /// `text` wrapped at `width`, every row in `style`.
+    fn wrapped(text: String, width: usize, style: Style) -> Item {
+        let rows = wrap(&text, width)
             .into_iter()
-            .map(|r| Line::styled(r, t.level(e.level)))
+            .map(|r| Line::styled(r, style))
             .collect();
-        wrapped.reverse();
-        rows.extend(wrapped);
-        if rows.len() >= want {
+        Item { text, rows }
+    }
+
+    /// One row, searched as drawn.
+    fn row(row: Line<'static>) -> Item {
+        let text = row.spans.iter().map(|s| s.content.as_ref()).collect();
+        Item {
+            text,
+            rows: vec![row],
+        }
+    }
+}
+
+/// The log's messages at `width`, oldest first: at least the newest
+/// `want` rows (all of them for `usize::MAX`).
+fn newest_items(app: &App, width: usize, want: usize) -> Vec<Item> {
+    let t = app.theme();
+    let mut items: Vec<Item> = Vec::new();
+    let mut rows = 0;
+    for e in app.chrome.log.entries().rev() {
+        let item = Item::wrapped(format!("{} {}", e.time, e.text), width, t.level(e.level));
+        rows += item.rows.len();
+        items.push(item);
+        if rows >= want {
             break;
         }
     }
-    rows.reverse();
-    rows
+    items.reverse();
+    items
 }
 
-/// Every row of the expanded log at `width`, oldest first (what `/`
+/// Every message of the expanded log at `width`, oldest first (what `/`
 /// searches).
-pub fn log_rows(app: &App, width: usize) -> Vec<Line<'static>> {
-    newest_rows(app, width, usize::MAX)
+pub fn log_items(app: &App, width: usize) -> Vec<Item> {
+    newest_items(app, width, usize::MAX)
 }
 
-/// `rows` with those that match the search on `target` marked.
-pub fn marked(app: &App, target: SearchTarget, rows: Vec<Line<'static>>) -> Vec<Line<'static>> {
-    let Some(s) = app
+/// The rows of `items`, those of the items that match the search on
+/// `target` marked.
+pub fn marked(app: &App, target: SearchTarget, items: Vec<Item>) -> Vec<Line<'static>> {
+    let search = app
         .chrome
         .search
         .as_ref()
-        .filter(|s| s.target == target && app.search_in_front())
-    else {
-        return rows;
-    };
+        .filter(|s| s.target == target && app.search_in_front());
     let t = app.theme();
-    rows.into_iter()
-        .map(|l| {
-            let text: String = l.spans.iter().map(|s| s.content.as_ref()).collect();
-            if s.matches(&text) {
-                l.patch_style(t.selected())
-            } else {
-                l
-            }
+    items
+        .into_iter()
+        .flat_map(|item| {
+            let hit = search.is_some_and(|s| s.matches(&item.text));
+            item.rows
+                .into_iter()
+                .map(move |l| if hit { l.patch_style(t.selected()) } else { l })
         })
         .collect()
 }
@@ -443,8 +475,10 @@ pub const LEGEND: &[(&str, &str)] = &[
     ("eN", "N hand edits in effect"),
 ];
 
-/// The help window's rows at `width` (the drawing and `/` both use them).
-pub fn help_lines(app: &App, width: usize) -> Vec<Line<'static>> {
+/// The help window's entries at `width` (the drawing and `/` both use
+/// them): a key with its description is one entry, however many rows it
+/// wraps to.
+pub fn help_items(app: &App, width: usize) -> Vec<Item> {
     let t = app.theme();
     let screen = app.chrome.screen;
     let mut sections: Vec<(String, Scope)> =
@@ -458,7 +492,25 @@ pub fn help_lines(app: &App, width: usize) -> Vec<Line<'static>> {
     }
     let key_w = 11;
     let desc_w = width.saturating_sub(key_w + 1).max(10);
-    let mut lines = vec![Line::styled("Files in use", t.title())];
+    // A key (or a name) right-aligned, its text wrapped beside it.
+    let keyed = |key: &str, text: &str| -> Item {
+        let rows = wrap(text, desc_w)
+            .into_iter()
+            .enumerate()
+            .map(|(i, part)| {
+                let key = if i == 0 { key } else { "" };
+                Line::from(vec![
+                    Span::styled(format!("{key:>key_w$} "), t.key()),
+                    Span::raw(part),
+                ])
+            })
+            .collect();
+        Item {
+            text: format!("{key} {text}"),
+            rows,
+        }
+    };
+    let mut items = vec![Item::row(Line::styled("Files in use", t.title()))];
     let plate = &app.screens.calibrate.plate_name;
     for (what, file) in [
         ("profile", app.cell.profile_file.clone()),
@@ -467,41 +519,25 @@ pub fn help_lines(app: &App, width: usize) -> Vec<Line<'static>> {
             crate::tui::text::clean(&crate::calib::plate::in_use(plate)),
         ),
     ] {
-        for (i, part) in wrap(&file, desc_w).into_iter().enumerate() {
-            let what = if i == 0 { what } else { "" };
-            lines.push(Line::from(vec![
-                Span::styled(format!("{what:>key_w$} "), t.key()),
-                Span::raw(part),
-            ]));
-        }
+        items.push(keyed(what, &file));
     }
     for (title, scope) in sections {
-        lines.push(Line::styled(title, t.title()));
+        items.push(Item::row(Line::styled(title, t.title())));
         for (k, d) in keymap::describe(scope) {
-            for (i, part) in wrap(d, desc_w).into_iter().enumerate() {
-                let key = if i == 0 { k.clone() } else { String::new() };
-                lines.push(Line::from(vec![
-                    Span::styled(format!("{key:>key_w$} "), t.key()),
-                    Span::raw(part),
-                ]));
-            }
+            items.push(keyed(&k, d));
         }
     }
-    lines.push(Line::styled("The checklist's marks", t.title()));
+    items.push(Item::row(Line::styled("The checklist's marks", t.title())));
     for (m, d) in LEGEND {
-        lines.push(Line::from(vec![
+        items.push(Item::row(Line::from(vec![
             Span::styled(format!("{m:>key_w$} "), t.key()),
             Span::raw(*d),
-        ]));
+        ])));
     }
     let mouse = "The mouse, where the terminal sends it: a click chooses a checklist row or a \
                  line, the wheel scrolls lists and zooms pictures; Shift+drag selects text.";
-    lines.extend(
-        wrap(mouse, width.max(10))
-            .into_iter()
-            .map(|r| Line::styled(r, t.dim())),
-    );
-    lines
+    items.push(Item::wrapped(mouse.to_string(), width.max(10), t.dim()));
+    items
 }
 
 pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
@@ -514,7 +550,7 @@ pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
     let (name, lines, scroll) = match o {
         Overlay::Help { scroll } => (
             "help",
-            marked(app, SearchTarget::Help, help_lines(app, inner_w)),
+            marked(app, SearchTarget::Help, help_items(app, inner_w)),
             scroll,
         ),
         Overlay::Message { scroll } => {
@@ -533,8 +569,12 @@ pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
                         .map(|r| Line::styled(r, t.level(e.level))),
                 );
             };
+            let shown = app.chrome.shown_message().map(|(e, _)| e);
+            if let Some(e) = shown {
+                entry(e, "on the message line,");
+            }
             let last = app.chrome.log.last();
-            if let Some(e) = last {
+            if let Some(e) = last.filter(|e| Some(*e) != shown) {
                 entry(e, "newest,");
             }
             // An error that a later note pushed off the message row.
@@ -544,7 +584,7 @@ pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
                 .entries()
                 .rev()
                 .find(|e| e.level != crate::tui::app::Level::Info);
-            if let Some(e) = trouble.filter(|e| Some(*e) != last) {
+            if let Some(e) = trouble.filter(|e| Some(*e) != last && Some(*e) != shown) {
                 entry(e, "last problem,");
             }
             if let Some(f) = app.chrome.log.file() {

@@ -7,6 +7,7 @@ use ratatui::layout::Rect;
 use ratatui::text::Line;
 use ratatui::widgets::{Paragraph, Widget, Wrap};
 
+use super::chrome::Item;
 use super::{block, split_panel, window};
 use crate::tui::app::{App, SearchTarget};
 
@@ -80,7 +81,7 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
             t.ok(),
         )]
     };
-    let rows = super::chrome::marked(app, SearchTarget::Files, file_rows(app, inner_w));
+    let rows = super::chrome::marked(app, SearchTarget::Files, file_items(app, inner_w));
     let room = (right.height.saturating_sub(2) as usize).saturating_sub(lines.len());
     lines.extend(window(rows, app.screens.files.scroll, room, t));
     Paragraph::new(lines)
@@ -88,36 +89,36 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         .render(right, buf);
 }
 
-/// The file list's rows at `width`: problems first, each wrapped whole
+/// The file list's entries at `width`: problems first, each wrapped whole
 /// (why a file is damaged is what the operator came for), then the files
-/// that read, one row each (the drawing and `/` both use them).
-pub fn file_rows(app: &App, width: usize) -> Vec<Line<'static>> {
+/// that read, one row each, cut at the width (the drawing and `/` both use
+/// them; `/` searches an entry's whole text).
+pub fn file_items(app: &App, width: usize) -> Vec<Item> {
     let t = app.theme();
     let Some(s) = &app.session.view else {
         return Vec::new();
     };
     let mut files: Vec<&crate::tui::event::FileState> = s.files.iter().collect();
     files.sort_by_key(|f| f.ok);
-    let mut rows: Vec<Line> = Vec::new();
+    let mut items: Vec<Item> = Vec::new();
     for f in files {
         let text = format!("{:<16} {}", f.name, f.state);
-        if !f.ok {
-            rows.extend(
-                super::chrome::wrap(&text, width)
-                    .into_iter()
-                    .map(|l| Line::styled(l, t.error())),
-            );
-            continue;
-        }
-        let text: String = if text.chars().count() > width {
-            text.chars()
+        let rows = if !f.ok {
+            super::chrome::wrap(&text, width)
+                .into_iter()
+                .map(|l| Line::styled(l, t.error()))
+                .collect()
+        } else if text.chars().count() > width {
+            let cut = text
+                .chars()
                 .take(width.saturating_sub(1))
                 .collect::<String>()
-                + "…"
+                + "…";
+            vec![Line::styled(cut, t.ok())]
         } else {
-            text
+            vec![Line::styled(text.clone(), t.ok())]
         };
-        rows.push(Line::styled(text, t.ok()));
+        items.push(Item { text, rows });
     }
-    rows
+    items
 }

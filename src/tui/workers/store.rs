@@ -77,27 +77,6 @@ fn session_err(what: impl Into<String>) -> impl Fn(SessionError) -> StoreError {
 /// How often the store looks for a request to leave its session.
 const LEAVE_POLL: Duration = Duration::from_millis(200);
 
-/// How long a take-over waits for the holder to answer its request before
-/// signalling it.
-const LEAVE_WAIT: Duration = Duration::from_secs(5);
-
-/// Opens session `dir` once its lock is free (or stale), waiting at most
-/// `limit`: `Ok(None)` when it is still held then.
-fn wait_for_lock(dir: &Path, limit: Duration) -> Result<Option<Session>, SessionError> {
-    let end = Instant::now() + limit;
-    loop {
-        match Session::open(dir) {
-            Ok(s) => return Ok(Some(s)),
-            Err(SessionError::Locked { stale: true, .. }) => {
-                return Session::open_take_over(dir).map(Some);
-            }
-            Err(SessionError::Locked { .. }) if Instant::now() > end => return Ok(None),
-            Err(SessionError::Locked { .. }) => std::thread::sleep(Duration::from_millis(50)),
-            Err(e) => return Err(e),
-        }
-    }
-}
-
 /// The UI's handle on the store worker.
 pub struct StoreHandle {
     tx: Sender<StoreCmd>,
@@ -551,68 +530,22 @@ impl Store {
         out.into_iter().map(|(_, e)| e).collect()
     }
 
-    /// Opens a session held by a console that still runs on this host:
-    /// first by request through the session folder (`NAME.lock.leave`,
-    /// which that console watches: it saves what it has, releases the lock
-    /// and says who took it), and only when the lock is still held after
-    /// [`LEAVE_WAIT`] by a signal (SIGTERM: it finishes its saves and
-    /// ends, as on a hang-up). A stale lock, or one held on another host,
-    /// is taken over as the lock allows, nobody asked.
+    /// Opens a session another vss holds, by the rule every take-over
+    /// follows ([`takeover::open_taking_over`]: a live holder on this host
+    /// is asked through the session folder, and signalled only when it
+    /// does not answer); each step is said.
     fn take_over(&self, dir: &Path) -> Result<Session, StoreError> {
-        use crate::session::lock;
-        let err = session_err(format!("cannot take over {}", dir.display()));
-        let inspected = Session::inspect(dir).ok();
-        let holder = inspected.as_ref().and_then(Session::lock_holder);
-        let local = holder
-            .as_ref()
-            .is_some_and(|h| h.host == lock::LockInfo::current().host && !h.is_stale());
-        let (true, Some(h), Some(s)) = (local, holder.as_ref(), inspected.as_ref()) else {
-            return Session::open_take_over(dir).map_err(err);
-        };
-        let lock_path = s.lock_path();
-        let leave = lock::leave_path(&lock_path);
-        let asked = lock::request_leave(&lock_path, h);
-        if let Err(e) = &asked {
-            self.reply(StoreEvent::Note(format!(
-                "cannot ask process {} through {} ({e}): signalling it instead",
-                h.pid,
-                leave.display()
-            )));
-        } else {
-            self.reply(StoreEvent::Note(format!(
-                "asking process {} to release session {}…",
-                h.pid,
-                dir.display()
-            )));
-            if let Some(s) = wait_for_lock(dir, LEAVE_WAIT).map_err(&err)? {
-                let _ = std::fs::remove_file(&leave);
-                return Ok(s);
+        use crate::session::takeover::{self, TakeOverError};
+        let mut say = |text: String| self.reply(StoreEvent::Note(text));
+        takeover::open_taking_over(dir, &mut say).map_err(|e| match e {
+            TakeOverError::Session(e) => {
+                session_err(format!("cannot take over {}", dir.display()))(e)
             }
-        }
-        // No answer: the request goes, and the holder is signalled — only
-        // the lock's own vss console.
-        let _ = std::fs::remove_file(&leave);
-        self.reply(StoreEvent::Note(format!(
-            "process {} did not release session {}: asking it to end…",
-            h.pid,
-            dir.display()
-        )));
-        if let Err(why) = lock::ask_holder_to_leave(h)
-            && !h.is_stale()
-        {
-            return Err(StoreError::TakeOverRefused {
-                dir: dir.to_path_buf(),
-                holder: h.to_string(),
-                why,
-            });
-        }
-        match wait_for_lock(dir, Duration::from_secs(15)).map_err(&err)? {
-            Some(s) => Ok(s),
-            None => Err(StoreError::TakeOver {
-                dir: dir.to_path_buf(),
-                holder: h.to_string(),
-            }),
-        }
+            TakeOverError::NoAnswer { dir, holder } => StoreError::TakeOver { dir, holder },
+            TakeOverError::Refused { dir, holder, why } => {
+                StoreError::TakeOverRefused { dir, holder, why }
+            }
+        })
     }
 
     /// Each camera's model (index 0 = camera 1) from

@@ -1,0 +1,115 @@
+//! Taking over a session another vss holds — one function for the console
+//! (`y` to "Take it over anyway?") and every CLI `--take-over` (`vss grab`,
+//! `vss session redo`), so they follow one rule (issue 34):
+//!
+//! - a stale lock, or one held on another host, is taken over as the lock
+//!   allows, nobody asked;
+//! - a live holder on this host is asked first through the session folder
+//!   (`NAME.lock.leave`, [`lock::request_leave`]): a console saves what it
+//!   has, releases the lock and says who took it; a `vss grab` stops the
+//!   frame under way (the lightings saved stay) and ends;
+//! - only when the lock is still held after [`LEAVE_WAIT`] is the holder
+//!   signalled (SIGTERM), and only the lock's own vss
+//!   ([`lock::ask_holder_to_leave`]).
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use super::lock::{self, LockInfo};
+use super::{Session, SessionError};
+
+/// How long the taker waits for a holder to answer a request before it
+/// signals it.
+pub const LEAVE_WAIT: Duration = Duration::from_secs(5);
+
+/// How long the taker waits for a signalled holder to end.
+const SIGNAL_WAIT: Duration = Duration::from_secs(15);
+
+#[derive(Debug, thiserror::Error)]
+pub enum TakeOverError {
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    #[error(
+        "session {} is still held by {holder} after asking it to end; nothing changed",
+        dir.display()
+    )]
+    NoAnswer { dir: PathBuf, holder: String },
+    #[error("session {} is held by {holder}, which was not asked to end: {why}; nothing changed", dir.display())]
+    Refused {
+        dir: PathBuf,
+        holder: String,
+        why: String,
+    },
+}
+
+/// Opens the session at `dir` for writing, taking it over from whoever
+/// holds it by the rule above; `say` hears each step ("asking process N
+/// to release…").
+pub fn open_taking_over(dir: &Path, say: &mut dyn FnMut(String)) -> Result<Session, TakeOverError> {
+    let inspected = Session::inspect(dir).ok();
+    let holder = inspected.as_ref().and_then(Session::lock_holder);
+    let local = holder
+        .as_ref()
+        .is_some_and(|h| h.host == LockInfo::current().host && !h.is_stale());
+    let (true, Some(h), Some(s)) = (local, holder.as_ref(), inspected.as_ref()) else {
+        return Ok(Session::open_take_over(dir)?);
+    };
+    let lock_path = s.lock_path();
+    let leave = lock::leave_path(&lock_path);
+    match lock::request_leave(&lock_path, h) {
+        Err(e) => say(format!(
+            "cannot ask process {} through {} ({e}): signalling it instead",
+            h.pid,
+            leave.display()
+        )),
+        Ok(()) => {
+            say(format!(
+                "asking process {} to release session {}…",
+                h.pid,
+                dir.display()
+            ));
+            if let Some(s) = wait_for_lock(dir, LEAVE_WAIT)? {
+                let _ = std::fs::remove_file(&leave);
+                return Ok(s);
+            }
+        }
+    }
+    // No answer: the request goes, and the holder is signalled — only the
+    // lock's own vss.
+    let _ = std::fs::remove_file(&leave);
+    say(format!(
+        "process {} did not release session {}: asking it to end…",
+        h.pid,
+        dir.display()
+    ));
+    if let Err(why) = lock::ask_holder_to_leave(h)
+        && !h.is_stale()
+    {
+        return Err(TakeOverError::Refused {
+            dir: dir.to_path_buf(),
+            holder: h.to_string(),
+            why,
+        });
+    }
+    wait_for_lock(dir, SIGNAL_WAIT)?.ok_or_else(|| TakeOverError::NoAnswer {
+        dir: dir.to_path_buf(),
+        holder: h.to_string(),
+    })
+}
+
+/// Opens `dir` once its lock is free (or stale), waiting at most `limit`;
+/// `None` if it is still held then.
+fn wait_for_lock(dir: &Path, limit: Duration) -> Result<Option<Session>, SessionError> {
+    let end = Instant::now() + limit;
+    loop {
+        match Session::open(dir) {
+            Ok(s) => return Ok(Some(s)),
+            Err(SessionError::Locked { stale: true, .. }) => {
+                return Session::open_take_over(dir).map(Some);
+            }
+            Err(SessionError::Locked { .. }) if Instant::now() > end => return Ok(None),
+            Err(SessionError::Locked { .. }) => std::thread::sleep(Duration::from_millis(50)),
+            Err(e) => return Err(e),
+        }
+    }
+}
