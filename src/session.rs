@@ -718,6 +718,7 @@ impl Session {
                 line: 0,
                 message: format!("cannot write the manifest: {e}"),
             })?;
+        manifest::check_record_sizes(&text, &self.path(&manifest_file))?;
         self.write_file(&manifest_file, text.as_bytes())
     }
 

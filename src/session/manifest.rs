@@ -25,6 +25,7 @@ use serde::{Deserialize, Serialize};
 mod records;
 
 pub use records::MAX_RECORD_LEN;
+pub(crate) use records::check_record_sizes;
 
 use super::{MAX_IMAGE_NUMBER, SessionError};
 use crate::llv::{Params, Segment};
@@ -240,10 +241,21 @@ pub struct LineAttributes {
     pub shadow: Vec<u32>,
 }
 
+/// Lines an image may have for their attributes to be recorded. About 50
+/// bytes of manifest a line: 2 048 lines keep an image's record well under
+/// [`MAX_RECORD_LEN`], which the reader refuses to go beyond. An image with
+/// more lines keeps them all in its `.ldr`; only their response, residual
+/// and shadow marks are not carried over to a reopened session.
+pub const MAX_ATTRIBUTED_LINES: usize = 2048;
+
 impl LineAttributes {
     /// `None` when no line carries an attribute (e.g. lines read from a
-    /// `.lex`): nothing worth recording.
+    /// `.lex`), nothing worth recording, or when there are more than
+    /// [`MAX_ATTRIBUTED_LINES`].
     pub fn of(lines: &[Segment]) -> Option<LineAttributes> {
+        if lines.len() > MAX_ATTRIBUTED_LINES {
+            return None;
+        }
         let any = lines
             .iter()
             .any(|s| s.response != 0.0 || s.residual != 0.0 || s.shadow);

@@ -14,8 +14,6 @@ use crate::llv::{GreyImage, LlvError, Params, Segment};
 use crate::session::FrameSettings;
 use crate::session::input::PipelineInput;
 
-pub use super::workers::store::StoreError;
-
 /// Everything that can happen to the console.
 #[derive(Debug)]
 pub enum Msg {
@@ -387,5 +385,45 @@ pub enum StoreCmd {
     WriteCdf {
         camera: u32,
         calibration: Box<crate::calib::Calibration>,
+    },
+}
+
+/// What the store worker can fail at; each says what and what to do.
+#[derive(Debug, thiserror::Error)]
+pub enum StoreError {
+    #[error("no session open: create or open one on the Survey screen (1)")]
+    NoSession,
+    #[error("{what}: {source}")]
+    Session {
+        what: String,
+        #[source]
+        source: crate::session::SessionError,
+    },
+    #[error("report NOT written: {why}{old}")]
+    Report { why: String, old: String },
+    #[error("log file {}: {source} — messages are still in the log pane (m)", path.display())]
+    Log {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error(
+        "session {} is still held by {holder} after asking it to end; nothing changed",
+        dir.display()
+    )]
+    TakeOver { dir: PathBuf, holder: String },
+    #[error("session {} is held by {holder}, which was not asked to end: {why}; nothing changed", dir.display())]
+    TakeOverRefused {
+        dir: PathBuf,
+        holder: String,
+        why: String,
+    },
+    #[error("the profile names no .cdf for camera {camera}: add it to [survey] cdf")]
+    NoCdf { camera: u32 },
+    #[error("{} NOT written: {source}", path.display())]
+    Cdf {
+        path: PathBuf,
+        #[source]
+        source: crate::formats::FormatError,
     },
 }

@@ -264,3 +264,54 @@ fn nonsense_manifest_is_reported_with_its_line_and_kept() {
         );
     }
 }
+
+/// An image of many lines (a big or busy picture) saves and reopens: its
+/// lines' attributes are recorded only up to `MAX_ATTRIBUTED_LINES`, so its
+/// manifest record stays within what the reader takes. Without that, 8 000
+/// lines made a record of 540 KB: the writer now refuses that ("nothing was
+/// written"), and before the writer's check the next open refused it, the
+/// whole session lost to the console.
+#[test]
+fn an_image_of_thousands_of_lines_saves_and_reopens() {
+    use vss::session::manifest::MAX_ATTRIBUTED_LINES;
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Session::create(dir.path(), "busy", &profile()).unwrap();
+    let sdir = s.dir().to_path_buf();
+    s.save_image(1, 'a', &grey(10)).unwrap();
+    s.save_image(1, 'b', &grey(20)).unwrap();
+    let e = edges(5);
+    let many: Vec<Segment> = (0..8000)
+        .map(|i| Segment {
+            response: 17.123_456_789_012 + f64::from(i),
+            residual: 0.251_234_567_89,
+            ..Segment::new(
+                Point::new(1.0, 0.5),
+                Point::new(30.0, 0.5 + f64::from(i) / 1e3),
+            )
+        })
+        .collect();
+    assert!(many.len() > MAX_ATTRIBUTED_LINES);
+    let set = OutputSet {
+        edges_h: Some(&e),
+        edges_v: Some(&e),
+        lines_raw: Some(&many),
+        lines: Some(&many),
+        ..Default::default()
+    };
+    s.save_output_set(1, &set, &Params::default()).unwrap();
+    drop(s);
+    let s = Session::open(&sdir).unwrap_or_else(|e| panic!("reopen: {e}"));
+    assert_eq!(
+        s.progress().next_step(),
+        Some(Step::Capture {
+            image: 2,
+            letter: 'a'
+        })
+    );
+    let text = fs::read_to_string(sdir.join("busy.toml")).unwrap();
+    assert!(
+        text.len() < vss::session::manifest::MAX_RECORD_LEN,
+        "{}",
+        text.len()
+    );
+}

@@ -594,7 +594,7 @@ fn accepting_the_last_image_while_the_one_before_saves_ends_the_survey() {
     // Image 1's save fails after all; later messages follow.
     app.update(Msg::Store(StoreEvent::OutputsNotSaved {
         k: 1,
-        error: vss::tui::workers::store::StoreError::NoSession,
+        error: vss::tui::event::StoreError::NoSession,
     }));
     app.update(Msg::Store(StoreEvent::OutputsSaved(2)));
     app.update(Msg::Store(StoreEvent::Note("a later note".into())));

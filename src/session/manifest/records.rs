@@ -165,16 +165,20 @@ fn header<I: Iterator<Item = toml_parser::lexer::Token>>(
     h
 }
 
-/// Parses manifest text record by record into a [`Manifest`] (not yet
-/// checked for sense); errors name `path` and the line in the whole file.
-pub(super) fn parse(text: &str, path: &Path) -> Result<Manifest, SessionError> {
-    let pieces = cut(text);
+/// Whether every record of manifest text is within [`MAX_RECORD_LEN`]: what
+/// the reader refuses, and the writer checks before it writes (so a session
+/// never saves what it could not read back).
+pub(crate) fn check_record_sizes(text: &str, path: &Path) -> Result<(), SessionError> {
+    check_sizes(text, &cut(text), path, "nothing was written")
+}
+
+fn check_sizes(text: &str, pieces: &Cut, path: &Path, outcome: &str) -> Result<(), SessionError> {
     let too_big = |r: &Range<usize>, what: &str, len: usize| SessionError::Manifest {
         path: path.to_path_buf(),
         line: line_of(text, r.start),
         message: format!(
             "{what} takes {len} bytes, more than the {MAX_RECORD_LEN} one may take \
-             (a real one takes about 13 KiB); nothing of the manifest was read"
+             (a real one takes about 13 KiB); {outcome}"
         ),
     };
     if let Some(r) = pieces.images.iter().find(|r| r.len() > MAX_RECORD_LEN) {
@@ -190,6 +194,14 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<Manifest, SessionError> {
             rest_len,
         ));
     }
+    Ok(())
+}
+
+/// Parses manifest text record by record into a [`Manifest`] (not yet
+/// checked for sense); errors name `path` and the line in the whole file.
+pub(super) fn parse(text: &str, path: &Path) -> Result<Manifest, SessionError> {
+    let pieces = cut(text);
+    check_sizes(text, &pieces, path, "nothing of the manifest was read")?;
     // The rest, made one text; `map` gives each of its pieces' offsets.
     let mut rest = String::with_capacity(pieces.rest.iter().map(|r| r.len()).sum());
     let mut map = Vec::with_capacity(pieces.rest.len());

@@ -4,11 +4,11 @@
 
 use super::{App, Modal, Pending, Phase};
 use crate::llv::edit::LineEditor;
+use crate::tui::event::StoreError;
 use crate::tui::event::{
     Cmd, DeviceEvent, FramePurpose, ImageKey, PipelineResult, StoreCmd, StoreEvent,
 };
 use crate::tui::text::clean;
-use crate::tui::workers::store::StoreError;
 
 impl App {
     pub(super) fn on_pipeline(&mut self, r: PipelineResult) -> Vec<Cmd> {

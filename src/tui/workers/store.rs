@@ -18,53 +18,13 @@ use crate::llv::lens::CameraModel;
 use crate::profile::Profile;
 use crate::report;
 use crate::session::{CheckReport, FrameSettings, Session, SessionError};
-use crate::tui::event::{Msg, SessionEntry, StoreCmd, StoreEvent};
+use crate::tui::event::{Msg, SessionEntry, StoreCmd, StoreError, StoreEvent};
 
 mod load;
 mod logfile;
 mod view;
 
 pub use view::view;
-
-/// What the store worker can fail at; each says what and what to do.
-#[derive(Debug, thiserror::Error)]
-pub enum StoreError {
-    #[error("no session open: create or open one on the Survey screen (1)")]
-    NoSession,
-    #[error("{what}: {source}")]
-    Session {
-        what: String,
-        #[source]
-        source: SessionError,
-    },
-    #[error("report NOT written: {why}{old}")]
-    Report { why: String, old: String },
-    #[error("log file {}: {source} — messages are still in the log pane (m)", path.display())]
-    Log {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
-    #[error(
-        "session {} is still held by {holder} after asking it to end; nothing changed",
-        dir.display()
-    )]
-    TakeOver { dir: PathBuf, holder: String },
-    #[error("session {} is held by {holder}, which was not asked to end: {why}; nothing changed", dir.display())]
-    TakeOverRefused {
-        dir: PathBuf,
-        holder: String,
-        why: String,
-    },
-    #[error("the profile names no .cdf for camera {camera}: add it to [survey] cdf")]
-    NoCdf { camera: u32 },
-    #[error("{} NOT written: {source}", path.display())]
-    Cdf {
-        path: PathBuf,
-        #[source]
-        source: formats::FormatError,
-    },
-}
 
 fn session_err(what: impl Into<String>) -> impl Fn(SessionError) -> StoreError {
     let what = what.into();
