@@ -23,3 +23,28 @@ where
         .output()
         .expect("run vss")
 }
+
+/// The address space (KiB) `vss` needs to start and exit (`vss --version`),
+/// found by bisection, once per test run. A memory bound is this plus what
+/// the work may take: the binary's libraries (more with the `genicam`
+/// feature: Aravis, GLib, libusb) are not the work's.
+pub fn baseline_kib() -> u64 {
+    static BASE: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
+    *BASE.get_or_init(|| {
+        let runs = |kib: u64| {
+            vss_under(Path::new("."), &format!("ulimit -v {kib}"), ["--version"])
+                .status
+                .success()
+        };
+        let (mut lo, mut hi) = (1024u64, 1 << 20);
+        assert!(
+            runs(hi),
+            "vss --version fails even in 1 GiB of address space"
+        );
+        while hi - lo > 256 {
+            let mid = (lo + hi) / 2;
+            if runs(mid) { hi = mid } else { lo = mid }
+        }
+        hi
+    })
+}
