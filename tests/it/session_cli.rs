@@ -283,12 +283,16 @@ fn lock_names_a_live_holder_and_yields_only_when_it_is_gone() {
     );
     let t = text(&o);
     assert!(t.contains(&format!("asking process {pid}")), "{t}");
-    assert!(
-        t.contains("did not release") && !t.contains("in use"),
-        "{t}"
-    );
-    use std::os::unix::process::ExitStatusExt;
-    assert_eq!(child.0.wait().unwrap().signal(), Some(libc::SIGTERM));
+    assert!(!t.contains("in use"), "{t}");
+    // The redo ran: image 3 has no frames, and it says so itself.
+    assert!(t.contains("no grey image captured yet"), "{t}");
+    // Signalled after the wait, unless the helper let the lock go between
+    // two saves first (on a busy machine it may; the first CI run of this
+    // test met that): either way the redo went on.
+    if t.contains("did not release") {
+        use std::os::unix::process::ExitStatusExt;
+        assert_eq!(child.0.wait().unwrap().signal(), Some(libc::SIGTERM));
+    }
 }
 
 /// Bytes that change a terminal's state: ESC, BEL, CR, and the 8-bit CSI
