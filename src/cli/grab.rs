@@ -33,6 +33,7 @@ use crate::formats::img::ImgFile;
 use crate::formats::names::{SessionName, VssFile};
 use crate::rig::Cell;
 use crate::rig::sim::Faults;
+use crate::session::takeover::LEAVE_POLL;
 use crate::session::{Session, SessionError};
 
 #[derive(Debug, clap::Args)]
@@ -63,9 +64,6 @@ pub struct Args {
     #[arg(long, value_name = "SPEC", hide = true)]
     pub sim_faults: Option<String>,
 }
-
-/// How often a transfer looks for a request to leave the session.
-const LEAVE_POLL: std::time::Duration = std::time::Duration::from_millis(200);
 
 pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     let profile = g.load_profile()?;

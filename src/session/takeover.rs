@@ -22,6 +22,10 @@ use super::{Session, SessionError};
 /// signals it.
 pub const LEAVE_WAIT: Duration = Duration::from_secs(5);
 
+/// How often a holder (the console's store, a `vss grab` in a transfer)
+/// looks for a request to leave its session: well inside [`LEAVE_WAIT`].
+pub const LEAVE_POLL: Duration = Duration::from_millis(200);
+
 /// How long the taker waits for a signalled holder to end.
 const SIGNAL_WAIT: Duration = Duration::from_secs(15);
 

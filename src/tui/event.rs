@@ -407,17 +407,11 @@ pub enum StoreError {
         #[source]
         source: std::io::Error,
     },
-    #[error(
-        "session {} is still held by {holder} after asking it to end; nothing changed",
-        dir.display()
-    )]
-    TakeOver { dir: PathBuf, holder: String },
-    #[error("session {} is held by {holder}, which was not asked to end: {why}; nothing changed", dir.display())]
-    TakeOverRefused {
-        dir: PathBuf,
-        holder: String,
-        why: String,
-    },
+    /// The holder did not let go, or was not asked
+    /// ([`crate::session::takeover::TakeOverError`], whose words are the
+    /// CLI's too).
+    #[error(transparent)]
+    TakeOver(crate::session::takeover::TakeOverError),
     #[error("the profile names no .cdf for camera {camera}: add it to [survey] cdf")]
     NoCdf { camera: u32 },
     #[error("{} NOT written: {source}", path.display())]

@@ -17,6 +17,7 @@ use crate::llv::GreyImage;
 use crate::llv::lens::CameraModel;
 use crate::profile::Profile;
 use crate::report;
+use crate::session::takeover::LEAVE_POLL;
 use crate::session::{CheckReport, FrameSettings, Session, SessionError};
 use crate::tui::event::{Msg, SessionEntry, StoreCmd, StoreError, StoreEvent};
 
@@ -33,9 +34,6 @@ fn session_err(what: impl Into<String>) -> impl Fn(SessionError) -> StoreError {
         source,
     }
 }
-
-/// How often the store looks for a request to leave its session.
-const LEAVE_POLL: Duration = Duration::from_millis(200);
 
 /// The UI's handle on the store worker.
 pub struct StoreHandle {
@@ -501,10 +499,7 @@ impl Store {
             TakeOverError::Session(e) => {
                 session_err(format!("cannot take over {}", dir.display()))(e)
             }
-            TakeOverError::NoAnswer { dir, holder } => StoreError::TakeOver { dir, holder },
-            TakeOverError::Refused { dir, holder, why } => {
-                StoreError::TakeOverRefused { dir, holder, why }
-            }
+            e => StoreError::TakeOver(e),
         })
     }
 
