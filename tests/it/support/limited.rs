@@ -24,27 +24,33 @@ where
         .expect("run vss")
 }
 
+/// The least address space (KiB, to within 256) in which `vss ARGS`, run
+/// in `cwd`, succeeds, found by bisection up to 1 GiB.
+pub fn least_kib<I, S>(cwd: &Path, args: I) -> u64
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<OsStr>,
+{
+    let args: Vec<S> = args.into_iter().collect();
+    let runs = |kib: u64| {
+        vss_under(cwd, &format!("ulimit -v {kib}"), &args)
+            .status
+            .success()
+    };
+    let (mut lo, mut hi) = (1024u64, 1 << 20);
+    assert!(runs(hi), "vss fails even in 1 GiB of address space");
+    while hi - lo > 256 {
+        let mid = (lo + hi) / 2;
+        if runs(mid) { hi = mid } else { lo = mid }
+    }
+    hi
+}
+
 /// The address space (KiB) `vss` needs to start and exit (`vss --version`),
-/// found by bisection, once per test run. A memory bound is this plus what
-/// the work may take: the binary's libraries (more with the `genicam`
-/// feature: Aravis, GLib, libusb) are not the work's.
+/// once per test run. A memory bound is this plus what the work may take:
+/// the binary's libraries (more with the `genicam` feature: Aravis, GLib,
+/// libusb) are not the work's.
 pub fn baseline_kib() -> u64 {
     static BASE: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
-    *BASE.get_or_init(|| {
-        let runs = |kib: u64| {
-            vss_under(Path::new("."), &format!("ulimit -v {kib}"), ["--version"])
-                .status
-                .success()
-        };
-        let (mut lo, mut hi) = (1024u64, 1 << 20);
-        assert!(
-            runs(hi),
-            "vss --version fails even in 1 GiB of address space"
-        );
-        while hi - lo > 256 {
-            let mid = (lo + hi) / 2;
-            if runs(mid) { hi = mid } else { lo = mid }
-        }
-        hi
-    })
+    *BASE.get_or_init(|| least_kib(Path::new("."), ["--version"]))
 }
