@@ -29,12 +29,16 @@ pub const INTRINSIC_NAMES: [&str; N_INTRINSICS] = [
 /// How many intrinsics the solver knows.
 pub const N_INTRINSICS: usize = 11;
 
-/// Indices in [`INTRINSIC_NAMES`] of the terms only the full model
-/// estimates: the thin prism `s1, s2` and the radial `k3`.
-pub const FULL_ONLY: [usize; 3] = [6, 7, 9];
-
+/// Index of `s1` in [`INTRINSIC_NAMES`] (`s2` follows it).
+const S1: usize = 6;
+/// Index of `k2` in [`INTRINSIC_NAMES`] (`k3` follows it).
+const K2: usize = 8;
 /// Index of `sy` in [`INTRINSIC_NAMES`].
 pub const SY: usize = 10;
+
+/// Indices in [`INTRINSIC_NAMES`] of the terms only the full model
+/// estimates: the thin prism `s1, s2` and the radial `k3`.
+pub const FULL_ONLY: [usize; 3] = [S1, S1 + 1, K2 + 1];
 
 /// Weng's folded `D = (k1, g1, g2, g3, g4)` from `(k1, p1, p2, s1, s2)`.
 pub fn fold(k1: f64, p1: f64, p2: f64, s1: f64, s2: f64) -> [f64; 5] {
@@ -106,7 +110,7 @@ pub fn model_from(v: &[f64], base: &CameraModel, estimate_sy: bool) -> CameraMod
         cy: g(1),
         f: g(2),
         distortion: Some(fold(g(3), g(4), g(5), g(6), g(7))),
-        radial: [g(8), g(9)],
+        radial: [g(K2), g(K2 + 1)],
         sx: base.sx,
         sy: if estimate_sy { g(SY) } else { base.sy },
     }
@@ -202,6 +206,23 @@ pub fn project(m: &CameraModel, pose: &Pose, x: &Vector3<f64>) -> Option<Project
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_named_indices_name_their_terms() {
+        let name = |i: usize| INTRINSIC_NAMES[i];
+        assert_eq!([name(S1), name(S1 + 1)], ["s1", "s2"]);
+        assert_eq!([name(K2), name(K2 + 1), name(SY)], ["k2", "k3", "sy"]);
+        let full: Vec<_> = FULL_ONLY.iter().map(|&i| name(i)).collect();
+        assert_eq!(full, ["s1", "s2", "k3"]);
+        // The vector puts each term where its name is.
+        let m = CameraModel {
+            radial: [2.0, 3.0],
+            sy: 4.0,
+            ..camera()
+        };
+        let v = intrinsics_vector(&m);
+        assert_eq!([v[K2], v[K2 + 1], v[SY]], [2.0, 3.0, 4.0]);
+    }
 
     fn camera() -> CameraModel {
         CameraModel {

@@ -117,45 +117,61 @@ fn york_urban_tune_false_length_on_flat_structure() {
 
 const FLAT_CEILING: f64 = 50.0;
 
-/// Several lightings on real photographs: each tune photograph lit three
-/// ways (dimmed to 70 %; a shadow darkening its left half to 35 % through
-/// a smooth ramp; the same from the right), the three combined
-/// (`llv::photometric`) against the best of them alone, by the same
-/// scorer. Printed by `cargo test --test accuracy real:: -- --nocapture`.
-///
-/// The issue's goal (the combination at least as good as the best single
-/// image) is nearly met here: within 0.005 F of the best of the three
-/// chosen afterwards for each photograph, whose noise is the same noise in
-/// all three (docs/accuracy.md). The floor keeps what it measures from
-/// getting worse.
-#[test]
-fn three_lightings_of_each_photograph_against_the_best_one() {
+/// What [`lightings`] measures over the tune set.
+struct Lit {
+    /// The best of the three lit images alone, chosen for each photograph
+    /// afterwards by its F.
+    best: vss::synth::real::RealMetrics,
+    /// The three combined (`llv::photometric`).
+    combined: vss::synth::real::RealMetrics,
+    /// Each lit image alone, pooled over the photographs.
+    singles: [vss::synth::real::RealMetrics; 3],
+    /// Photographs where the combination is below the best single by > 0.02 F.
+    worse: Vec<String>,
+}
+
+/// Each tune photograph lit three ways (dimmed to 70 %; a shadow darkening
+/// its left half to 35 % through a smooth ramp; the same from the right),
+/// each lit image with, when `sigma` is given, its own Gaussian sensor
+/// noise of that many grey levels (a new exposure each, as the cell's
+/// camera takes them); scored alone and combined by the same scorer.
+fn lightings(sigma: Option<f64>) -> Lit {
     use vss::llv::GreyImage;
     use vss::llv::pipeline::{Input, run};
+    use vss::llv::rng::{SplitMix64, mix};
     use vss::synth::real::{RealTally, read_photo, read_truth, score_real};
-    let relit = |img: &GreyImage, gain: &dyn Fn(usize) -> f64| {
-        let (w, h) = img.size();
-        let d = img.data();
-        let px = (0..w * h)
-            .map(|i| (f64::from(d[i]) * gain(i % w)).round().clamp(0.0, 255.0) as u8)
-            .collect();
-        GreyImage::new(w, h, px).unwrap()
-    };
     let p = default_params();
     let (mut best, mut combined) = (RealTally::default(), RealTally::default());
+    let mut singles: [RealTally; 3] = Default::default();
     let mut worse = Vec::new();
-    for ph in photographs(&folder()).unwrap() {
+    for (k, ph) in photographs(&folder()).unwrap().iter().enumerate() {
         let img = read_photo(&ph.image).unwrap();
         let truth = read_truth(&ph.truth).unwrap();
-        let w = img.size().0 as f64;
+        let (w, h) = img.size();
+        let wf = w as f64;
         // 0.35 on the dark side, 1.0 on the lit side, a ramp a fifth of the
         // width wide across the middle.
-        let ramp = |x: f64| 0.35 + 0.65 * ((x / w - 0.4) / 0.2).clamp(0.0, 1.0);
-        let lit = [
-            relit(&img, &|_| 0.7),
-            relit(&img, &|x| ramp(x as f64)),
-            relit(&img, &|x| ramp(w - 1.0 - x as f64)),
-        ];
+        let ramp = |x: f64| 0.35 + 0.65 * ((x / wf - 0.4) / 0.2).clamp(0.0, 1.0);
+        let gains: [&dyn Fn(usize) -> f64; 3] = [&|_| 0.7, &|x| ramp(x as f64), &|x| {
+            ramp(wf - 1.0 - x as f64)
+        }];
+        let lit: Vec<GreyImage> = gains
+            .iter()
+            .enumerate()
+            .map(|(l, gain)| {
+                let mut rng = SplitMix64::new(mix(k as u64, l as u64));
+                let d = img.data();
+                let px = (0..w * h)
+                    .map(|i| {
+                        let n = sigma.map_or(0.0, |s| s * rng.gauss());
+                        (f64::from(d[i]) * gain(i % w) + n)
+                            .round()
+                            .clamp(0.0, 255.0) as u8
+                    })
+                    .collect();
+                GreyImage::new(w, h, px).unwrap()
+            })
+            .collect();
         let lines = |imgs: &[GreyImage]| {
             let input = Input {
                 images: imgs,
@@ -164,8 +180,11 @@ fn three_lightings_of_each_photograph_against_the_best_one() {
             };
             run(&input, &p).unwrap().lines
         };
-        let singles: Vec<_> = lit.iter().map(|i| lines(std::slice::from_ref(i))).collect();
-        let top = singles
+        let alone: Vec<_> = lit.iter().map(|i| lines(std::slice::from_ref(i))).collect();
+        for (t, l) in singles.iter_mut().zip(&alone) {
+            t.add(l, &truth);
+        }
+        let top = alone
             .iter()
             .max_by(|a, b| score_real(a, &truth).f.total_cmp(&score_real(b, &truth).f))
             .unwrap();
@@ -177,23 +196,71 @@ fn three_lightings_of_each_photograph_against_the_best_one() {
         best.add(top, &truth);
         combined.add(&all, &truth);
     }
-    let (b, c) = (best.metrics(), combined.metrics());
+    let lit = Lit {
+        best: best.metrics(),
+        combined: combined.metrics(),
+        singles: singles.map(|t| t.metrics()),
+        worse,
+    };
+    let prf = |m: &vss::synth::real::RealMetrics| {
+        format!("P {:.4} R {:.4} F {:.4}", m.precision, m.recall, m.f)
+    };
     eprintln!(
-        "three lightings: best single P {:.4} R {:.4} F {:.4}; combined P {:.4} R {:.4} F {:.4}; \
-         combined below the best single by > 0.02 F on {} photographs: {worse:?}",
-        b.precision,
-        b.recall,
-        b.f,
-        c.precision,
-        c.recall,
-        c.f,
-        worse.len()
+        "three lightings ({}): best single {}; combined {}; each alone: 70 % {}, shadow left {}, \
+         shadow right {}; combined below the best single by > 0.02 F on {} photographs: {:?}",
+        sigma.map_or("no noise added".to_string(), |s| format!(
+            "each with its own sensor noise, σ {s}"
+        )),
+        prf(&lit.best),
+        prf(&lit.combined),
+        prf(&lit.singles[0]),
+        prf(&lit.singles[1]),
+        prf(&lit.singles[2]),
+        lit.worse.len(),
+        lit.worse
     );
-    assert!(b.f >= 0.732, "best single F {:.4}", b.f);
+    lit
+}
+
+/// Several lightings as the cell takes them: three exposures, each with
+/// its own sensor noise (σ 2 grey levels, about an 8-bit industrial
+/// camera's at mid-grey). The issue's goal is the combination at least as
+/// good as the best single image in recall and F, the best chosen
+/// afterwards for each photograph. It is not met (docs/accuracy.md): the
+/// combination sums magnitudes, whose noise floor rises with each term.
+/// The floors keep what is measured: the combination within 0.005 F of
+/// that best and above each lighting taken alone over all photographs.
+/// Printed by `cargo test --test accuracy real:: -- --nocapture`.
+#[test]
+fn three_exposures_of_each_photograph_against_the_best_one() {
+    let lit = lightings(Some(2.0));
+    let each = lit.singles.iter().map(|m| m.f).fold(0.0, f64::max);
     assert!(
-        c.f >= 0.726,
-        "combined F {:.4} (best single {:.4})",
-        c.f,
-        b.f
+        lit.combined.f >= lit.best.f - 0.005 && lit.combined.f >= each,
+        "combined F {:.4} R {:.4}, best single F {:.4} R {:.4}, each alone at most {each:.4}",
+        lit.combined.f,
+        lit.combined.recall,
+        lit.best.f,
+        lit.best.recall
+    );
+}
+
+/// The same lightings made from the photograph alone, with no noise of
+/// their own: the three images then carry the same noise, so combining
+/// them has nothing to average and cannot find what none of them shows; the
+/// best of the three chosen afterwards for each photograph gains by the
+/// choice (docs/accuracy.md). The floors keep what is measured from
+/// getting worse: the combination within 0.005 F of that best and not
+/// below the better of the lit images taken alone.
+#[test]
+fn three_noiseless_lightings_of_each_photograph_against_the_best_one() {
+    let lit = lightings(None);
+    assert!(lit.best.f >= 0.732, "best single F {:.4}", lit.best.f);
+    let each = lit.singles.iter().map(|m| m.f).fold(0.0, f64::max);
+    assert!(
+        lit.combined.f >= 0.726 && lit.combined.f >= lit.best.f - 0.005 && lit.combined.f >= each,
+        "combined F {:.4} (best single {:.4}, each alone at most {each:.4})",
+        lit.combined.f,
+        lit.best.f
     );
 }
