@@ -17,7 +17,7 @@ use crate::rig::sim::{Faults, SimCell};
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Faults injected into the grabber, e.g.
-    /// `drop=1e-4,corrupt=1e-4,stall=2s,unplug-after=100000,reset,garbage=64`.
+    /// `drop=1e-4,corrupt=1e-4,stall=2s,slow-freeze=1s,unplug-after=100000,reset,garbage=64`.
     #[arg(long, value_name = "SPEC")]
     pub faults: Option<String>,
     /// Keep a symlink here pointing at the grabber's pseudo-terminal (a

@@ -591,18 +591,31 @@ impl<P: Link> FrameGrabber for VsgClient<P> {
         Ok(())
     }
 
+    /// FREEZE. When it had to be sent again, the answer taken may be the
+    /// first FREEZE's, arriving late, while the grabber holds the second's
+    /// frame (each freeze is a new exposure): STATUS then says which CRC
+    /// the frame held now has, and the transfer checks that one.
     fn freeze(&mut self) -> Result<FrameInfo, RigError> {
         self.frame = None;
         self.frozen_from = None;
+        let retries = self.stats.retries;
         let r = self.exchange(
             Command::Freeze,
             |r| matches!(r, Reply::Ok(s) if FrameInfo::parse(s).is_some()),
         )?;
-        let f = match &r {
+        let mut f = match &r {
             Reply::Ok(s) => FrameInfo::parse(s),
             _ => None,
         }
         .ok_or_else(|| self.garbled("FREEZE", &r))?;
+        if self.stats.retries > retries {
+            // The answer to the last FREEZE, if it is still on its way, is
+            // passed over as late by STATUS's exchange.
+            let held = self.status()?.frame;
+            f.crc = held.ok_or_else(|| RigError::NoFrame {
+                port: self.name.clone(),
+            })?;
+        }
         self.frame = Some(f);
         self.frozen_from = self.camera;
         Ok(f)

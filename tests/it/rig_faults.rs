@@ -196,6 +196,24 @@ fn unplug_mid_frame_is_a_clear_error_and_reconnect_works() {
     assert!(again.expect("capture after reconnect") == want);
 }
 
+/// A FREEZE answered after the reply timeout (a slow digitiser; the
+/// simulator on a busy machine rendering a plate): the client freezes
+/// again, and the first answer, arriving late, names the first frame while
+/// the grabber holds the second. The transfer must check the frame the
+/// grabber holds; it failed twice with "the frame's CRC … does not match
+/// FREEZE's" (seen under load in `calib_cli` and in the audit's grabs).
+#[test]
+fn a_freeze_answered_late_transfers_the_frame_the_grabber_holds() {
+    let mut p = profile();
+    // Every freeze a new exposure, with a CRC of its own.
+    p.sim.noise = 2.0;
+    let (r, took, mut cell) = faulty_with("slow-freeze=700ms", p);
+    let c = r.expect("a capture despite the late answer");
+    let st = cell.grabber.status().expect("status");
+    assert_eq!(st.frame, Some(crc32(c.image.data())));
+    assert!(took < Duration::from_secs(10), "{took:?}");
+}
+
 #[test]
 fn garbage_on_connect_is_skipped() {
     let want = reference();

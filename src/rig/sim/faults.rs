@@ -1,5 +1,5 @@
 //! Fault injection for the simulated grabber, as `vss sim --faults` takes it:
-//! `drop=RATE,corrupt=RATE,stall=DURATION,unplug-after=BYTES,reset,garbage=BYTES`.
+//! `drop=RATE,corrupt=RATE,stall=DURATION,slow-freeze=DURATION,unplug-after=BYTES,reset,garbage=BYTES`.
 //! Faults act on the bytes the device sends (drops, corruption, the unplug
 //! count) and on its behaviour (a stall, a reset in the middle of a frame).
 
@@ -17,6 +17,9 @@ pub struct Faults {
     /// The device goes silent this long, once, at the first READ past the
     /// start of a frame.
     pub stall: Option<Duration>,
+    /// The first FREEZE takes this long before it digitises (a slow
+    /// digitiser, or a busy machine running the simulator).
+    pub slow_freeze: Option<Duration>,
     /// The device vanishes (its pseudo-terminal closes) after sending this
     /// many bytes.
     pub unplug_after: Option<u64>,
@@ -32,7 +35,7 @@ pub struct Faults {
 /// A `--faults` string that does not parse.
 #[derive(Debug, thiserror::Error)]
 #[error(
-    "bad fault `{item}`: {why} (expected drop=RATE,corrupt=RATE,stall=2s,unplug-after=BYTES,reset,garbage=BYTES,seed=N)"
+    "bad fault `{item}`: {why} (expected drop=RATE,corrupt=RATE,stall=2s,slow-freeze=2s,unplug-after=BYTES,reset,garbage=BYTES,seed=N)"
 )]
 pub struct FaultsError {
     pub item: String,
@@ -91,6 +94,12 @@ impl Faults {
                             .ok_or_else(|| err("not a duration like 2s or 500ms"))?,
                     )
                 }
+                "slow-freeze" => {
+                    f.slow_freeze = Some(
+                        parse_duration(value)
+                            .ok_or_else(|| err("not a duration like 2s or 500ms"))?,
+                    )
+                }
                 "unplug-after" => {
                     f.unplug_after = Some(value.parse().map_err(|_| err("not a byte count"))?)
                 }
@@ -115,6 +124,9 @@ impl Faults {
         if let Some(d) = self.stall {
             parts.push(format!("stall={}ms", d.as_millis()));
         }
+        if let Some(d) = self.slow_freeze {
+            parts.push(format!("slow-freeze={}ms", d.as_millis()));
+        }
         if let Some(n) = self.unplug_after {
             parts.push(format!("unplug-after={n}"));
         }
@@ -138,6 +150,7 @@ pub(crate) struct FaultState {
     rng: SplitMix64,
     pub sent: u64,
     pub stall_done: bool,
+    pub slow_freeze_done: bool,
     pub reset_done: bool,
 }
 
@@ -157,6 +170,7 @@ impl FaultState {
             rng: SplitMix64::new(seed),
             sent: 0,
             stall_done: false,
+            slow_freeze_done: false,
             reset_done: false,
         }
     }
@@ -200,8 +214,9 @@ mod tests {
 
     #[test]
     fn parses_the_documented_spec() {
-        let f =
-            Faults::parse("drop=1e-4,corrupt=1e-4,stall=2s,unplug-after=100000,reset,garbage=50");
+        let f = Faults::parse(
+            "drop=1e-4,corrupt=1e-4,stall=2s,slow-freeze=1s,unplug-after=100000,reset,garbage=50",
+        );
         let f = f.ok();
         assert_eq!(
             f,
@@ -209,6 +224,7 @@ mod tests {
                 drop: 1e-4,
                 corrupt: 1e-4,
                 stall: Some(Duration::from_secs(2)),
+                slow_freeze: Some(Duration::from_secs(1)),
                 unplug_after: Some(100_000),
                 reset: true,
                 garbage: 50,

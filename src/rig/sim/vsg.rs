@@ -168,6 +168,15 @@ impl Grabber<'_> {
                 ok(String::new())
             }
             Command::Freeze => {
+                if let Some(d) = self
+                    .faults
+                    .faults
+                    .slow_freeze
+                    .filter(|_| !self.faults.slow_freeze_done)
+                {
+                    self.faults.slow_freeze_done = true;
+                    self.pause(d);
+                }
                 self.live = false;
                 self.shots += 1;
                 let data = self
@@ -259,13 +268,18 @@ impl Grabber<'_> {
         Reply::Ok(String::new())
     }
 
+    /// Goes silent for `d` (or until the simulator stops).
+    fn pause(&self, d: Duration) {
+        let until = Instant::now() + d;
+        while Instant::now() < until && !self.stop.load(Ordering::SeqCst) {
+            std::thread::sleep(POLL.min(until.saturating_duration_since(Instant::now())));
+        }
+    }
+
     fn read(&mut self, off: u32, len: u32) -> Result<(), Gone> {
         if off > 0 && self.faults.faults.stall.is_some() && !self.faults.stall_done {
             self.faults.stall_done = true;
-            let until = Instant::now() + self.faults.faults.stall.unwrap_or_default();
-            while Instant::now() < until && !self.stop.load(Ordering::SeqCst) {
-                std::thread::sleep(POLL.min(until.saturating_duration_since(Instant::now())));
-            }
+            self.pause(self.faults.faults.stall.unwrap_or_default());
         }
         if off > 0 && self.faults.faults.reset && !self.faults.reset_done {
             self.faults.reset_done = true;
