@@ -223,7 +223,21 @@ impl Link for serialport::TTYPort {
 /// The serial port type the drivers use on real devices and ptys.
 pub type SerialLink = Box<dyn serialport::SerialPort>;
 
-/// Opens a serial device 8N1, no flow control.
+/// How long [`open_serial`] waits for a port another open file holds
+/// locked.
+pub const BUSY_WAIT: Duration = Duration::from_millis(300);
+
+/// Opens a serial device 8N1, no flow control, exclusively (serialport's
+/// `TIOCEXCL` and `flock`).
+///
+/// A port found locked is tried again every 10 ms for [`BUSY_WAIT`]
+/// before "in use" is the answer. The lock belongs to an open file, and a
+/// process that starts a program copies its open files into the child
+/// until the program is loaded (close-on-exec acts only then): a port
+/// closed and opened again at once (a reconnect, a board opened twice in a
+/// row) can find its own last lock still held by a child of some other
+/// thread for that moment. Another program that holds the port is still
+/// refused, after the wait.
 pub fn open_serial(path: &str, baud: u32, timeout: Duration) -> Result<SerialLink, RigError> {
     if path.is_empty() {
         return Err(RigError::Config(
@@ -231,15 +245,31 @@ pub fn open_serial(path: &str, baud: u32, timeout: Duration) -> Result<SerialLin
                 .to_string(),
         ));
     }
-    serialport::new(path, baud)
-        .timeout(timeout)
-        .data_bits(serialport::DataBits::Eight)
-        .parity(serialport::Parity::None)
-        .stop_bits(serialport::StopBits::One)
-        .flow_control(serialport::FlowControl::None)
-        .open()
-        .map_err(|source| RigError::Open {
-            port: path.to_string(),
-            source,
-        })
+    let start = std::time::Instant::now();
+    loop {
+        let r = serialport::new(path, baud)
+            .timeout(timeout)
+            .data_bits(serialport::DataBits::Eight)
+            .parity(serialport::Parity::None)
+            .stop_bits(serialport::StopBits::One)
+            .flow_control(serialport::FlowControl::None)
+            .open();
+        match r {
+            Err(e) if is_locked(&e) && start.elapsed() < BUSY_WAIT => {
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            r => {
+                return r.map_err(|source| RigError::Open {
+                    port: path.to_string(),
+                    source,
+                });
+            }
+        }
+    }
+}
+
+/// Whether serialport refused a port because another open file holds its
+/// lock (its only way of saying so is this kind and text).
+fn is_locked(e: &serialport::Error) -> bool {
+    e.kind() == serialport::ErrorKind::NoDevice && e.description.contains("lock")
 }

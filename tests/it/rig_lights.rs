@@ -66,6 +66,36 @@ fn numato_driver_switches_and_reads_back() {
     assert!(matches!(b.set(40, true), Err(RigError::Board { .. })));
 }
 
+/// A port whose lock is held for a moment is waited for: a port closed
+/// and opened again at once found its own last lock still held, by the
+/// copy of the open file a child process of another thread keeps until its
+/// program is loaded (this test's next open failed "Unable to acquire
+/// exclusive lock" under load). A port held on is refused after the wait,
+/// naming the port.
+#[test]
+fn a_port_locked_for_a_moment_is_waited_for_and_one_held_is_refused() {
+    let sim = SimCell::start(SimOptions::new(32, 32)).expect("sim");
+    let path = sim.relay_path().to_string();
+    let t = Duration::from_millis(100);
+    let held = open_serial(&path, 19200, t).expect("the first open");
+    let release = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(100));
+        drop(held);
+    });
+    let again = open_serial(&path, 19200, t);
+    release.join().expect("released");
+    let again = again.expect("opened once the lock was let go");
+    let start = Instant::now();
+    let e = open_serial(&path, 19200, t).expect_err("a port held on");
+    assert!(
+        start.elapsed() >= vss::rig::BUSY_WAIT,
+        "{:?}",
+        start.elapsed()
+    );
+    assert!(e.to_string().contains(&path), "{e}");
+    drop(again);
+}
+
 #[test]
 fn writeall_sends_as_many_digits_as_the_board_has_relays_over_four() {
     for (relays, mask, typed) in [
