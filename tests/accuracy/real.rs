@@ -115,7 +115,7 @@ fn york_urban_tune_false_length_on_flat_structure() {
     );
 }
 
-const FLAT_CEILING: f64 = 16.0;
+const FLAT_CEILING: f64 = 33.0;
 
 /// Several lightings on real photographs: each tune photograph lit three
 /// ways (dimmed to 70 %; a shadow darkening its left half to 35 % through
