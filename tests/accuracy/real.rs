@@ -115,7 +115,7 @@ fn york_urban_tune_false_length_on_flat_structure() {
     );
 }
 
-const FLAT_CEILING: f64 = 50.0;
+const FLAT_CEILING: f64 = 33.0;
 
 /// What [`lightings`] measures over the tune set.
 struct Lit {

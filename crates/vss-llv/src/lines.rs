@@ -55,6 +55,7 @@ pub mod align;
 pub mod nfa;
 pub mod source;
 mod split;
+pub mod step;
 
 use super::edges::{NoiseMap, PeakMap, PeakScratch, Response};
 use super::fit::LineFit;

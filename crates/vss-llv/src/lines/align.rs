@@ -38,7 +38,10 @@
 //! shading, a faint cloud or faint print, and is dropped whatever its
 //! alignment. The mean is taken along the whole line, not per sample: a
 //! faint edge in noise (10 grey levels at a blur of σ 1.5 px has a slope
-//! of 2.7) dips below it at single pixels but not on average.
+//! of 2.7) dips below it at single pixels but not on average. A gradient
+//! above ρ may still be shading's, not the line's: what counts is the
+//! gradient along the line less the shading beside it
+//! ([`super::step`]).
 
 use crate::{GreyImage, Point, Segment};
 
@@ -226,7 +229,8 @@ pub fn keep_aligned(
     let AlignScratch { v, ps, out } = scratch;
     out.clear();
     for s in lines.iter() {
-        if samples(images, s, v) < min_slope() {
+        let g = samples(images, s, v);
+        if g - super::step::least_shading(images, s).unwrap_or(0.0) < min_slope() {
             continue;
         }
         let counted = v.iter().filter(|x| **x != Sample::Unknown).count();
@@ -312,6 +316,28 @@ mod tests {
         let mut lines = vec![s];
         keep_aligned(&[step], &mut lines, 0.9, 8.0, &mut AlignScratch::default());
         assert_eq!(lines, vec![s]);
+    }
+
+    #[test]
+    fn a_line_on_a_soft_shadow_is_dropped() {
+        // A penumbra of 60 grey levels over σ 8 px: its gradient along the
+        // line is above ρ and across it everywhere, but nearly as steep
+        // 2-6 px beside it: no step of its own.
+        let (w, h) = (64, 64);
+        let px = (0..w * h)
+            .map(|i| {
+                let x = (i % w) as f64;
+                (100.0 + 60.0 / (1.0 + (-(x - 31.5) / 4.8).exp())).round() as u8
+            })
+            .collect();
+        let img = GreyImage::new(w, h, px).unwrap();
+        let s = line(31.5, 5.0, 31.5, 58.0);
+        let mut v = Vec::new();
+        assert!(samples(std::slice::from_ref(&img), &s, &mut v) > min_slope());
+        assert_eq!(aligned_fraction(std::slice::from_ref(&img), &s), Some(1.0));
+        let mut lines = vec![s];
+        keep_aligned(&[img], &mut lines, 0.9, 8.0, &mut AlignScratch::default());
+        assert!(lines.is_empty(), "{lines:?}");
     }
 
     #[test]
