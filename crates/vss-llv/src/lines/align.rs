@@ -229,8 +229,13 @@ pub fn keep_aligned(
     let AlignScratch { v, ps, out } = scratch;
     out.clear();
     for s in lines.iter() {
+        // The shading beside a line is read only where it can decide: at
+        // twice ρ, the image beside the line would have to slope at half
+        // the line's own gradient on both sides, a blurred edge's shape
+        // rather than shading's.
         let g = samples(images, s, v);
-        if g - super::step::least_shading(images, s).unwrap_or(0.0) < min_slope() {
+        let shading = || super::step::least_shading(images, s).unwrap_or(0.0);
+        if g < min_slope() || (g < 2.0 * min_slope() && g - shading() < min_slope()) {
             continue;
         }
         let counted = v.iter().filter(|x| **x != Sample::Unknown).count();

@@ -14,7 +14,8 @@
 //! The gradient is the line's mean Sobel magnitude (as for ρ); the shading
 //! is read from the image's profile across the line: grey levels at
 //! whole-pixel offsets `-REACH..=REACH` along the normal (bilinear), one
-//! profile a pixel along the line, averaged (noise and texture that the
+//! profile a pixel along the line up to [`PROFILES`] spread evenly over it,
+//! averaged (noise and texture that the
 //! line does not follow cancel); the mean slope from [`CORE`] to [`REACH`]
 //! px out, in the direction of the profile's steepest step within [`CORE`]
 //! px of the line, on each side; the lesser side counts (a neighbouring
@@ -30,6 +31,11 @@ use crate::{GreyImage, Segment};
 /// Profile half-width (px): beyond a blurred edge's reach (σ ≤ 1.5 px),
 /// within a soft shadow's.
 pub const REACH: usize = 6;
+/// At most this many profiles are averaged along a line: enough to
+/// average out noise and texture the line does not follow (the slope
+/// beside it is a difference of means over 4 px), and the cost stays that
+/// of a short line whatever the length.
+pub const PROFILES: usize = 16;
 /// The step is looked for within this many px of the line (the line's
 /// position error after the refit is under one pixel).
 pub const CORE: usize = 2;
@@ -69,7 +75,8 @@ pub fn mean_profile(img: &GreyImage, s: &Segment) -> Option<[f64; 2 * REACH + 1]
     let mut sum = [0.0; 2 * REACH + 1];
     let mut p = [0.0; 2 * REACH + 1];
     let mut count = 0usize;
-    let n = len.ceil().max(1.0);
+    // Profiles spread evenly along the line, at most PROFILES of them.
+    let n = len.ceil().clamp(1.0, PROFILES as f64);
     'sample: for k in 0..n as usize {
         let t = (k as f64 + 0.5) / n * len;
         let (x, y) = (s.a.x + dx * t, s.a.y + dy * t);
