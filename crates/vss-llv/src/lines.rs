@@ -56,11 +56,12 @@ pub mod nfa;
 pub mod source;
 mod split;
 
+use super::edges::band::PixelSums;
 use super::edges::{NoiseMap, PeakMap, PeakScratch, Response};
 use super::fit::LineFit;
 use super::params::LineParams;
 use super::{EdgePoints, Point, ScanDir, Segment};
-use source::{Cand, Peaks, PointBufs, ResponseBufs, ResponsePeaks};
+use source::{Cand, Peaks, PointBufs, ResponseBufs, ResponsePeaks, SumAt};
 
 /// Largest `|du/dv|` used for the prediction.
 const MAX_SLOPE: f64 = 8.0;
@@ -176,7 +177,49 @@ pub fn track_into(
         own.build_into(resp, noise, floor, p.track_sigmas, &mut s.peaks);
         &own
     };
-    let mut src = ResponsePeaks::new(resp, noise, map, &mut s.response);
+    let src = ResponsePeaks::new(resp, noise, map, &mut s.response);
+    track_from(src, (w, h), vertical, seeds, starts, half_width, p, out, s);
+    s.map = own;
+}
+
+/// [`track_into`] on a response read at its pixels ([`PixelSums`]), with
+/// the peak map the edge pass made of it at `p.track_sigmas`
+/// (`edges::peaks::strips::detect_strips`).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn track_pixels(
+    sums: PixelSums,
+    noise: &NoiseMap,
+    map: &PeakMap,
+    seeds: &EdgePoints,
+    starts: &[[u16; 2]],
+    half_width: usize,
+    p: &LineParams,
+    out: &mut Vec<Segment>,
+    s: &mut LineScratch,
+) {
+    out.clear();
+    let (w, h, vertical) = (sums.w, sums.h, sums.dir == ScanDir::Vertical);
+    if w < 3 || h < 3 {
+        return;
+    }
+    let src = ResponsePeaks::of_pixels(sums, noise, map, &mut s.response);
+    track_from(src, (w, h), vertical, seeds, starts, half_width, p, out, s);
+}
+
+/// The tracks of [`track_into`] from the peaks of `src`, a `size` response.
+#[allow(clippy::too_many_arguments)]
+fn track_from<S: SumAt>(
+    mut src: ResponsePeaks<S>,
+    size: (usize, usize),
+    vertical: bool,
+    seeds: &EdgePoints,
+    starts: &[[u16; 2]],
+    half_width: usize,
+    p: &LineParams,
+    out: &mut Vec<Segment>,
+    s: &mut LineScratch,
+) {
+    let (w, h) = size;
     // Seeds are scan positions, packed `v << 32 | u`, in scan order.
     s.seeds.clear();
     if starts.len() == seeds.points.len() {
@@ -232,7 +275,6 @@ pub fn track_into(
         out,
     );
     src.finish(&mut s.response);
-    s.map = own;
 }
 
 /// The per-track buffers.
