@@ -400,10 +400,24 @@ fn select(
     starts: &mut Starts,
     s: &mut PeakScratch,
 ) {
+    let (region, nreg, m) = regions(shape, p);
+    region_limits(cand, nreg, m, region, s);
+    for c in cand {
+        if c.key < s.lim[region(c)] {
+            continue;
+        }
+        out.points.push(point_of(c, shape, scale, &sum));
+        starts.push([c.x, c.y]);
+    }
+}
+
+/// The region of a candidate, the number of regions, and `M`: a region
+/// is `region_lines` scan lines.
+fn regions(shape: Shape, p: &EdgeParams) -> (impl Fn(&Peak) -> usize + Copy, usize, usize) {
     let Shape { w, h, dir } = shape;
     let rl = p.region_lines.max(1) as usize;
     let m = p.per_region.max(1) as usize;
-    let region = |c: &Peak| -> usize {
+    let region = move |c: &Peak| -> usize {
         match dir {
             ScanDir::Horizontal => usize::from(c.y) / rl,
             ScanDir::Vertical => usize::from(c.x) / rl,
@@ -413,29 +427,30 @@ fn select(
         ScanDir::Horizontal => h.div_ceil(rl),
         ScanDir::Vertical => w.div_ceil(rl),
     };
-    region_limits(cand, nreg, m, region, s);
-    let step = match dir {
+    (region, nreg, m)
+}
+
+/// The edge point of candidate `c` (`sum(i)` the response's sum at image
+/// index `i`): its subpixel position along the scan and its response.
+#[inline]
+fn point_of(c: &Peak, shape: Shape, scale: f32, sum: &impl Fn(usize) -> i16) -> EdgePoint {
+    let w = shape.w;
+    let step = match shape.dir {
         ScanDir::Horizontal => 1,
         ScanDir::Vertical => w,
     };
-    for c in cand {
-        if c.key < s.lim[region(c)] {
-            continue;
-        }
-        let i = usize::from(c.y) * w + usize::from(c.x);
-        let mag = |j: usize| f32::from(key(sum(j)));
-        let d = subpixel(mag(i - step), mag(i), mag(i + step));
-        let (x, y) = (f32::from(c.x), f32::from(c.y));
-        let (x, y) = match dir {
-            ScanDir::Horizontal => (x + d, y),
-            ScanDir::Vertical => (x, y + d),
-        };
-        out.points.push(EdgePoint {
-            x,
-            y,
-            response: f32::from(sum(i)) * scale,
-        });
-        starts.push([c.x, c.y]);
+    let i = usize::from(c.y) * w + usize::from(c.x);
+    let mag = |j: usize| f32::from(key(sum(j)));
+    let d = subpixel(mag(i - step), mag(i), mag(i + step));
+    let (x, y) = (f32::from(c.x), f32::from(c.y));
+    let (x, y) = match shape.dir {
+        ScanDir::Horizontal => (x + d, y),
+        ScanDir::Vertical => (x, y + d),
+    };
+    EdgePoint {
+        x,
+        y,
+        response: f32::from(sum(i)) * scale,
     }
 }
 
@@ -493,7 +508,8 @@ fn scan(
         0..h
     };
     let th = Thresholds { start, track };
-    scan_rows(&mut Whole(sums, w), shape, ys, noise, th, s, cand, map);
+    let mut push = |c: Peak| cand.push(c);
+    scan_rows(&mut Whole(sums, w), shape, ys, noise, th, s, &mut push, map);
 }
 
 /// A response's size and scan direction.
@@ -514,7 +530,7 @@ pub(crate) struct Thresholds<'a> {
 
 /// [`scan`] of the rows `ys` of a `w × h` response (`w`, `h` ≥ 3) that
 /// `rows` gives (it loads them and, along a vertical scan, the rows
-/// above and below).
+/// above and below); each candidate goes to `sink`, in image order.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn scan_rows<R: Rows>(
     rows_of: &mut R,
@@ -523,7 +539,7 @@ pub(crate) fn scan_rows<R: Rows>(
     noise: &NoiseMap,
     th: Thresholds,
     s: &mut PeakScratch,
-    cand: &mut Vec<Peak>,
+    sink: &mut impl FnMut(Peak),
     map: &mut PeakMap,
 ) {
     let Shape { w, h, dir } = shape;
@@ -618,7 +634,7 @@ pub(crate) fn scan_rows<R: Rows>(
             while m != 0 {
                 let x = k * 64 + m.trailing_zeros() as usize;
                 m &= m - 1;
-                cand.push(Peak {
+                sink(Peak {
                     x: x as u16,
                     y: y as u16,
                     key: key(row[x]),

@@ -61,9 +61,10 @@ pub struct ResponsePeaks<'a, S: SumAt = &'a [i16]> {
     tile_u: Vec<u32>,
     tile_v: Vec<u32>,
     /// The peaks not yet taken (a copy of the map's, cleared as tracks
-    /// take them), and the map itself.
+    /// take them), and the map itself; without it (a map given to be
+    /// used up), a seed's bit 63 says whether it was in the map.
     map: PeakMap,
-    orig: &'a PeakMap,
+    orig: Option<&'a PeakMap>,
 }
 
 /// Reusable buffers of [`ResponsePeaks`].
@@ -101,32 +102,42 @@ impl<'a> ResponsePeaks<'a> {
         let (w, h) = (r.width, r.height);
         let sums = if r.covers(w, h) { r.sums() } else { &[] };
         let shape = (w, h, r.dir, r.scale());
-        ResponsePeaks::with_sums(shape, sums, !sums.is_empty(), noise, map, b)
+        b.map.copy_from(map);
+        let work = std::mem::take(&mut b.map);
+        ResponsePeaks::with_sums(shape, sums, !sums.is_empty(), noise, work, Some(map), b)
     }
 }
 
 impl<'a> ResponsePeaks<'a, PixelSums<'a>> {
-    /// The peaks in `map` (made for it) of a response read at pixels.
+    /// The peaks in `map` (made for it) of a response read at pixels; the
+    /// map is used up (tracks clear what they take), so a seed carries in
+    /// bit 63 whether it was in the map.
     pub(crate) fn of_pixels(
         src: PixelSums<'a>,
         noise: &NoiseMap,
-        map: &'a PeakMap,
+        map: PeakMap,
         b: &mut ResponseBufs,
     ) -> Self {
         let shape = (src.w, src.h, src.dir, src.scale());
-        ResponsePeaks::with_sums(shape, src, true, noise, map, b)
+        ResponsePeaks::with_sums(shape, src, true, noise, map, None, b)
+    }
+
+    /// Whether scan position `(u, v)` is (still) in the map.
+    pub(crate) fn in_map(&self, u: usize, v: usize) -> bool {
+        self.map.is_set(u, v)
     }
 }
 
 impl<'a, S: SumAt> ResponsePeaks<'a, S> {
     /// The peaks of a response of size, direction and unit `shape`
-    /// (`sums`: none unless `valid`) in `map`.
+    /// (`sums`: none unless `valid`) in `map`, a copy of `orig` if given.
     fn with_sums(
         shape: (usize, usize, ScanDir, f32),
         sums: S,
         valid: bool,
         noise: &NoiseMap,
-        map: &'a PeakMap,
+        map: PeakMap,
+        orig: Option<&'a PeakMap>,
         b: &mut ResponseBufs,
     ) -> Self {
         let (w, h, dir, scale) = shape;
@@ -146,7 +157,6 @@ impl<'a, S: SumAt> ResponsePeaks<'a, S> {
         noise.columns_into(w, cols);
         rows.clear();
         rows.extend((0..h).map(|y| noise.row_of(y) as u32));
-        b.map.copy_from(map);
         let (step_u, step_v, len_u, nlines) = match dir {
             ScanDir::Horizontal => (1, w, w, h),
             ScanDir::Vertical => (w, 1, h, w),
@@ -161,8 +171,8 @@ impl<'a, S: SumAt> ResponsePeaks<'a, S> {
             inv_sigma: std::mem::take(&mut b.inv_sigma),
             tile_u: std::mem::take(&mut b.tile_u),
             tile_v: std::mem::take(&mut b.tile_v),
-            map: std::mem::take(&mut b.map),
-            orig: map,
+            map,
+            orig,
         }
     }
 
@@ -276,13 +286,28 @@ impl<S: SumAt> Peaks for ResponsePeaks<'_, S> {
     fn is_taken(&self, id: u64) -> bool {
         // Taken: a peak of the map that a track cleared (a start below
         // the map's threshold is never taken by a track).
-        let (u, v) = ((id & 0xFFFF_FFFF) as usize, (id >> 32) as usize);
-        self.orig.is_set(u, v) && !self.map.is_set(u, v)
+        let (u, v) = unpack(id);
+        let was = match self.orig {
+            Some(m) => m.is_set(u, v),
+            None => id >> 63 != 0,
+        };
+        was && !self.map.is_set(u, v)
     }
 
     fn seed(&self, id: u64) -> Option<Cand> {
-        self.start((id & 0xFFFF_FFFF) as usize, (id >> 32) as usize)
+        let (u, v) = unpack(id);
+        self.start(u, v)
     }
+}
+
+/// The scan position `(u, v)` of a response's seed `v << 32 | u` (bit 63
+/// aside: [`ResponsePeaks::of_pixels`]).
+#[inline]
+fn unpack(id: u64) -> (usize, usize) {
+    (
+        (id & 0xFFFF_FFFF) as usize,
+        (id >> 32 & 0x7FFF_FFFF) as usize,
+    )
 }
 
 /// A point filed in scan coordinates.
