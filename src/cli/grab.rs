@@ -16,7 +16,8 @@
 //! and signalled only when it does not answer.
 //!
 //! A grab asked to leave its session (`NAME.lock.leave`, checked between
-//! lightings and every 0.2 s of a transfer) stops the frame under way —
+//! lightings, every 0.2 s of a transfer and at each reply a stalled
+//! grabber does not send in time) stops the frame under way —
 //! nothing of it is saved, the lightings saved before stay recorded —
 //! releases the lock and exits non-zero, naming who took the session.
 

@@ -310,3 +310,50 @@ fn llv_of_the_largest_picture_holds_one_direction_at_a_time() {
     assert!(v["lines"].as_u64().unwrap() >= 8, "{v}");
     assert!(dir.path().join("max1.ldr").is_file());
 }
+
+/// Issue 34: `vss llv` of an 8192² image of uniform random pixels (pure
+/// texture: about 1.7 million edge points a direction) within 4 × the
+/// file above what vss needs to start. It needed 4.8 × (307 MiB) while it
+/// held a scan direction's response whole; made a strip at a time and
+/// read at the peaks, without keeping the candidates, it needs 2.0 ×, the
+/// same outputs.
+#[test]
+fn llv_of_a_pure_texture_at_the_picture_bound_fits_four_times_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let side = 8192usize;
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut px = vec![0u8; side * side];
+    for chunk in px.chunks_exact_mut(8) {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        chunk.copy_from_slice(&seed.to_le_bytes());
+    }
+    let img = ImgFile::new(GreyImage::new(side, side, px).unwrap());
+    write_img(&dir.path().join("rnd1.img"), &img).unwrap();
+    drop(img);
+    let file = std::fs::metadata(dir.path().join("rnd1.img"))
+        .unwrap()
+        .len();
+    let limit_kib = crate::support::limited::baseline_kib() + 4 * file / 1024;
+    let o = crate::support::limited::vss_under(
+        dir.path(),
+        &format!("ulimit -v {limit_kib}"),
+        ["llv", "--json", "--out", "out", "rnd1.img"],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.success(),
+        "{:?} in {limit_kib} KiB, most likely an allocation over the limit: {err}",
+        o.status
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // Edge points by the million in each direction, each file 12 bytes a
+    // point past its header.
+    for ext in ["hpo", "vpo"] {
+        let len = std::fs::metadata(dir.path().join("out").join(format!("rnd1.{ext}")))
+            .unwrap()
+            .len();
+        assert!(len > 12_000_000, "{ext}: {len} bytes, {v}");
+    }
+}

@@ -632,3 +632,95 @@ fn a_terminal_is_asked_before_a_stale_lock_is_taken_over() {
     assert!(text.contains("took over"), "{text}");
     assert_eq!(imgs(&session), ["ask1a.img"]);
 }
+
+/// Issue 34: a grab holding its session, asked to leave by a second grab
+/// with `--take-over` (through `NAME.lock.leave`, checked every 0.2 s of a
+/// transfer), stops the frame under way, saves nothing of it, releases the
+/// lock and exits non-zero naming who took the session; the second grab
+/// captures, and the manifest checks out.
+#[test]
+fn a_grab_asked_to_leave_by_a_take_over_stops_and_says_so() {
+    use std::io::Read;
+    let tmp = tempfile::tempdir().expect("tmp");
+    // Four blocks a frame: the stall comes after the first.
+    let mut p = base();
+    p.grabber.block = 4096;
+    let prof = write_profile(tmp.path(), "p.toml", &p);
+    let session = tmp.path().join("s/leave");
+    let mut first = vss()
+        .arg("--profile")
+        .arg(&prof)
+        .args(["grab", "--camera", "1", "--lighting", "a", "--image", "1"])
+        .args(["--yes", "--sim-faults", "stall=60s", "--session"])
+        .arg(&session)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start grab");
+    let pid = first.id();
+    let mut err = first.stderr.take().expect("stderr");
+    let mut seen = Vec::new();
+    let mut buf = [0u8; 256];
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !String::from_utf8_lossy(&seen).contains("bytes (") {
+        assert!(Instant::now() < deadline, "no progress from grab");
+        match err.read(&mut buf) {
+            Ok(0) | Err(_) => panic!("grab ended early: {}", String::from_utf8_lossy(&seen)),
+            Ok(n) => seen.extend_from_slice(&buf[..n]),
+        }
+    }
+    assert!(
+        session.join("leave.lock").exists(),
+        "the first grab holds it"
+    );
+    assert!(
+        first.try_wait().expect("try_wait").is_none(),
+        "the first grab runs"
+    );
+    let second = vss()
+        .arg("--profile")
+        .arg(&prof)
+        .args(["grab", "--camera", "1", "--lighting", "a", "--image", "2"])
+        .args(["--yes", "--take-over", "--session"])
+        .arg(&session)
+        .stdin(Stdio::null())
+        .output()
+        .expect("run the second grab");
+    let said = format!(
+        "{}{}",
+        String::from_utf8_lossy(&second.stdout),
+        String::from_utf8_lossy(&second.stderr)
+    );
+    assert!(second.status.success(), "{said}");
+    assert!(said.contains(&format!("process {pid}")), "{said}");
+    // The first grab has left: its stderr to the end, its exit status.
+    err.read_to_end(&mut seen)
+        .expect("read the first grab's stderr");
+    let status = first.wait().expect("wait");
+    let left = String::from_utf8_lossy(&seen);
+    assert!(!status.success(), "{left}");
+    assert!(
+        status.code().is_some(),
+        "it stopped by itself, not by a signal: {status:?} {left}"
+    );
+    assert!(
+        left.contains("was taken over by") && left.contains("leave1a was not captured"),
+        "{left}"
+    );
+    assert_eq!(imgs(&session), ["leave2a.img"]);
+    assert!(
+        !session.join("leave.lock").exists(),
+        "released after the grab"
+    );
+    let check = vss()
+        .args(["session", "check", "leave"])
+        .current_dir(tmp.path().join("s"))
+        .output()
+        .expect("run session check");
+    assert!(
+        check.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&check.stdout),
+        String::from_utf8_lossy(&check.stderr)
+    );
+}

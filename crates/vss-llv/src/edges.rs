@@ -25,6 +25,7 @@ use super::image::GreyImage;
 use super::params::EdgeParams;
 use super::{EdgePoints, LlvError, ScanDir};
 
+pub(crate) mod band;
 pub mod noise;
 pub mod peaks;
 #[cfg(test)]
@@ -200,9 +201,30 @@ pub fn response_into(
     let shift = row::shift(a, 1);
     out.reshape(w, h, dir, row::scale(a) * (1u32 << shift) as f32);
     let sums = &mut out.sums;
+    rows_into(px, w, h, dir, a, shift, 0, sums, &mut scratch.wide);
+    if let Some(mask) = img.valid_mask() {
+        mask_invalid(mask, w, h, dir, a, sums, &mut scratch.mask);
+    }
+    Ok(())
+}
+
+/// The sums of the image rows `y0..` that `out` holds (whole rows of `w`),
+/// unmasked: what [`response_into`] writes there before the mask.
+#[allow(clippy::too_many_arguments)]
+fn rows_into(
+    px: &[u8],
+    w: usize,
+    h: usize,
+    dir: ScanDir,
+    a: usize,
+    shift: u32,
+    y0: usize,
+    out: &mut [i16],
+    wide: &mut Vec<i32>,
+) {
     match dir {
         ScanDir::Horizontal => {
-            for (row, srow) in px.chunks_exact(w).zip(sums.chunks_exact_mut(w)) {
+            for (row, srow) in px[y0 * w..].chunks_exact(w).zip(out.chunks_exact_mut(w)) {
                 if w <= 2 * a {
                     srow.fill(NONE);
                     continue;
@@ -210,24 +232,21 @@ pub fn response_into(
                 srow[..a].fill(NONE);
                 srow[w - a..].fill(NONE);
                 let taps = row::Taps::horizontal(row, a);
-                row_sums(&taps, a, shift, &mut srow[a..w - a], &mut scratch.wide);
+                row_sums(&taps, a, shift, &mut srow[a..w - a], wide);
             }
         }
         ScanDir::Vertical => {
-            for (y, srow) in sums.chunks_exact_mut(w).enumerate() {
+            for (k, srow) in out.chunks_exact_mut(w).enumerate() {
+                let y = y0 + k;
                 if y < a || y + a >= h {
                     srow.fill(NONE);
                     continue;
                 }
                 let taps = row::Taps::vertical(px, w, y, a);
-                row_sums(&taps, a, shift, srow, &mut scratch.wide);
+                row_sums(&taps, a, shift, srow, wide);
             }
         }
     }
-    if let Some(mask) = img.valid_mask() {
-        mask_invalid(mask, w, h, dir, a, sums, &mut scratch.mask);
-    }
-    Ok(())
 }
 
 /// One row of sums, stored as `i16` (exactly for `A ≤ 5`, else shifted).

@@ -57,11 +57,12 @@ pub mod source;
 mod split;
 pub mod step;
 
+use super::edges::band::PixelSums;
 use super::edges::{NoiseMap, PeakMap, PeakScratch, Response};
 use super::fit::LineFit;
 use super::params::LineParams;
 use super::{EdgePoints, Point, ScanDir, Segment};
-use source::{Cand, Peaks, PointBufs, ResponseBufs, ResponsePeaks};
+use source::{Cand, Peaks, PointBufs, ResponseBufs, ResponsePeaks, SumAt};
 
 /// Largest `|du/dv|` used for the prediction.
 const MAX_SLOPE: f64 = 8.0;
@@ -134,7 +135,7 @@ pub fn extract_into(e: &EdgePoints, p: &LineParams, out: &mut Vec<Segment>, s: &
     s.seeds.extend(0..src.len() as u64);
     follow(
         &mut src,
-        &s.seeds,
+        s.seeds.iter().copied(),
         p,
         None,
         DEFAULT_TRIM,
@@ -177,7 +178,90 @@ pub fn track_into(
         own.build_into(resp, noise, floor, p.track_sigmas, &mut s.peaks);
         &own
     };
-    let mut src = ResponsePeaks::new(resp, noise, map, &mut s.response);
+    let src = ResponsePeaks::new(resp, noise, map, &mut s.response);
+    track_from(src, (w, h), vertical, seeds, starts, half_width, p, out, s);
+    s.map = own;
+}
+
+/// [`track_into`] on a response read at its pixels ([`PixelSums`]), with
+/// the peak map the edge pass made of it at `p.track_sigmas`
+/// (`edges::peaks::strips::detect_strips`), which the tracks use up, and
+/// the starts it gave with `seeds`, which a vertical scan puts in column
+/// order. Nothing the size of the seeds is made: on a texture there are
+/// millions.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn track_pixels(
+    sums: PixelSums,
+    noise: &NoiseMap,
+    map: PeakMap,
+    seeds: &EdgePoints,
+    starts: &mut [[u16; 2]],
+    half_width: usize,
+    p: &LineParams,
+    out: &mut Vec<Segment>,
+    s: &mut LineScratch,
+) {
+    out.clear();
+    let (w, h, vertical) = (sums.w, sums.h, sums.dir == ScanDir::Vertical);
+    if w < 3 || h < 3 {
+        return;
+    }
+    let mut src = ResponsePeaks::of_pixels(sums, noise, map, &mut s.response);
+    if starts.len() != seeds.points.len() {
+        track_from(src, (w, h), vertical, seeds, &[], half_width, p, out, s);
+        return;
+    }
+    // Scan order: image order along a horizontal scan, columns then rows
+    // along a vertical one (each pixel once).
+    if vertical {
+        starts.sort_unstable_by_key(|&[x, y]| (x, y));
+    }
+    let scan = |&[x, y]: &[u16; 2]| {
+        let (x, y) = (usize::from(x), usize::from(y));
+        if vertical { (y, x) } else { (x, y) }
+    };
+    // Which starts are in the map, before tracks clear it: bit 63.
+    let flags: Vec<u64> = starts
+        .chunks(64)
+        .map(|c| {
+            c.iter().enumerate().fold(0u64, |b, (k, st)| {
+                let (u, v) = scan(st);
+                b | u64::from(src.in_map(u, v)) << k
+            })
+        })
+        .collect();
+    let ids = starts.iter().enumerate().map(|(k, st)| {
+        let (u, v) = scan(st);
+        pack(u, v) | (flags[k / 64] >> (k % 64) & 1) << 63
+    });
+    let nfa = nfa::Nfa::new(w, h, half_width, p.search_width, p.track_sigmas);
+    follow(
+        &mut src,
+        ids,
+        p,
+        Some(&nfa),
+        half_width,
+        vertical,
+        &mut s.tracks,
+        out,
+    );
+    src.finish(&mut s.response);
+}
+
+/// The tracks of [`track_into`] from the peaks of `src`, a `size` response.
+#[allow(clippy::too_many_arguments)]
+fn track_from<S: SumAt>(
+    mut src: ResponsePeaks<S>,
+    size: (usize, usize),
+    vertical: bool,
+    seeds: &EdgePoints,
+    starts: &[[u16; 2]],
+    half_width: usize,
+    p: &LineParams,
+    out: &mut Vec<Segment>,
+    s: &mut LineScratch,
+) {
+    let (w, h) = size;
     // Seeds are scan positions, packed `v << 32 | u`, in scan order.
     s.seeds.clear();
     if starts.len() == seeds.points.len() {
@@ -224,7 +308,7 @@ pub fn track_into(
     let nfa = nfa::Nfa::new(w, h, half_width, p.search_width, p.track_sigmas);
     follow(
         &mut src,
-        &s.seeds,
+        s.seeds.iter().copied(),
         p,
         Some(&nfa),
         half_width,
@@ -233,7 +317,6 @@ pub fn track_into(
         out,
     );
     src.finish(&mut s.response);
-    s.map = own;
 }
 
 /// The per-track buffers.
@@ -250,7 +333,7 @@ struct Tracks {
 #[allow(clippy::too_many_arguments)]
 fn follow<P: Peaks>(
     src: &mut P,
-    seeds: &[u64],
+    seeds: impl IntoIterator<Item = u64>,
     p: &LineParams,
     nfa: Option<&nfa::Nfa>,
     trim: usize,
@@ -267,7 +350,7 @@ fn follow<P: Peaks>(
     // Every slope the angle test admits, for the first step.
     let steep = (1.0 / min_angle.clamp(1e-3, std::f64::consts::FRAC_PI_2).tan()).min(MAX_SLOPE);
     let gap = p.max_gap.max(1) as usize;
-    for &id in seeds {
+    for id in seeds {
         if src.is_taken(id) {
             continue;
         }

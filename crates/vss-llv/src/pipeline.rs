@@ -25,6 +25,8 @@ use super::photometric::{PhotoScratch, combined_response_into};
 use super::refine::{RefineScratch, refine_into};
 use super::{EdgePoints, LlvError, ScanDir, Segment};
 
+mod lean;
+
 /// Wall-clock time of each stage of one run, in microseconds (0 for a
 /// stage that a [`rerun`] did not repeat).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
@@ -458,6 +460,9 @@ impl Job<'_> {
         o: DirOut,
     ) -> Result<(u64, u64), LlvError> {
         let p = self.params;
+        if let ([img], None, true) = (images, ambient, self.lean && self.from <= Stage::Edges) {
+            return self.run_lean(img, o);
+        }
         let mut edges_us = 0;
         let t = Instant::now();
         if self.from <= Stage::Edges && self.response {

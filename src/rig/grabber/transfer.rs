@@ -508,6 +508,15 @@ impl<P: Link> VsgClient<P> {
                     self.given_up()?;
                 }
                 Event::Silent => {
+                    // A stalled grabber is no reason to keep a cancel (or
+                    // a request to leave the session) waiting for retries.
+                    if !progress(done, total) {
+                        return Err(RigError::Cancelled {
+                            port: self.name.clone(),
+                            done,
+                            total,
+                        });
+                    }
                     silent += 1;
                     if silent > self.cfg.retries {
                         let (off, len) = t.pending.front().copied().unwrap_or_default();

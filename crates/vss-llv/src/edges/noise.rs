@@ -20,6 +20,7 @@
 //! SIMD lanes, and each tile of the row of tiles counts its samples from
 //! them: the count is then two instructions a sample.
 
+use super::band::{Rows, Whole};
 use super::{NONE, Response, key};
 
 /// Tile side (px) of the noise estimate; an image side shorter than two
@@ -151,9 +152,27 @@ impl NoiseMap {
     /// [`NoiseMap::estimate`] into reusable buffers.
     pub fn estimate_into(&mut self, r: &Response, s: &mut NoiseScratch) {
         let (w, h) = (r.width, r.height);
+        if !r.covers(w, h) {
+            self.shape(w, h);
+            self.global = 0.0;
+            return;
+        }
+        self.estimate_rows(w, h, r.scale(), &mut Whole(r.sums(), w), s);
+    }
+
+    /// [`NoiseMap::estimate_into`] of a `w × h` response of `scale` grey
+    /// levels a unit whose rows `rows` gives, a row of tiles at a time.
+    pub(crate) fn estimate_rows<R: Rows>(
+        &mut self,
+        w: usize,
+        h: usize,
+        scale: f32,
+        rows: &mut R,
+        s: &mut NoiseScratch,
+    ) {
         self.shape(w, h);
         self.global = 0.0;
-        if w == 0 || h == 0 || !r.covers(w, h) {
+        if w == 0 || h == 0 {
             return;
         }
         s.known.clear();
@@ -169,11 +188,12 @@ impl NoiseMap {
             let y0 = ty * self.th;
             let y1 = if ty + 1 == self.ny { h } else { y0 + self.th };
             s.hist.fill(0);
+            rows.load(y0, y1);
             let mut y = y0 + 1;
             while y < y1 {
                 // The row's bins at once (lanes), then each tile's samples
                 // counted from them.
-                bins_of(&r.sums()[y * w..(y + 1) * w], &mut s.bins);
+                bins_of(rows.row(y), &mut s.bins);
                 for (tx, hist) in s.hist.chunks_exact_mut(stride).enumerate() {
                     let x0 = tx * self.tw;
                     let x1 = if tx + 1 == nx { w } else { x0 + self.tw };
@@ -190,7 +210,7 @@ impl NoiseMap {
                 let n = rows * (x1 - x0).div_ceil(COLUMN_STEP) - usize::from(hist[BINS]);
                 let t = ty * nx + tx;
                 self.sigma[t] = if n >= MIN_SAMPLES {
-                    let sigma = median_bin(&hist[..BINS], n) * r.scale() * MEDIAN_TO_SIGMA;
+                    let sigma = median_bin(&hist[..BINS], n) * scale * MEDIAN_TO_SIGMA;
                     s.known.push(sigma);
                     sigma
                 } else {

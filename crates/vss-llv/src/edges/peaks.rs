@@ -36,7 +36,9 @@
 //! does in all; `docs/performance.md` has the measurements.
 
 mod lanes;
+pub(crate) mod strips;
 
+use super::band::{Rows, Whole};
 use super::{NoiseMap, Response, key};
 use crate::params::EdgeParams;
 use crate::{EdgePoint, EdgePoints, ScanDir};
@@ -113,15 +115,25 @@ impl PeakMap {
 
     /// Sizes and clears the map for `r` at a threshold.
     fn reset(&mut self, r: &Response, floor: f64, sigmas: f64) {
-        self.width = r.width;
-        self.height = r.height;
-        self.dir = Some(r.dir);
+        let shape = Shape {
+            w: r.width,
+            h: r.height,
+            dir: r.dir,
+        };
+        self.reset_for(shape, floor, sigmas);
+    }
+
+    /// [`PeakMap::reset`] for a response of this shape.
+    fn reset_for(&mut self, shape: Shape, floor: f64, sigmas: f64) {
+        self.width = shape.w;
+        self.height = shape.h;
+        self.dir = Some(shape.dir);
         self.floor = floor;
         self.sigmas = sigmas;
-        self.wpr = r.width.div_ceil(64);
+        self.wpr = shape.w.div_ceil(64);
         for bits in [&mut self.pos, &mut self.neg] {
             bits.clear();
-            bits.resize(self.wpr * r.height, 0);
+            bits.resize(self.wpr * shape.h, 0);
         }
     }
 
@@ -139,7 +151,7 @@ impl PeakMap {
         if !r.covers(r.width, r.height) || floor.is_nan() {
             return;
         }
-        tile_floors(r, noise, floor, sigmas, &mut s.track_thr);
+        tile_floors(r.scale(), noise, floor, sigmas, &mut s.track_thr);
         let mut cand = std::mem::take(&mut s.cand);
         cand.clear();
         let track = std::mem::take(&mut s.track_thr);
@@ -148,9 +160,10 @@ impl PeakMap {
         s.cand = cand;
     }
 
-    /// Whether the map holds a response's rows (it was reset for one).
-    fn holds(&self, r: &Response) -> bool {
-        self.dir == Some(r.dir) && self.wpr > 0 && self.pos.len() == self.wpr * r.height
+    /// Whether the map holds the rows of a response of `h` rows along
+    /// `dir` (it was reset for one).
+    fn holds(&self, dir: ScanDir, h: usize) -> bool {
+        self.dir == Some(dir) && self.wpr > 0 && self.pos.len() == self.wpr * h
     }
 
     /// The image coordinates of scan position `(u, v)`.
@@ -229,13 +242,13 @@ impl PeakMap {
 
 /// Per tile of `noise`, the largest key at or below `floor` grey levels and
 /// `sigmas` noise sigmas (a key passes when it is above this).
-fn tile_floors(r: &Response, noise: &NoiseMap, floor: f64, sigmas: f64, out: &mut Vec<i32>) {
+fn tile_floors(scale: f32, noise: &NoiseMap, floor: f64, sigmas: f64, out: &mut Vec<i32>) {
     let (nx, ny) = noise.tiles();
     let rest = sigmas as f32;
     out.clear();
     for t in 0..nx * ny {
         let limit = (floor as f32).max(rest * noise.sigma(t));
-        out.push(key_floor(limit, r.scale()));
+        out.push(key_floor(limit, scale));
     }
 }
 
@@ -339,12 +352,12 @@ pub fn points_into(
     if w < 3 || h < 3 || !resp.covers(w, h) || p.floor.is_nan() {
         return;
     }
-    tile_floors(resp, noise, p.floor, p.noise_sigmas, &mut s.thr);
+    tile_floors(resp.scale(), noise, p.floor, p.noise_sigmas, &mut s.thr);
     let mut cand = std::mem::take(&mut s.cand);
     match map {
         Some(m) => {
             let (f, t) = (m.floor, m.sigmas);
-            tile_floors(resp, noise, f, t, &mut s.track_thr);
+            tile_floors(resp.scale(), noise, f, t, &mut s.track_thr);
             let (thr, track) = (std::mem::take(&mut s.thr), std::mem::take(&mut s.track_thr));
             scan(resp, noise, Some(&thr), &track, s, &mut cand, m);
             (s.thr, s.track_thr) = (thr, track);
@@ -363,44 +376,82 @@ pub fn points_into(
             s.thr = thr;
         }
     }
+    let shape = Shape {
+        w,
+        h,
+        dir: resp.dir,
+    };
+    let sums = resp.sums();
+    select(shape, resp.scale(), p, &cand, |i| sums[i], out, starts, s);
+    s.cand = cand;
+}
+
+/// The edge points among the candidates `cand` of a response (`sum(i)`
+/// its sum at image index `i`): those among the `M` strongest of their
+/// region, with their subpixel positions, into `out` and `starts`.
+#[allow(clippy::too_many_arguments)]
+fn select(
+    shape: Shape,
+    scale: f32,
+    p: &EdgeParams,
+    cand: &[Peak],
+    sum: impl Fn(usize) -> i16,
+    out: &mut EdgePoints,
+    starts: &mut Starts,
+    s: &mut PeakScratch,
+) {
+    let (region, nreg, m) = regions(shape, p);
+    region_limits(cand, nreg, m, region, s);
+    for c in cand {
+        if c.key < s.lim[region(c)] {
+            continue;
+        }
+        out.points.push(point_of(c, shape, scale, &sum));
+        starts.push([c.x, c.y]);
+    }
+}
+
+/// The region of a candidate, the number of regions, and `M`: a region
+/// is `region_lines` scan lines.
+fn regions(shape: Shape, p: &EdgeParams) -> (impl Fn(&Peak) -> usize + Copy, usize, usize) {
+    let Shape { w, h, dir } = shape;
     let rl = p.region_lines.max(1) as usize;
     let m = p.per_region.max(1) as usize;
-    let region = |c: &Peak| -> usize {
-        match resp.dir {
+    let region = move |c: &Peak| -> usize {
+        match dir {
             ScanDir::Horizontal => usize::from(c.y) / rl,
             ScanDir::Vertical => usize::from(c.x) / rl,
         }
     };
-    let nreg = match resp.dir {
+    let nreg = match dir {
         ScanDir::Horizontal => h.div_ceil(rl),
         ScanDir::Vertical => w.div_ceil(rl),
     };
-    region_limits(&cand, nreg, m, region, s);
-    let step = match resp.dir {
+    (region, nreg, m)
+}
+
+/// The edge point of candidate `c` (`sum(i)` the response's sum at image
+/// index `i`): its subpixel position along the scan and its response.
+#[inline]
+fn point_of(c: &Peak, shape: Shape, scale: f32, sum: &impl Fn(usize) -> i16) -> EdgePoint {
+    let w = shape.w;
+    let step = match shape.dir {
         ScanDir::Horizontal => 1,
         ScanDir::Vertical => w,
     };
-    let sums = resp.sums();
-    for c in &cand {
-        if c.key < s.lim[region(c)] {
-            continue;
-        }
-        let i = usize::from(c.y) * w + usize::from(c.x);
-        let mag = |j: usize| f32::from(key(sums[j]));
-        let d = subpixel(mag(i - step), mag(i), mag(i + step));
-        let (x, y) = (f32::from(c.x), f32::from(c.y));
-        let (x, y) = match resp.dir {
-            ScanDir::Horizontal => (x + d, y),
-            ScanDir::Vertical => (x, y + d),
-        };
-        out.points.push(EdgePoint {
-            x,
-            y,
-            response: f32::from(sums[i]) * resp.scale(),
-        });
-        starts.push([c.x, c.y]);
+    let i = usize::from(c.y) * w + usize::from(c.x);
+    let mag = |j: usize| f32::from(key(sum(j)));
+    let d = subpixel(mag(i - step), mag(i), mag(i + step));
+    let (x, y) = (f32::from(c.x), f32::from(c.y));
+    let (x, y) = match shape.dir {
+        ScanDir::Horizontal => (x + d, y),
+        ScanDir::Vertical => (x, y + d),
+    };
+    EdgePoint {
+        x,
+        y,
+        response: f32::from(sum(i)) * scale,
     }
-    s.cand = cand;
 }
 
 /// Every pixel that is a peak along the scan (`|E|` above the left/upper
@@ -446,7 +497,63 @@ fn scan(
     if w < 3 || h < 3 || sums.len() != w * h {
         return;
     }
-    let mapped = map.holds(resp);
+    let shape = Shape {
+        w,
+        h,
+        dir: resp.dir,
+    };
+    let ys = if resp.dir == ScanDir::Vertical {
+        1..h - 1
+    } else {
+        0..h
+    };
+    let th = Thresholds { start, track };
+    let mut push = |c: Peak| cand.push(c);
+    scan_rows(&mut Whole(sums, w), shape, ys, noise, th, s, &mut push, map);
+}
+
+/// A response's size and scan direction.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Shape {
+    pub w: usize,
+    pub h: usize,
+    pub dir: ScanDir,
+}
+
+/// The keys a peak must pass, per tile: an edge point's (none: no
+/// candidates), a tracked peak's.
+#[derive(Clone, Copy)]
+pub(crate) struct Thresholds<'a> {
+    pub start: Option<&'a [i32]>,
+    pub track: &'a [i32],
+}
+
+/// [`scan`] of the rows `ys` of a `w × h` response (`w`, `h` ≥ 3) that
+/// `rows` gives (it loads them and, along a vertical scan, the rows
+/// above and below); each candidate goes to `sink`, in image order.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn scan_rows<R: Rows>(
+    rows_of: &mut R,
+    shape: Shape,
+    ys: std::ops::Range<usize>,
+    noise: &NoiseMap,
+    th: Thresholds,
+    s: &mut PeakScratch,
+    sink: &mut impl FnMut(Peak),
+    map: &mut PeakMap,
+) {
+    let Shape { w, h, dir } = shape;
+    let (start, track) = (th.start, th.track);
+    if ys.is_empty() {
+        return;
+    }
+    let vertical = dir == ScanDir::Vertical;
+    if vertical {
+        rows_of.load(ys.start - 1, (ys.end + 1).min(h));
+    } else {
+        rows_of.load(ys.start, ys.end);
+    }
+    let mapped = map.holds(dir, h);
     let wpr = w.div_ceil(64);
     // Positions padded to whole blocks (and words: two blocks a word).
     let wp = wpr * 64;
@@ -467,14 +574,13 @@ fn scan(
     rb.bits.clear();
     rb.bits.resize(3 * wpr, 0);
     let mut tile_row = usize::MAX;
-    let vertical = resp.dir == ScanDir::Vertical;
-    let rows = if vertical { 1..h - 1 } else { 0..h };
+    let y_first = ys.start;
     if vertical {
         // The rows above and at the first: keys[0], keys[1].
-        key_row(&sums[..w], &mut rb.keys[0][1..=w]);
-        key_row(&sums[w..2 * w], &mut rb.keys[1][1..=w]);
+        key_row(&rows_of.row(y_first - 1)[..w], &mut rb.keys[0][1..=w]);
+        key_row(&rows_of.row(y_first)[..w], &mut rb.keys[1][1..=w]);
     }
-    for y in rows {
+    for y in ys {
         // The thresholds of every column of this row's tiles: `cols[..wp]`
         // the edge points', `cols[wp..]` the tracks' (never passed beyond
         // the row).
@@ -493,12 +599,12 @@ fn scan(
                 }
             }
         }
-        let at = y * w;
-        let row = &sums[at..at + w];
+        let from = rows_of.row(y);
+        let row = &from[..w];
         // The signs: the row itself where the padded length stays inside
         // the response (what follows the row is never a peak: thresholds
         // are `i16::MAX` there), else a padded copy.
-        let sign: &[i16] = match sums.get(at..at + wp) {
+        let sign: &[i16] = match from.get(..wp) {
             Some(s) => s,
             None => {
                 rb.sign[..w].copy_from_slice(row);
@@ -508,7 +614,7 @@ fn scan(
         let [k0, k1, k2] = &mut rb.keys;
         let keys: [&[i16]; 3] = if vertical {
             // keys[2] takes the row below; then the three turn.
-            key_row(&sums[at + w..at + 2 * w], &mut k2[1..=w]);
+            key_row(&rows_of.row(y + 1)[..w], &mut k2[1..=w]);
             [&k0[1..], &k1[1..], &k2[1..]]
         } else {
             key_row(row, &mut k0[1..=w]);
@@ -528,10 +634,10 @@ fn scan(
             while m != 0 {
                 let x = k * 64 + m.trailing_zeros() as usize;
                 m &= m - 1;
-                cand.push(Peak {
+                sink(Peak {
                     x: x as u16,
                     y: y as u16,
-                    key: key(sums[at + x]),
+                    key: key(row[x]),
                 });
             }
         }

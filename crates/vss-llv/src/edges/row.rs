@@ -63,7 +63,7 @@ impl<'a> Taps<'a> {
 }
 
 /// `c_s = 6 s (A − s)` for `s = 0..8` (only `1..A` is used).
-const fn coef(a: usize, s: usize) -> i32 {
+pub(crate) const fn coef(a: usize, s: usize) -> i32 {
     if s == 0 || s >= a {
         0
     } else {

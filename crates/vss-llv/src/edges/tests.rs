@@ -18,7 +18,7 @@ fn img_from(w: usize, h: usize, f: impl Fn(usize, usize) -> u8) -> GreyImage {
 /// A random scene: a few steps of random height and direction, noise of
 /// random amplitude, optionally a validity mask with random invalid
 /// blobs and a few scattered invalid pixels.
-fn random_image(rng: &mut SplitMix64, w: usize, h: usize, masked: bool) -> GreyImage {
+pub(crate) fn random_image(rng: &mut SplitMix64, w: usize, h: usize, masked: bool) -> GreyImage {
     let (x0, y0) = (
         (rng.next_u64() % w as u64) as i64,
         (rng.next_u64() % h as u64) as i64,

@@ -5,6 +5,7 @@
 //! Both work in scan coordinates `(u, v)`: `u` along the scan, `v` the scan
 //! line (for `EdgeH` that is `(x, y)`; for `EdgeV`, `(y, x)`).
 
+use crate::edges::band::PixelSums;
 use crate::edges::peaks::subpixel;
 use crate::edges::{NONE, NoiseMap, PeakMap, Response, key};
 use crate::{EdgePoints, ScanDir};
@@ -46,8 +47,8 @@ pub trait Peaks {
 /// made in its pass. A search window is one word of it; a point's
 /// position, response and noise sigmas are read from the response only
 /// for the peaks in the window.
-pub struct ResponsePeaks<'a> {
-    sums: &'a [i16],
+pub struct ResponsePeaks<'a, S: SumAt = &'a [i16]> {
+    sums: S,
     scale: f32,
     /// Index steps along the scan and from one scan line to the next.
     step_u: usize,
@@ -60,9 +61,10 @@ pub struct ResponsePeaks<'a> {
     tile_u: Vec<u32>,
     tile_v: Vec<u32>,
     /// The peaks not yet taken (a copy of the map's, cleared as tracks
-    /// take them), and the map itself.
+    /// take them), and the map itself; without it (a map given to be
+    /// used up), a seed's bit 63 says whether it was in the map.
     map: PeakMap,
-    orig: &'a PeakMap,
+    orig: Option<&'a PeakMap>,
 }
 
 /// Reusable buffers of [`ResponsePeaks`].
@@ -74,23 +76,80 @@ pub struct ResponseBufs {
     map: PeakMap,
 }
 
+/// A response's sum at an image index.
+pub trait SumAt {
+    fn sum_at(&self, i: usize) -> i16;
+}
+
+impl SumAt for &[i16] {
+    #[inline(always)]
+    fn sum_at(&self, i: usize) -> i16 {
+        self[i]
+    }
+}
+
+impl SumAt for PixelSums<'_> {
+    #[inline]
+    fn sum_at(&self, i: usize) -> i16 {
+        self.at(i)
+    }
+}
+
 impl<'a> ResponsePeaks<'a> {
     /// The peaks of `r` in `map` (made for it: [`PeakMap::fits`]), with the
     /// noise sigmas of their tile of `noise`.
     pub fn new(r: &'a Response, noise: &NoiseMap, map: &'a PeakMap, b: &mut ResponseBufs) -> Self {
         let (w, h) = (r.width, r.height);
+        let sums = if r.covers(w, h) { r.sums() } else { &[] };
+        let shape = (w, h, r.dir, r.scale());
+        b.map.copy_from(map);
+        let work = std::mem::take(&mut b.map);
+        ResponsePeaks::with_sums(shape, sums, !sums.is_empty(), noise, work, Some(map), b)
+    }
+}
+
+impl<'a> ResponsePeaks<'a, PixelSums<'a>> {
+    /// The peaks in `map` (made for it) of a response read at pixels; the
+    /// map is used up (tracks clear what they take), so a seed carries in
+    /// bit 63 whether it was in the map.
+    pub(crate) fn of_pixels(
+        src: PixelSums<'a>,
+        noise: &NoiseMap,
+        map: PeakMap,
+        b: &mut ResponseBufs,
+    ) -> Self {
+        let shape = (src.w, src.h, src.dir, src.scale());
+        ResponsePeaks::with_sums(shape, src, true, noise, map, None, b)
+    }
+
+    /// Whether scan position `(u, v)` is (still) in the map.
+    pub(crate) fn in_map(&self, u: usize, v: usize) -> bool {
+        self.map.is_set(u, v)
+    }
+}
+
+impl<'a, S: SumAt> ResponsePeaks<'a, S> {
+    /// The peaks of a response of size, direction and unit `shape`
+    /// (`sums`: none unless `valid`) in `map`, a copy of `orig` if given.
+    fn with_sums(
+        shape: (usize, usize, ScanDir, f32),
+        sums: S,
+        valid: bool,
+        noise: &NoiseMap,
+        map: PeakMap,
+        orig: Option<&'a PeakMap>,
+        b: &mut ResponseBufs,
+    ) -> Self {
+        let (w, h, dir, scale) = shape;
         let (nx, ny) = noise.tiles();
         b.inv_sigma.clear();
         for t in 0..nx * ny {
             let s = noise.sigma(t);
-            b.inv_sigma.push(if s > 0.0 {
-                r.scale() / s
-            } else {
-                f32::INFINITY
-            });
+            b.inv_sigma
+                .push(if s > 0.0 { scale / s } else { f32::INFINITY });
         }
         let (cols, rows) = (&mut b.tile_u, &mut b.tile_v);
-        let (cols, rows) = if r.dir == ScanDir::Horizontal {
+        let (cols, rows) = if dir == ScanDir::Horizontal {
             (cols, rows)
         } else {
             (rows, cols)
@@ -98,24 +157,22 @@ impl<'a> ResponsePeaks<'a> {
         noise.columns_into(w, cols);
         rows.clear();
         rows.extend((0..h).map(|y| noise.row_of(y) as u32));
-        b.map.copy_from(map);
-        let (step_u, step_v, len_u, nlines) = match r.dir {
+        let (step_u, step_v, len_u, nlines) = match dir {
             ScanDir::Horizontal => (1, w, w, h),
             ScanDir::Vertical => (w, 1, h, w),
         };
-        let sums = if r.covers(w, h) { r.sums() } else { &[] };
         ResponsePeaks {
             sums,
-            scale: r.scale(),
+            scale,
             step_u,
             step_v,
             len_u,
-            nlines: if sums.is_empty() { 0 } else { nlines },
+            nlines: if valid { nlines } else { 0 },
             inv_sigma: std::mem::take(&mut b.inv_sigma),
             tile_u: std::mem::take(&mut b.tile_u),
             tile_v: std::mem::take(&mut b.tile_v),
-            map: std::mem::take(&mut b.map),
-            orig: map,
+            map,
+            orig,
         }
     }
 
@@ -136,7 +193,7 @@ impl<'a> ResponsePeaks<'a> {
     /// The candidate of the peak at `(u, v)`, image index `i`.
     #[inline]
     fn cand(&self, u: usize, v: usize, i: usize) -> Cand {
-        let mag = |j: usize| f32::from(key(self.sums[j]));
+        let mag = |j: usize| f32::from(key(self.sums.sum_at(j)));
         let k0 = mag(i);
         let d = subpixel(mag(i - self.step_u), k0, mag(i + self.step_u));
         Cand {
@@ -144,7 +201,7 @@ impl<'a> ResponsePeaks<'a> {
             // then sees the same positions.)
             u: f64::from(u as f32 + d),
             v,
-            response: f32::from(self.sums[i]) * self.scale,
+            response: f32::from(self.sums.sum_at(i)) * self.scale,
             z: k0 * self.inv_sigma[(self.tile_u[u] + self.tile_v[v]) as usize],
             id: i,
             pix: u as u32,
@@ -157,7 +214,7 @@ impl<'a> ResponsePeaks<'a> {
             return None;
         }
         let i = self.index(u, v);
-        (self.sums[i] != NONE).then(|| self.cand(u, v, i))
+        (self.sums.sum_at(i) != NONE).then(|| self.cand(u, v, i))
     }
 
     /// The whole positions `u` whose peak may lie within `r` of `c`
@@ -178,7 +235,7 @@ impl<'a> ResponsePeaks<'a> {
     }
 }
 
-impl Peaks for ResponsePeaks<'_> {
+impl<S: SumAt> Peaks for ResponsePeaks<'_, S> {
     fn lines(&self) -> usize {
         self.nlines
     }
@@ -229,13 +286,28 @@ impl Peaks for ResponsePeaks<'_> {
     fn is_taken(&self, id: u64) -> bool {
         // Taken: a peak of the map that a track cleared (a start below
         // the map's threshold is never taken by a track).
-        let (u, v) = ((id & 0xFFFF_FFFF) as usize, (id >> 32) as usize);
-        self.orig.is_set(u, v) && !self.map.is_set(u, v)
+        let (u, v) = unpack(id);
+        let was = match self.orig {
+            Some(m) => m.is_set(u, v),
+            None => id >> 63 != 0,
+        };
+        was && !self.map.is_set(u, v)
     }
 
     fn seed(&self, id: u64) -> Option<Cand> {
-        self.start((id & 0xFFFF_FFFF) as usize, (id >> 32) as usize)
+        let (u, v) = unpack(id);
+        self.start(u, v)
     }
+}
+
+/// The scan position `(u, v)` of a response's seed `v << 32 | u` (bit 63
+/// aside: [`ResponsePeaks::of_pixels`]).
+#[inline]
+fn unpack(id: u64) -> (usize, usize) {
+    (
+        (id & 0xFFFF_FFFF) as usize,
+        (id >> 32 & 0x7FFF_FFFF) as usize,
+    )
 }
 
 /// A point filed in scan coordinates.

@@ -245,7 +245,7 @@ fn reading_peaks_where_tracks_look_equals_listing_them_all() {
             let mut t = Tracks::default();
             follow(
                 &mut src,
-                &starts,
+                starts.iter().copied(),
                 &p,
                 Some(&nfa),
                 4,

@@ -167,7 +167,7 @@ fn the_peak_map_holds_the_plain_peaks() {
             let mut map = PeakMap::default();
             map.build_into(&r, &noise, 2.0, 1.5, &mut PeakScratch::default());
             let mut thr = Vec::new();
-            tile_floors(&r, &noise, 2.0, 1.5, &mut thr);
+            tile_floors(r.scale(), &noise, 2.0, 1.5, &mut thr);
             let mut plain = Vec::new();
             candidates_plain(&r, &noise, &thr, &mut plain);
             assert!(plain.len() > 20 || w < 20, "{w}x{h} {dir:?}");
