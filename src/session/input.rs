@@ -162,10 +162,12 @@ impl Runner {
 
     /// A runner for one-shot runs whose responses nobody reads (`vss llv`):
     /// one scan direction's buffers in memory at a time
-    /// ([`Workspace::lean`]), the same results.
+    /// ([`Workspace::lean`]), the same results. Its runs write edge files,
+    /// so a direction with more edge points than a file holds stops the run
+    /// at once ([`Workspace::limit_edge_points`]).
     pub fn lean() -> Runner {
         Runner {
-            ws: Workspace::lean(),
+            ws: Workspace::lean().limit_edge_points(crate::formats::edgefile::MAX_POINTS),
             ..Runner::default()
         }
     }

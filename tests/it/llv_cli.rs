@@ -357,3 +357,34 @@ fn llv_of_a_pure_texture_at_the_picture_bound_fits_four_times_the_file() {
         assert!(len > 12_000_000, "{ext}: {len} bytes, {v}");
     }
 }
+
+/// An image where every pixel is an edge (pixel `i` = `i mod 251`): its
+/// scan directions find more edge points than an edge file holds, so `vss
+/// llv` refuses it, and now as soon as the first direction has them: within
+/// 4 × the file, writing nothing. It used to finish both directions' lines
+/// and CONNECT first, at 5.1 × the file, and refuse the same after.
+#[test]
+fn llv_of_an_image_of_edges_everywhere_is_refused_at_once_within_four_times_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let side = 8192usize;
+    let px = (0..side * side).map(|i| (i % 251) as u8).collect();
+    let img = ImgFile::new(GreyImage::new(side, side, px).unwrap());
+    write_img(&dir.path().join("mod1.img"), &img).unwrap();
+    drop(img);
+    let file = std::fs::metadata(dir.path().join("mod1.img"))
+        .unwrap()
+        .len();
+    let limit_kib = crate::support::limited::baseline_kib() + 4 * file / 1024;
+    let o = crate::support::limited::vss_under(
+        dir.path(),
+        &format!("ulimit -v {limit_kib}"),
+        ["llv", "--out", "out", "mod1.img"],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("scan are more than the 4194304 an edge file holds"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out").join("mod1.hpo").exists());
+}

@@ -62,6 +62,17 @@ pub enum LlvError {
         a: (usize, usize),
         b: (usize, usize),
     },
+    /// A scan direction found more edge points than the run was told to
+    /// keep ([`pipeline::Workspace::limit_edge_points`]).
+    #[error(
+        "{points} edge points in the {dir} scan are more than the {max} an edge file holds: \
+         the image is texture, not a scene"
+    )]
+    TooManyEdgePoints {
+        dir: &'static str,
+        points: usize,
+        max: usize,
+    },
     /// A parameter is outside its allowed range.
     #[error("parameter {name} = {value} is out of range ({range})")]
     Param {

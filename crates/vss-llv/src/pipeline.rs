@@ -108,6 +108,8 @@ pub struct Workspace {
     valid: bool,
     /// Free each direction's buffers after its lines ([`Workspace::lean`]).
     lean: bool,
+    /// Edge points a scan direction may find ([`Workspace::limit_edge_points`]).
+    edge_limit: Option<usize>,
 }
 
 impl Workspace {
@@ -123,6 +125,15 @@ impl Workspace {
             lean: true,
             ..Workspace::default()
         }
+    }
+
+    /// Stops a run whose scan direction finds more than `max` edge points,
+    /// as soon as it has them ([`LlvError::TooManyEdgePoints`]): for runs
+    /// that must write them to edge files, which cannot hold more, so the
+    /// lines, CONNECT and the memory they take are not spent for nothing.
+    pub fn limit_edge_points(mut self, max: usize) -> Self {
+        self.edge_limit = Some(max);
+        self
     }
 
     /// A workspace whose "previous run" is `prev` (for [`rerun`]).
@@ -228,6 +239,7 @@ impl Workspace {
                 response: !same_response,
                 params: p,
                 lean: self.lean,
+                edge_limit: self.edge_limit,
             };
             let parallel = p.edges.threads >= 2 && !self.lean;
             let StageOutputs {
@@ -448,6 +460,7 @@ struct Job<'p> {
     params: &'p Params,
     /// Free the response and buffers at the end (all but the lines).
     lean: bool,
+    edge_limit: Option<usize>,
 }
 
 impl Job<'_> {
@@ -490,6 +503,7 @@ impl Job<'_> {
                 &mut o.s.starts,
                 &mut o.s.peaks,
             );
+            self.check_edge_count(&o)?;
             edges_us = micros(t);
         }
         let t = Instant::now();

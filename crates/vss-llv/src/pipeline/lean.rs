@@ -11,7 +11,7 @@ use super::{DirOut, DirScratch, Job, micros};
 use crate::edges::Response;
 use crate::edges::peaks::strips::detect_strips;
 use crate::lines::track_pixels;
-use crate::{GreyImage, LlvError};
+use crate::{GreyImage, LlvError, ScanDir};
 
 impl Job<'_> {
     /// [`Job::run`] of one image, from the edges on, without the response:
@@ -33,6 +33,7 @@ impl Job<'_> {
             &mut o.s.starts,
             &mut o.s.peaks,
         )?;
+        self.check_edge_count(&o)?;
         let edges_us = micros(t);
         let t = Instant::now();
         track_pixels(
@@ -49,6 +50,23 @@ impl Job<'_> {
         let segs = std::mem::take(&mut o.s.segs);
         (*o.s, o.s.segs) = (DirScratch::default(), segs);
         Ok((edges_us, micros(t)))
+    }
+}
+
+impl Job<'_> {
+    /// [`Workspace::limit_edge_points`] on a direction's edge points.
+    pub(super) fn check_edge_count(&self, o: &DirOut) -> Result<(), LlvError> {
+        match self.edge_limit {
+            Some(max) if o.edges.points.len() > max => Err(LlvError::TooManyEdgePoints {
+                dir: match o.dir {
+                    ScanDir::Horizontal => "horizontal",
+                    ScanDir::Vertical => "vertical",
+                },
+                points: o.edges.points.len(),
+                max,
+            }),
+            _ => Ok(()),
+        }
     }
 }
 
