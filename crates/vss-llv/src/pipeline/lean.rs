@@ -1,9 +1,8 @@
 //! A scan direction of one image in a lean run (`Workspace::lean`, `vss
 //! llv`) without its response held whole: made a strip of rows at a time
 //! for the edge pass and read at the peaks for the tracks
-//! (`edges/band.rs`). The same results; on an 8192² image of pure texture
-//! the run needs 2.0 times the file instead of 4.8 (docs/reliability.md,
-//! issue 34).
+//! (`edges/band.rs`). The same results, in a fraction of the memory on
+//! images of pure texture (docs/reliability.md has the figures).
 
 use std::time::Instant;
 
