@@ -490,11 +490,18 @@ fn a_grabber_pulled_and_plugged_back_is_found_under_its_name() {
 
 /// Starts `vss grab` with a long stall, waits until its transfer has begun
 /// (progress on stderr) and SIGKILLs it: the session's lock stays behind.
+/// The grab waits 30 s for each READ of the stall (its profile beside
+/// `prof`), so it is still there when the kill comes on a loaded machine:
+/// with the cell's short timeout it gave up, and released the lock, first.
 fn kill_mid_grab(prof: &Path, session: &Path) {
     use std::io::Read;
+    let mut p = base();
+    p.grabber.timeout_ms = 30_000;
+    let dir = prof.parent().expect("the profile's folder");
+    let stalled = write_profile(dir, "stalled.toml", &p);
     let mut child = vss()
         .arg("--profile")
-        .arg(prof)
+        .arg(&stalled)
         .args(["grab", "--camera", "1", "--lighting", "a", "--image", "1"])
         .args(["--yes", "--sim-faults", "stall=60s", "--session"])
         .arg(session)
