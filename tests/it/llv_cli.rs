@@ -311,6 +311,32 @@ fn llv_of_the_largest_picture_holds_one_direction_at_a_time() {
     assert!(dir.path().join("max1.ldr").is_file());
 }
 
+/// Writes the 8192² `STEM.img` of `px` into `dir` and runs `vss llv ARGS
+/// --out out STEM.img` there under `ulimit -v` of the start-up baseline + 4
+/// × the file: its output and that limit (KiB).
+fn llv_within_four_times(
+    dir: &Path,
+    stem: &str,
+    px: Vec<u8>,
+    args: &[&str],
+) -> (std::process::Output, u64) {
+    let file = dir.join(format!("{stem}.img"));
+    write_img(
+        &file,
+        &ImgFile::new(GreyImage::new(8192, 8192, px).unwrap()),
+    )
+    .unwrap();
+    let len = std::fs::metadata(&file).unwrap().len();
+    let limit_kib = crate::support::limited::baseline_kib() + 4 * len / 1024;
+    let name = format!("{stem}.img");
+    let all: Vec<&str> = std::iter::once("llv")
+        .chain(args.iter().copied())
+        .chain(["--out", "out", &name])
+        .collect();
+    let o = crate::support::limited::vss_under(dir, &format!("ulimit -v {limit_kib}"), all);
+    (o, limit_kib)
+}
+
 /// Issue 34: `vss llv` of an 8192² image of uniform random pixels (pure
 /// texture: about 1.7 million edge points a direction) within 4 × the
 /// file above what vss needs to start. It needed 4.8 × (307 MiB) while it
@@ -329,18 +355,7 @@ fn llv_of_a_pure_texture_at_the_picture_bound_fits_four_times_the_file() {
         seed ^= seed << 17;
         chunk.copy_from_slice(&seed.to_le_bytes());
     }
-    let img = ImgFile::new(GreyImage::new(side, side, px).unwrap());
-    write_img(&dir.path().join("rnd1.img"), &img).unwrap();
-    drop(img);
-    let file = std::fs::metadata(dir.path().join("rnd1.img"))
-        .unwrap()
-        .len();
-    let limit_kib = crate::support::limited::baseline_kib() + 4 * file / 1024;
-    let o = crate::support::limited::vss_under(
-        dir.path(),
-        &format!("ulimit -v {limit_kib}"),
-        ["llv", "--json", "--out", "out", "rnd1.img"],
-    );
+    let (o, limit_kib) = llv_within_four_times(dir.path(), "rnd1", px, &["--json"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
         o.status.success(),
@@ -368,18 +383,7 @@ fn llv_of_an_image_of_edges_everywhere_is_refused_at_once_within_four_times_the_
     let dir = tempfile::tempdir().unwrap();
     let side = 8192usize;
     let px = (0..side * side).map(|i| (i % 251) as u8).collect();
-    let img = ImgFile::new(GreyImage::new(side, side, px).unwrap());
-    write_img(&dir.path().join("mod1.img"), &img).unwrap();
-    drop(img);
-    let file = std::fs::metadata(dir.path().join("mod1.img"))
-        .unwrap()
-        .len();
-    let limit_kib = crate::support::limited::baseline_kib() + 4 * file / 1024;
-    let o = crate::support::limited::vss_under(
-        dir.path(),
-        &format!("ulimit -v {limit_kib}"),
-        ["llv", "--out", "out", "mod1.img"],
-    );
+    let (o, _) = llv_within_four_times(dir.path(), "mod1", px, &[]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(

@@ -494,14 +494,32 @@ fn a_grabber_pulled_and_plugged_back_is_found_under_its_name() {
 /// `prof`), so it is still there when the kill comes on a loaded machine:
 /// with the cell's short timeout it gave up, and released the lock, first.
 fn kill_mid_grab(prof: &Path, session: &Path) {
-    use std::io::Read;
     let mut p = base();
     p.grabber.timeout_ms = 30_000;
     let dir = prof.parent().expect("the profile's folder");
     let stalled = write_profile(dir, "stalled.toml", &p);
+    let (mut child, _, _) = start_stalled_grab(&stalled, session);
+    child.kill().expect("SIGKILL");
+    child.wait().expect("wait");
+    let name = session.file_name().expect("name").to_string_lossy();
+    assert!(
+        session.join(format!("{name}.lock")).exists(),
+        "the lock stayed"
+    );
+}
+
+/// Starts `vss grab --image 1` of camera 1, lighting a, whose grabber
+/// stalls for 60 s after the frame's first block, and returns once the
+/// transfer has begun (progress on stderr): the child, its stderr and what
+/// it has said so far.
+fn start_stalled_grab(
+    prof: &Path,
+    session: &Path,
+) -> (std::process::Child, std::process::ChildStderr, Vec<u8>) {
+    use std::io::Read;
     let mut child = vss()
         .arg("--profile")
-        .arg(&stalled)
+        .arg(prof)
         .args(["grab", "--camera", "1", "--lighting", "a", "--image", "1"])
         .args(["--yes", "--sim-faults", "stall=60s", "--session"])
         .arg(session)
@@ -520,13 +538,7 @@ fn kill_mid_grab(prof: &Path, session: &Path) {
             Ok(n) => seen.extend_from_slice(&buf[..n]),
         }
     }
-    child.kill().expect("SIGKILL");
-    child.wait().expect("wait");
-    let name = session.file_name().expect("name").to_string_lossy();
-    assert!(
-        session.join(format!("{name}.lock")).exists(),
-        "the lock stayed"
-    );
+    (child, err, seen)
 }
 
 fn grab_one(prof: &Path, session: &Path, extra: &[&str]) -> std::process::Output {
@@ -654,28 +666,8 @@ fn a_grab_asked_to_leave_by_a_take_over_stops_and_says_so() {
     p.grabber.block = 4096;
     let prof = write_profile(tmp.path(), "p.toml", &p);
     let session = tmp.path().join("s/leave");
-    let mut first = vss()
-        .arg("--profile")
-        .arg(&prof)
-        .args(["grab", "--camera", "1", "--lighting", "a", "--image", "1"])
-        .args(["--yes", "--sim-faults", "stall=60s", "--session"])
-        .arg(&session)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start grab");
+    let (mut first, mut err, mut seen) = start_stalled_grab(&prof, &session);
     let pid = first.id();
-    let mut err = first.stderr.take().expect("stderr");
-    let mut seen = Vec::new();
-    let mut buf = [0u8; 256];
-    let deadline = Instant::now() + Duration::from_secs(60);
-    while !String::from_utf8_lossy(&seen).contains("bytes (") {
-        assert!(Instant::now() < deadline, "no progress from grab");
-        match err.read(&mut buf) {
-            Ok(0) | Err(_) => panic!("grab ended early: {}", String::from_utf8_lossy(&seen)),
-            Ok(n) => seen.extend_from_slice(&buf[..n]),
-        }
-    }
     assert!(
         session.join("leave.lock").exists(),
         "the first grab holds it"
