@@ -288,35 +288,44 @@ fn temp_owner(file_name: &str) -> Option<(u32, bool)> {
     Some((pid, here))
 }
 
-/// Removes the temporary files in `dir` whose writer ran on this host and
-/// is gone. Returns how many went. Best effort: a folder that cannot be
-/// listed is left alone, and without `/proc` nothing is removed.
-pub fn sweep_stale_temps(dir: &Path) -> usize {
+/// The temporary files in `dir` whose writer ran on this host and is gone
+/// (a live writer's, this process's included, are in use), sorted. Best
+/// effort: a folder that cannot be listed has none, and without `/proc`
+/// no writer can be proved gone.
+pub fn stale_temps(dir: &Path) -> Vec<PathBuf> {
     if !Path::new("/proc/self").exists() {
-        return 0;
+        return Vec::new();
     }
     let Ok(rd) = fs::read_dir(dir) else {
-        return 0;
+        return Vec::new();
     };
     let me = std::process::id();
-    let mut removed = 0;
-    for entry in rd.filter_map(Result::ok) {
-        let name = entry.file_name();
-        let Some((pid, here)) = name.to_str().and_then(temp_owner) else {
-            continue;
-        };
-        if !here || pid == me || Path::new(&format!("/proc/{pid}")).exists() {
-            continue;
-        }
-        // Only files and links (unlinking a link leaves its target alone).
-        let kind = entry.file_type();
-        if kind.is_ok_and(|t| t.is_file() || t.is_symlink())
-            && fs::remove_file(entry.path()).is_ok()
-        {
-            removed += 1;
-        }
-    }
-    removed
+    let mut stale: Vec<PathBuf> = rd
+        .filter_map(Result::ok)
+        .filter(|entry| {
+            let name = entry.file_name();
+            let Some((pid, here)) = name.to_str().and_then(temp_owner) else {
+                return false;
+            };
+            // Only files and links (unlinking a link leaves its target alone).
+            here && pid != me
+                && !Path::new(&format!("/proc/{pid}")).exists()
+                && entry
+                    .file_type()
+                    .is_ok_and(|t| t.is_file() || t.is_symlink())
+        })
+        .map(|entry| entry.path())
+        .collect();
+    stale.sort();
+    stale
+}
+
+/// Removes [`stale_temps`] from `dir`. Returns how many went.
+pub fn sweep_stale_temps(dir: &Path) -> usize {
+    stale_temps(dir)
+        .iter()
+        .filter(|p| fs::remove_file(p).is_ok())
+        .count()
 }
 
 /// Opens a file to read it: not through a symbolic link, without blocking

@@ -722,29 +722,17 @@ impl Session {
         self.write_file(&manifest_file, text.as_bytes())
     }
 
-    /// Removes temporary files an interrupted save left behind (we hold the
-    /// lock, so no other writer owns them).
+    /// Removes temporary files an interrupted save left behind. Holding
+    /// the lock does not make every temporary file ours: a second vss
+    /// asking for the lock has its own in flight here.
     fn remove_leftovers(&self) {
-        for p in self.leftovers() {
-            let _ = fs::remove_file(p);
-        }
+        crate::fsutil::sweep_stale_temps(&self.dir);
     }
 
-    /// Temporary files of interrupted atomic writes.
+    /// Temporary files of interrupted atomic writes: those whose writer is
+    /// gone. Another writer's file in flight (a second vss asking for the
+    /// lock, say) is not one.
     pub fn leftovers(&self) -> Vec<PathBuf> {
-        let Ok(rd) = fs::read_dir(&self.dir) else {
-            return Vec::new();
-        };
-        let mut v: Vec<PathBuf> = rd
-            .filter_map(Result::ok)
-            .map(|e| e.path())
-            .filter(|p| {
-                p.file_name()
-                    .map(|n| n.to_string_lossy())
-                    .is_some_and(|n| n.starts_with('.') && n.contains(".tmp."))
-            })
-            .collect();
-        v.sort();
-        v
+        crate::fsutil::stale_temps(&self.dir)
     }
 }

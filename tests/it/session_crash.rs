@@ -143,3 +143,52 @@ fn killed_saves_leave_complete_files_and_a_passing_check() {
         "opening for writing clears leftovers"
     );
 }
+
+/// Opening a session for writing removes the temporary files of saves
+/// whose writer is gone, and only those: a temporary file of a live vss (a
+/// second one asking for the lock has one in flight) stays. Removing it
+/// made that vss fail with "NAME.lock: No such file or directory" when the
+/// holder reopened the session at that moment.
+#[test]
+fn opening_removes_the_temporary_files_of_dead_writers_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().join("torture");
+    std::fs::write(dir.path().join("p.toml"), PROFILE).unwrap();
+    let o = vss()
+        .args([
+            "session",
+            "new",
+            "torture",
+            "--dir",
+            ".",
+            "--profile",
+            "p.toml",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut live = std::process::Command::new("sleep")
+        .arg("30")
+        .spawn()
+        .unwrap();
+    let mut dead = std::process::Command::new("true").spawn().unwrap();
+    let dead_pid = dead.id();
+    dead.wait().unwrap();
+    let in_flight = d.join(format!(".torture.lock.tmp.{}", live.id()));
+    let left = d.join(format!(".torture1a.img.tmp.{dead_pid}"));
+    std::fs::write(&in_flight, "pid = 1\n").unwrap();
+    std::fs::write(&left, "half an image").unwrap();
+    let s = Session::inspect(&d).unwrap();
+    assert_eq!(s.leftovers(), vec![left.clone()], "only the dead writer's");
+    drop(s);
+    let s = Session::open(&d).unwrap();
+    let _ = live.kill();
+    let _ = live.wait();
+    assert!(!left.exists(), "the dead writer's temporary file stays");
+    assert!(
+        in_flight.exists(),
+        "a live writer's temporary file was removed"
+    );
+    drop(s);
+}
