@@ -30,6 +30,24 @@ fn alone() -> Alone {
     let bin = dir.path().join("bin/vss");
     std::fs::create_dir_all(bin.parent().unwrap()).unwrap();
     std::fs::copy(env!("CARGO_BIN_EXE_vss"), &bin).unwrap();
+    // A child another test thread forked while the copy was open for
+    // writing holds it until that child execs, and until then running the
+    // copy fails with "Text file busy" (ETXTBSY). Once one run starts,
+    // nobody can hold it any more.
+    let end = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    loop {
+        match Command::new(&bin).arg("--version").output() {
+            Err(e)
+                if e.raw_os_error() == Some(libc::ETXTBSY) && std::time::Instant::now() < end =>
+            {
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            }
+            r => {
+                r.unwrap();
+                break;
+            }
+        }
+    }
     let work = dir.path().join("work");
     let home = dir.path().join("home");
     std::fs::create_dir_all(&work).unwrap();
