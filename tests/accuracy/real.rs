@@ -224,20 +224,21 @@ fn lightings(sigma: Option<f64>) -> Lit {
 
 /// Several lightings as the cell takes them: three exposures, each with
 /// its own sensor noise (σ 2 grey levels, about an 8-bit industrial
-/// camera's at mid-grey). The goal is the combination at least as
+/// camera's at mid-grey). The goal: the combination at least as
 /// good as the best single image in recall and F, the best chosen
-/// afterwards for each photograph. It is not met (docs/accuracy.md): the
-/// combination sums magnitudes, whose noise floor rises with each term.
-/// The floors keep what is measured: the combination within 0.005 F of
-/// that best and not below any lighting taken alone over all photographs
-/// (by more than 0.002 F: they are level).
-/// Printed by `cargo test --test accuracy real:: -- --nocapture`.
+/// afterwards for each photograph. It is met since the combination sums
+/// only the terms of the strongest term's sign (`llv::photometric`); the
+/// sum of every term's magnitude, before, gave F 0.7288 against 0.7332
+/// (docs/accuracy.md). Printed by `cargo test --test accuracy real:: --
+/// --nocapture`.
 #[test]
 fn three_exposures_of_each_photograph_against_the_best_one() {
     let lit = lightings(Some(2.0));
     let each = lit.singles.iter().map(|m| m.f).fold(0.0, f64::max);
     assert!(
-        lit.combined.f >= lit.best.f - 0.005 && lit.combined.f >= each - 0.002,
+        lit.combined.f >= lit.best.f
+            && lit.combined.recall >= lit.best.recall
+            && lit.combined.f > each,
         "combined F {:.4} R {:.4}, best single F {:.4} R {:.4}, each alone at most {each:.4}",
         lit.combined.f,
         lit.combined.recall,

@@ -10,9 +10,12 @@
 //! no clipping of the negative differences that an 8-bit difference image
 //! would suffer.
 //!
-//! **The combination is `Σ g_i |r_i|`**, with the sign of the largest term
-//! `g_i |r_i|` (the image that shows the edge best, which is the same image
-//! all along a straight edge between two faces). `g_i` brings every
+//! **The combination is `Σ g_i |r_i|` over the terms of the strongest
+//! term's sign**, with that sign: the strongest term `g_i |r_i|` is the
+//! image that shows the edge best, which is the same image all along a
+//! straight edge between two faces, and an image where the response has
+//! the other sign shows another edge there, or noise, which would only
+//! raise the floor. `g_i` brings every
 //! image to the noise units of the least noisy one: `g_i = m_min / m_i`, `m_i`
 //! the image's noise level as a median |response| (with
 //! `edges.noise_percentile`, the percentile of strips' medians, as one
@@ -24,11 +27,20 @@
 //! [`edges::peaks()`] measures its noise per tile, bounds it by the least
 //! textured tiles, and thresholds it, so `edges.noise_sigmas`,
 //! `lines.track_sigmas` and the a-contrario test mean what they mean with
-//! one image. A sum of magnitudes is never negative, so on pure noise its
-//! median — and the noise the tiles read — is high compared with the spread
-//! of its values: on noise the combination is stricter than one image (the
-//! `calibration` test below), while an edge seen in several images adds up
-//! linearly.
+//! one image. The combination is never negative before its sign is given,
+//! so on pure noise its median — and the noise the tiles read — is high
+//! compared with the spread of its values: on noise it is stricter than
+//! one image (the `calibration` test below), while an edge seen in several
+//! images adds up linearly.
+//!
+//! **Why only one sign.** Summing every term's magnitude (the rule before)
+//! adds each image's noise whatever its sign, so with exposures of their
+//! own the floor rose with every term as fast as the edge: on photographs
+//! lit three ways, each with its own noise, it lost to the best single
+//! image; a signed sum `Σ g_i r_i`, where noise of opposite signs cancels,
+//! beat it there but cancelled the edges whose polarity the lights flip
+//! (lights on opposite sides of a workpiece). Summing the terms of one sign
+//! keeps what each did well (docs/accuracy.md, "Several lightings").
 //!
 //! **Why not the thesis's τ.** The earlier rule took a noise level
 //! `τ_i = edges.noise_factor × m_i` off each term (`Σ max(0, |r_i| − τ_i)`,
@@ -78,6 +90,7 @@ pub struct PhotoScratch {
     amb_row: Vec<i32>,
     row: Vec<i32>,
     sum_row: Vec<i32>,
+    neg_row: Vec<i32>,
     best_row: Vec<i32>,
     mask: edges::MaskBufs,
 }
@@ -136,7 +149,13 @@ pub fn combined_response_into(
     let terms = images.len() as u32 * if ambient.is_some() { 2 } else { 1 };
     let shift = row::shift(a, terms);
     out.reshape(w, h, dir, row::scale(a) * (1u32 << shift) as f32);
-    for buf in [&mut s.amb_row, &mut s.row, &mut s.sum_row, &mut s.best_row] {
+    for buf in [
+        &mut s.amb_row,
+        &mut s.row,
+        &mut s.sum_row,
+        &mut s.neg_row,
+        &mut s.best_row,
+    ] {
         buf.clear();
         buf.resize(w, 0);
     }
@@ -189,13 +208,19 @@ pub fn combined_response_into(
                 &s.row[c.clone()],
                 &s.amb_row[c.clone()],
                 s.gains[i],
-                &mut s.sum_row[c.clone()],
+                (&mut s.sum_row[c.clone()], &mut s.neg_row[c.clone()]),
                 &mut s.best_row[c],
             );
         }
         let c = cols.clone();
         let orow = &mut sums[y * w..(y + 1) * w][c.clone()];
-        finish_row(orow, &s.sum_row[c.clone()], &s.best_row[c], shift);
+        finish_row(
+            orow,
+            &s.sum_row[c.clone()],
+            &s.neg_row[c.clone()],
+            &s.best_row[c],
+            shift,
+        );
     }
     // No combined response where any image's kernel touches an invalid
     // pixel.
@@ -232,15 +257,15 @@ fn combine(
     r: &[i32],
     amb: &[i32],
     gain: i32,
-    sum: &mut [i32],
+    (sum, neg): (&mut [i32], &mut [i32]),
     best: &mut [i32],
 ) {
     let rank = (MAX_RANK - image.min(MAX_RANK as usize) as i32) << 1;
     match (first, sub) {
-        (true, true) => combine_row::<true, true>(r, amb, gain, rank, sum, best),
-        (true, false) => combine_row::<true, false>(r, amb, gain, rank, sum, best),
-        (false, true) => combine_row::<false, true>(r, amb, gain, rank, sum, best),
-        (false, false) => combine_row::<false, false>(r, amb, gain, rank, sum, best),
+        (true, true) => combine_row::<true, true>(r, amb, gain, rank, sum, neg, best),
+        (true, false) => combine_row::<true, false>(r, amb, gain, rank, sum, neg, best),
+        (false, true) => combine_row::<false, true>(r, amb, gain, rank, sum, neg, best),
+        (false, false) => combine_row::<false, false>(r, amb, gain, rank, sum, neg, best),
     }
 }
 
@@ -251,18 +276,23 @@ fn combine(
 /// `|v| × GAIN_ONE` fit an `i32`.)
 const MAX_RANK: i32 = 31;
 
-/// The combined row: each sum narrowed to the stored unit, with the sign
-/// of its strongest term.
+/// The combined row: the sum of the terms of the strongest term's sign
+/// (`sum` the positive terms', `neg` the negative terms'), narrowed to the
+/// stored unit, with that sign.
 #[multiversion::multiversion(targets("x86_64+avx2+bmi1+bmi2+lzcnt+popcnt", "x86_64+sse4.1"))]
-fn finish_row(out: &mut [i16], sum: &[i32], best: &[i32], shift: u32) {
-    for ((o, &m), &b) in out.iter_mut().zip(sum).zip(best) {
-        let v = row::narrow_one(m, shift);
-        *o = if b & 1 != 0 { -v } else { v };
+fn finish_row(out: &mut [i16], sum: &[i32], neg: &[i32], best: &[i32], shift: u32) {
+    for (((o, &m), &n), &b) in out.iter_mut().zip(sum).zip(neg).zip(best) {
+        *o = if b & 1 != 0 {
+            -row::narrow_one(n, shift)
+        } else {
+            row::narrow_one(m, shift)
+        };
     }
 }
 
 /// One image's contribution to one row of the combination: `sum +=
-/// gain × |v|` with `v = r − amb` (`SUB`) or `r`, and `best` the key
+/// gain × |v|` where `v > 0`, `neg +=` it where `v < 0`, with `v = r −
+/// amb` (`SUB`) or `r`, and `best` the key
 /// ([`MAX_RANK`]) of the `v` of largest magnitude so far (`FIRST` starts
 /// both). The flags are constants, so the loop vectorises. The strongest
 /// term is a maximum of keys, not a select of values: a select that keeps
@@ -276,18 +306,28 @@ fn combine_row<const FIRST: bool, const SUB: bool>(
     gain: i32,
     rank: i32,
     sum: &mut [i32],
+    neg: &mut [i32],
     best: &mut [i32],
 ) {
-    for (((&v, &am), o), b) in r.iter().zip(amb).zip(sum.iter_mut()).zip(best.iter_mut()) {
+    for ((((&v, &am), o), n), b) in r
+        .iter()
+        .zip(amb)
+        .zip(sum.iter_mut())
+        .zip(neg.iter_mut())
+        .zip(best.iter_mut())
+    {
         let v = if SUB { v - am } else { v };
         let m = v.abs();
         let add = (m * gain) >> GAIN_BITS;
         let key = (add << 6) | rank | i32::from(v < 0);
+        let down = if v < 0 { add } else { 0 };
         if FIRST {
-            *o = add;
+            *o = add - down;
+            *n = down;
             *b = key;
         } else {
-            *o += add;
+            *o += add - down;
+            *n += down;
             *b = (*b).max(key);
         }
     }
@@ -355,24 +395,49 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_sum_is_of_the_magnitudes_times_the_gains() {
+    fn the_sum_is_of_the_strongest_terms_sign_times_the_gains() {
         let mut rng = crate::rng::SplitMix64::new(0x9E37_79B9_7F4A_7C15);
         let mut next = || (rng.next_u64() % 200_001) as i32 - 100_000;
         for _ in 0..200 {
             let r: Vec<i32> = (0..4).map(|_| next()).collect();
             let g: Vec<i32> = (0..4).map(|_| next().rem_euclid(GAIN_ONE + 1)).collect();
-            let (mut sum, mut best) = (vec![0], vec![0]);
+            let (mut sum, mut neg, mut best) = (vec![0], vec![0], vec![0]);
             for i in 0..4 {
+                let rank = (MAX_RANK - i as i32) << 1;
                 if i == 0 {
-                    combine_row::<true, false>(&r[i..=i], &[0], g[i], 0, &mut sum, &mut best);
+                    combine_row::<true, false>(
+                        &r[i..=i],
+                        &[0],
+                        g[i],
+                        rank,
+                        &mut sum,
+                        &mut neg,
+                        &mut best,
+                    );
                 } else {
-                    combine_row::<false, false>(&r[i..=i], &[0], g[i], 0, &mut sum, &mut best);
+                    combine_row::<false, false>(
+                        &r[i..=i],
+                        &[0],
+                        g[i],
+                        rank,
+                        &mut sum,
+                        &mut neg,
+                        &mut best,
+                    );
                 }
             }
-            let want: i64 = (0..4)
-                .map(|i| (i64::from(r[i].abs()) * i64::from(g[i])) >> GAIN_BITS)
-                .sum();
-            assert_eq!(i64::from(sum[0]), want, "{r:?} {g:?}");
+            let term = |i: usize| (i64::from(r[i].abs()) * i64::from(g[i])) >> GAIN_BITS;
+            let of_sign = |down: bool| {
+                (0..4)
+                    .filter(|&i| (r[i] < 0) == down)
+                    .map(term)
+                    .sum::<i64>()
+            };
+            assert_eq!(i64::from(sum[0]), of_sign(false), "{r:?} {g:?}");
+            assert_eq!(i64::from(neg[0]), of_sign(true), "{r:?} {g:?}");
+            // The strongest term (the first of equals) gives the sign.
+            let strongest = (0..4).rev().max_by_key(|&i| term(i)).unwrap();
+            assert_eq!(best[0] & 1 != 0, r[strongest] < 0, "{r:?} {g:?}");
         }
     }
 
@@ -390,18 +455,21 @@ mod tests {
 
     #[test]
     fn sign_follows_the_strongest_image() {
-        let (mut sum, mut best) = (vec![0; 3], vec![0; 3]);
+        let (mut sum, mut neg, mut best) = (vec![0; 3], vec![0; 3], vec![0; 3]);
         let rank = |i: i32| (MAX_RANK - i) << 1;
         let one = GAIN_ONE;
-        combine_row::<true, false>(&[10, -3, 7], &[0; 3], one, rank(0), &mut sum, &mut best);
-        combine_row::<false, false>(&[-30, 1, -7], &[0; 3], one, rank(1), &mut sum, &mut best);
-        assert_eq!(sum, [40, 4, 14]);
+        let (r0, r1) = ([10, -3, 7], [-30, 1, -7]);
+        combine_row::<true, false>(&r0, &[0; 3], one, rank(0), &mut sum, &mut neg, &mut best);
+        combine_row::<false, false>(&r1, &[0; 3], one, rank(1), &mut sum, &mut neg, &mut best);
+        assert_eq!((&sum[..], &neg[..]), (&[10, 1, 7][..], &[30, 3, 7][..]));
         // The sign of the strongest term; of the first of two as strong.
         let signs: Vec<bool> = best.iter().map(|b| b & 1 != 0).collect();
         assert_eq!(signs, [true, true, false]);
+        // Only the terms of the strongest's sign are summed: the others
+        // are another edge, or noise.
         let mut out = [0i16; 3];
-        finish_row(&mut out, &sum, &best, 0);
-        assert_eq!(out, [-40, -4, 14]);
+        finish_row(&mut out, &sum, &neg, &best, 0);
+        assert_eq!(out, [-30, -3, 7]);
     }
 
     #[test]
@@ -586,9 +654,9 @@ mod tests {
                         .collect();
                     let amb_r = ambient.map(|m| edges::response(m, dir, a as usize).unwrap());
                     for i in 0..150 * 50 {
-                        // The sum, and the strongest gained term of each
-                        // sign.
-                        let (mut sum, mut pos, mut neg) = (0f32, 0f32, 0f32);
+                        // The sum of each sign, and the strongest gained
+                        // term of each sign.
+                        let (mut up, mut down, mut pos, mut neg) = (0f32, 0f32, 0f32, 0f32);
                         let mut none = false;
                         for (k, r) in singles.iter().enumerate() {
                             let mut v = r.value(i);
@@ -597,10 +665,11 @@ mod tests {
                             }
                             none |= v.is_nan();
                             let t = v.abs() * s.gains[k] as f32 / GAIN_ONE as f32;
-                            sum += t;
                             if v < 0.0 {
+                                down += t;
                                 neg = neg.max(t);
                             } else {
+                                up += t;
                                 pos = pos.max(t);
                             }
                         }
@@ -611,14 +680,16 @@ mod tests {
                             // Each image's sum at A = 6, 7 was rounded to its
                             // stored unit; the combination is rounded once.
                             let tol = c.scale() * 0.5 + 3.0 * singles[0].scale();
-                            assert!(
-                                (got.abs() - sum).abs() <= tol,
-                                "A {a} {dir:?} {i}: {got} vs {sum}"
-                            );
-                            // The sign of the strongest term, where the two
-                            // signs' strongest terms are told apart.
+                            // The sign of the strongest term, and the sum of
+                            // the terms of that sign, where the two signs'
+                            // strongest terms are told apart.
                             if (pos - neg).abs() > tol {
                                 assert_eq!(got < 0.0, neg > pos, "A {a} {dir:?} {i}");
+                                let sum = if neg > pos { down } else { up };
+                                assert!(
+                                    (got.abs() - sum).abs() <= tol,
+                                    "A {a} {dir:?} {i}: {got} vs {sum}"
+                                );
                             }
                         }
                     }
