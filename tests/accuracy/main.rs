@@ -7,6 +7,7 @@
 #[path = "../it/support/bin.rs"]
 mod bin;
 mod cubes;
+mod lightings;
 mod real;
 mod yard;
 
