@@ -244,7 +244,9 @@ pub fn whole_pixel_lines(
         raw
     };
     if params.connect.refine {
-        refine::refine_into(images, &mut out, &mut refine::RefineScratch::default());
+        let mut scratch = refine::RefineScratch::default();
+        refine::refine_into(images, &mut out, &mut scratch);
+        refine::drop_ghosts(&mut out, &scratch);
     }
     if params.connect.corner_radius > 0.0 {
         corners::close_corners(&mut out, params.connect.corner_radius);

@@ -22,7 +22,7 @@ use super::lens::{LensMap, correct_into};
 use super::lines::{LineScratch, extract_into, track_into};
 use super::params::{Params, Stage};
 use super::photometric::{PhotoScratch, combined_response_into};
-use super::refine::{RefineScratch, refine_into};
+use super::refine::{RefineScratch, drop_ghosts, refine_into};
 use super::{EdgePoints, LlvError, ScanDir, Segment};
 
 mod lean;
@@ -388,6 +388,7 @@ impl Workspace {
         );
         if p.connect.refine {
             refine_into(images, &mut self.out.lines, &mut self.refine);
+            drop_ghosts(&mut self.out.lines, &self.refine);
         }
         super::lines::align::keep_aligned(
             images,

@@ -46,6 +46,19 @@
 //! derivative as weight helps where edges fade along their length (the
 //! yard's), not where they do not (the cubes').
 //!
+//! - **Ghosts.** A line the refit cannot place because fewer than half its
+//!   blocks have an edge of either polarity within `REACH` is not on an
+//!   edge along most of its length. Where it also runs beside a longer line
+//!   at under [`GHOST_DEG`], touching it at one end and leaving it by a few
+//!   pixels at the other, it is a second track of that line's edge that
+//!   drifted off it (a line 22–30° from a scan direction is found in both
+//!   scans, and the one along its stretched profile wanders), which CONNECT
+//!   does not merge because it is not on the same line: [`drop_ghosts`]
+//!   removes it. Either polarity counts, so that an edge whose contrast
+//!   changes sign along it (a beam across a plate) is not a ghost; a line
+//!   with no longer line beside it is never one, so that a faint edge the
+//!   blocks miss is kept.
+//!
 //! The refit needs the image: lines made from edge files alone (`vss llv
 //! --from-edges`, and a session image without frames) are not refitted;
 //! it is `connect.refine` in a profile. `residual` stays the tracker's.
@@ -80,7 +93,17 @@ type Profile = [f64; SAMPLES];
 pub struct RefineScratch {
     profiles: Vec<Profile>,
     centres: Vec<f64>,
+    /// The lines of the last [`refine_into`] that no edge confirms (module
+    /// doc, "Ghosts"), by index, ascending.
+    unconfirmed: Vec<usize>,
 }
+
+/// Largest angle (degrees) between a ghost and the line it runs beside.
+pub const GHOST_DEG: f64 = 5.0;
+/// A ghost touches that line within this distance (px) at one end…
+const GHOST_NEAR: f64 = 1.5;
+/// …and is at most this far from it at the other.
+const GHOST_FAR: f64 = 6.0;
 
 /// Lee's kernel of half-width `KERNEL_A`, negated so that a dark-to-bright
 /// step along the normal gives a positive peak.
@@ -240,7 +263,8 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
         return;
     }
     let kern = kernel();
-    for seg in segs.iter_mut() {
+    s.unconfirmed.clear();
+    for (i, seg) in segs.iter_mut().enumerate() {
         let Some(f) = Frame::of(seg) else {
             continue;
         };
@@ -289,6 +313,12 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
             }
         }
         if fit.len() < 2 || 2 * fit.len() < s.profiles.len() {
+            let edge = |p: &Profile| {
+                peak_near_line(p, &kern, pol).is_some() || peak_near_line(p, &kern, -pol).is_some()
+            };
+            if 2 * s.profiles.iter().filter(|p| edge(p)).count() < s.profiles.len() {
+                s.unconfirmed.push(i);
+            }
             continue;
         }
         if let Some(line) = fit.line() {
@@ -296,6 +326,53 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
             seg.b = line.project(seg.b);
         }
     }
+}
+
+/// Removes the ghosts among the lines [`refine_into`] left unconfirmed
+/// (module doc): `segs` must be the lines it was given, unchanged since.
+pub fn drop_ghosts(segs: &mut Vec<Segment>, s: &RefineScratch) {
+    if s.unconfirmed.is_empty() {
+        return;
+    }
+    let ghost = |i: usize| {
+        let u = &segs[i];
+        segs.iter()
+            .enumerate()
+            .any(|(j, l)| j != i && l.length() >= u.length() && beside(u, l))
+    };
+    let gone: Vec<usize> = s
+        .unconfirmed
+        .iter()
+        .copied()
+        .filter(|&i| ghost(i))
+        .collect();
+    let mut k = 0;
+    segs.retain(|_| {
+        k += 1;
+        gone.binary_search(&(k - 1)).is_err()
+    });
+}
+
+/// Whether `u` runs beside `l` as a ghost does: within [`GHOST_DEG`] of its
+/// direction, one end within [`GHOST_NEAR`] px of its line and the other
+/// within [`GHOST_FAR`], over at least half of `u`'s length.
+fn beside(u: &Segment, l: &Segment) -> bool {
+    let (dx, dy) = (l.b.x - l.a.x, l.b.y - l.a.y);
+    let (ux, uy) = (u.b.x - u.a.x, u.b.y - u.a.y);
+    let (len, ulen) = (dx.hypot(dy), ux.hypot(uy));
+    if !(len > 0.0 && ulen > 0.0) {
+        return false;
+    }
+    let cos = (ux * dx + uy * dy).abs() / (len * ulen);
+    let off = |p: &Point| ((p.x - l.a.x) * dy - (p.y - l.a.y) * dx).abs() / len;
+    let along = |p: &Point| ((p.x - l.a.x) * dx + (p.y - l.a.y) * dy) / len;
+    let (da, db) = (off(&u.a), off(&u.b));
+    let (ta, tb) = (along(&u.a), along(&u.b));
+    let overlap = ta.max(tb).min(len) - ta.min(tb).max(0.0);
+    cos >= GHOST_DEG.to_radians().cos()
+        && da.min(db) <= GHOST_NEAR
+        && da.max(db) <= GHOST_FAR
+        && overlap >= 0.5 * ulen
 }
 
 /// The offset (px along the normal) of the peak of polarity `pol` nearest

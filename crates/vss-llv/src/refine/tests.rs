@@ -199,3 +199,75 @@ fn where_the_edge_fades_its_blocks_count_for_less() {
     let mean = total / (2 * seeds) as f64;
     assert!(mean < 0.1, "mean endpoint error {mean:.3} px");
 }
+
+/// A second track of an edge that drifted off it (it starts on the edge
+/// and leaves it by 3 px over 80 px, 2.1° off) is removed; the line on the
+/// edge stays, and so does the same drifting line with no line beside it
+/// (nothing says it is a second track of anything).
+#[test]
+fn a_drifting_second_track_beside_its_edge_is_dropped() {
+    let img = edge_image(96, 120, A, B, 60.0, 160.0, None);
+    let (dx, dy) = (B.0 - A.0, B.1 - A.1);
+    let len = dx.hypot(dy);
+    let n = (-dy / len, dx / len);
+    let start = (A.0 + 0.1 * dx, A.1 + 0.1 * dy);
+    let end = (A.0 + 0.9 * dx + 3.0 * n.0, A.1 + 0.9 * dy + 3.0 * n.1);
+    let ghost = seg(start, end);
+    let mut s = RefineScratch::default();
+    let mut lines = vec![seg(A, B), ghost];
+    refine_into(std::slice::from_ref(&img), &mut lines, &mut s);
+    drop_ghosts(&mut lines, &s);
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    assert!(off_line(lines[0].a, A, B) < 0.1 && off_line(lines[0].b, A, B) < 0.1);
+    let mut alone = vec![ghost];
+    refine_into(std::slice::from_ref(&img), &mut alone, &mut s);
+    drop_ghosts(&mut alone, &s);
+    assert_eq!(alone.len(), 1);
+}
+
+/// An edge whose contrast changes sign along it (a beam in front of a
+/// plate: lighter than the background on one part, darker than the plate
+/// on the other) is confirmed by the blocks of either polarity, and is not
+/// dropped beside a longer line.
+#[test]
+fn an_edge_whose_polarity_flips_along_it_is_not_a_ghost() {
+    // Left of the line p → q: 100 above y = 45, 20 from y = 65, and 60
+    // between, as right of it: the edge bright on dark, then no edge, then
+    // dark on bright (neither polarity on half the line, so the refit
+    // cannot place it).
+    let (p, q) = ((40.0, 5.0), (44.0, 115.0));
+    let (dx, dy) = (q.0 - p.0, q.1 - p.1);
+    let len = f64::hypot(dx, dy);
+    let data = (0..120 * 96)
+        .map(|i| {
+            let (x, y) = ((i % 96) as f64, (i / 96) as f64);
+            let left = (x - p.0) * dy - (y - p.1) * dx < 0.0;
+            if !left {
+                60
+            } else if y < 45.0 {
+                100
+            } else if y < 65.0 {
+                60
+            } else {
+                20
+            }
+        })
+        .collect();
+    let img = GreyImage::new(96, 120, data).unwrap();
+    // The edge, 0.8 px off, and a longer line 1.1 px beside it.
+    let n = (dy / len, -dx / len);
+    let on = seg(
+        (p.0 + 0.8 * n.0, p.1 + 0.8 * n.1),
+        (q.0 + 0.8 * n.0, q.1 + 0.8 * n.1),
+    );
+    let longer = seg((p.0 - 0.3 * n.0, p.1 - 5.0), (q.0 - 0.3 * n.0, q.1 + 4.0));
+    let mut s = RefineScratch::default();
+    let mut lines = vec![on, longer];
+    refine_into(std::slice::from_ref(&img), &mut lines, &mut s);
+    // The refit could not place it (it is where it was), and it runs
+    // beside the longer line as a ghost would.
+    assert_eq!(lines[0], on);
+    assert!(beside(&lines[0], &lines[1]));
+    drop_ghosts(&mut lines, &s);
+    assert_eq!(lines.len(), 2, "{lines:?}");
+}
