@@ -109,6 +109,8 @@ pub struct Workspace {
     refine: RefineScratch,
     align: super::lines::align::AlignScratch,
     draw: super::lines::draw::DrawScratch,
+    /// Whether the last run's image was noisy (`edges.noisy_sigma`).
+    noisy: bool,
     /// Whether `out` holds the results of a complete run.
     valid: bool,
     /// Free each direction's buffers after its lines ([`Workspace::lean`]).
@@ -219,7 +221,8 @@ impl Workspace {
                 Some(img) if p.edges.noisy_sigma > 0.0 => noise_level(img),
                 _ => 0.0,
             };
-            if p.edges.noisy_sigma > 0.0 && sigma >= p.edges.noisy_sigma {
+            self.noisy = p.edges.noisy_sigma > 0.0 && sigma >= p.edges.noisy_sigma;
+            if self.noisy {
                 widened = {
                     let mut q = p.clone();
                     q.edges.half_width = (q.edges.half_width + 1).min(7);

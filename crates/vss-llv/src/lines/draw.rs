@@ -26,13 +26,18 @@
 //! - **Pieces**: a least-squares line `u = a + b v` grows with the chain;
 //!   once it has [`CUT_AFTER`] points, [`CUT_RUN`] points in a row more
 //!   than [`CUT_DISTANCE`] px from it end the piece, and the next starts
-//!   at them (ELSED's rule). A piece shorter than `lines.min_length`
+//!   at them (ELSED's rule). In a noisy image (`edges.noisy_sigma`, which
+//!   also widens the kernel) "off" is also beyond 3 RMS residuals of the
+//!   piece, as the tracker's stray test: a faint edge at σ 10 scatters
+//!   more than 1 px (yard σ 10: F 0.636 with the fixed 1 px, 0.811 with
+//!   it; applied to every photograph, most of them clean, it cost F
+//!   0.013). A piece shorter than `lines.min_length`
 //!   between its ends is dropped at once; the others go to `keep_pieces`.
 //! - Points carry the peak's parabolic subpixel position across the edge,
 //!   its response and noise sigmas, as the tracker's do.
 
 use super::nfa::Nfa;
-use super::{TrackPoint, Tracks, keep_pieces, pack};
+use super::{STRAY_SCATTER_SQ, TrackPoint, Tracks, keep_pieces, pack};
 use crate::Segment;
 use crate::edges::peaks::{key_floor, subpixel};
 use crate::edges::{NONE, NoiseMap, Response, key};
@@ -217,7 +222,7 @@ pub fn draw_into(
     h: DrawDir,
     v: DrawDir,
     floor: f64,
-    half_width: usize,
+    (half_width, noisy): (usize, bool),
     p: &LineParams,
     out: &mut Vec<Segment>,
     s: &mut DrawScratch,
@@ -275,7 +280,7 @@ pub fn draw_into(
         s.chain.extend(s.back.iter().rev());
         s.chain.push(seed);
         s.chain.extend(s.fwd.iter());
-        cut(&s.chain, &mut s.cuts);
+        cut(&s.chain, noisy, &mut s.cuts);
 
         for r in s.cuts.drain(..) {
             let piece = &s.chain[r];
@@ -405,21 +410,24 @@ fn slope(list: &[TrackPoint], u: f64, v: usize) -> f64 {
     if dv == 0.0 { 0.0 } else { (u - q.u) / dv }
 }
 
-/// The straight pieces of a chain (module doc), as ranges into `chain`.
-fn cut(chain: &[TrackPoint], out: &mut Vec<std::ops::Range<usize>>) {
+/// The straight pieces of a chain (module doc), as ranges into `chain`;
+/// `noisy`: the image is, and the piece's own scatter widens the limit.
+fn cut(chain: &[TrackPoint], noisy: bool, out: &mut Vec<std::ops::Range<usize>>) {
+    let scatter = if noisy { STRAY_SCATTER_SQ } else { 0.0 };
     out.clear();
     let Some(o) = chain.first() else { return };
     let (u0, v0) = (o.u, o.v);
     let mut start = 0;
-    // Sums of the piece's points kept in its line: n, v, u, vv, vu.
-    let mut f = [0f64; 5];
-    let add = |f: &mut [f64; 5], q: &TrackPoint| {
+    // Sums of the piece's points kept in its line: n, v, u, vv, vu, uu.
+    let mut f = [0f64; 6];
+    let add = |f: &mut [f64; 6], q: &TrackPoint| {
         let (u, v) = (q.u - u0, q.v - v0);
         f[0] += 1.0;
         f[1] += v;
         f[2] += u;
         f[3] += v * v;
         f[4] += v * u;
+        f[5] += u * u;
     };
     let mut run = 0;
     for (j, q) in chain.iter().enumerate() {
@@ -432,13 +440,15 @@ fn cut(chain: &[TrackPoint], out: &mut Vec<std::ops::Range<usize>>) {
             };
             let a = (f[2] - b * f[1]) / f[0];
             let d = (q.u - u0 - a - b * (q.v - v0)).abs();
-            if d * d > CUT_DISTANCE * CUT_DISTANCE * (1.0 + b * b) {
+            let rss = (f[5] - a * f[2] - b * f[4]).max(0.0);
+            let lim = (CUT_DISTANCE * CUT_DISTANCE).max(scatter * rss / f[0]);
+            if d * d > lim * (1.0 + b * b) {
                 run += 1;
                 if run >= CUT_RUN {
                     let first = j + 1 - run;
                     out.push(start..first);
                     start = first;
-                    f = [0.0; 5];
+                    f = [0.0; 6];
                     for q in &chain[first..=j] {
                         add(&mut f, q);
                     }

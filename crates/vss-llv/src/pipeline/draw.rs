@@ -25,7 +25,8 @@ impl Workspace {
         };
         let a = p.edges.half_width as usize;
         let (floor, lines) = (p.edges.floor, &p.lines);
-        draw_into(h, v, floor, a, lines, &mut o.lines_raw, &mut self.draw);
+        let shape = (a, self.noisy);
+        draw_into(h, v, floor, shape, lines, &mut o.lines_raw, &mut self.draw);
         o.timings.lines_us += micros(t);
     }
 }

@@ -59,7 +59,15 @@ fn drawn(img: &GreyImage, p: &Params) -> Vec<Segment> {
     };
     let mut out = Vec::new();
     let mut s = DrawScratch::default();
-    draw_into(d(0), d(1), p.edges.floor, a, &p.lines, &mut out, &mut s);
+    draw_into(
+        d(0),
+        d(1),
+        p.edges.floor,
+        (a, false),
+        &p.lines,
+        &mut out,
+        &mut s,
+    );
     out
 }
 
@@ -117,10 +125,10 @@ fn a_bent_chain_is_cut_at_the_bend() {
         })
         .collect();
     let mut cuts = Vec::new();
-    cut(&chain, &mut cuts);
+    cut(&chain, false, &mut cuts);
     assert_eq!(cuts.len(), 2, "{cuts:?}");
     assert!((20..=23).contains(&cuts[0].end), "{cuts:?}");
     let mut straight = Vec::new();
-    cut(&chain[..20], &mut straight);
+    cut(&chain[..20], false, &mut straight);
     assert_eq!(straight, vec![0..20]);
 }
