@@ -52,6 +52,7 @@
 //!   the line.
 
 pub mod align;
+pub mod draw;
 pub mod nfa;
 pub mod source;
 mod split;

@@ -301,6 +301,11 @@ params! {
         min_aligned: f64 = 0.9,
             "fraction", 0.0..=1.0, step 0.1,
             "lines need the gradient across them at this fraction of their pixels; 0 is off";
+        /// Experimental: draw edge chains from anchors on both responses
+        /// (`lines/draw.rs`) instead of tracking each scan direction.
+        draw: bool = false,
+            "", 0.0..=1.0, step 1.0,
+            "draw edge chains from anchors instead of the two trackers (experimental)";
     }
 
     /// CONNECT, the automatic post-processing (llv.md §4), and the corner closing

@@ -25,7 +25,11 @@ use super::photometric::{PhotoScratch, combined_response_into};
 use super::refine::{RefineScratch, drop_ghosts, refine_into};
 use super::{EdgePoints, LlvError, ScanDir, Segment};
 
+mod draw;
 mod lean;
+mod noise;
+
+pub use noise::noise_level;
 
 /// Wall-clock time of each stage of one run, in microseconds (0 for a
 /// stage that a [`rerun`] did not repeat).
@@ -104,6 +108,9 @@ pub struct Workspace {
     corners: CornerScratch,
     refine: RefineScratch,
     align: super::lines::align::AlignScratch,
+    draw: super::lines::draw::DrawScratch,
+    /// Whether the last run's image was noisy (`edges.noisy_sigma`).
+    noisy: bool,
     /// Whether `out` holds the results of a complete run.
     valid: bool,
     /// Free each direction's buffers after its lines ([`Workspace::lean`]).
@@ -214,7 +221,8 @@ impl Workspace {
                 Some(img) if p.edges.noisy_sigma > 0.0 => noise_level(img),
                 _ => 0.0,
             };
-            if p.edges.noisy_sigma > 0.0 && sigma >= p.edges.noisy_sigma {
+            self.noisy = p.edges.noisy_sigma > 0.0 && sigma >= p.edges.noisy_sigma;
+            if self.noisy {
                 widened = {
                     let mut q = p.clone();
                     q.edges.half_width = (q.edges.half_width + 1).min(7);
@@ -238,7 +246,7 @@ impl Workspace {
                 from,
                 response: !same_response,
                 params: p,
-                lean: self.lean,
+                lean: self.lean && !p.lines.draw,
                 edge_limit: self.edge_limit,
             };
             let parallel = p.edges.threads >= 2 && !self.lean;
@@ -296,6 +304,9 @@ impl Workspace {
             lines_raw.clear();
             lines_raw.extend_from_slice(&self.dir_h.segs);
             lines_raw.extend_from_slice(&self.dir_v.segs);
+        }
+        if from <= Stage::Lines && p.lines.draw {
+            self.draw_lines(p);
         }
         self.connect_on(input, p);
         self.valid = true;
@@ -508,18 +519,22 @@ impl Job<'_> {
             edges_us = micros(t);
         }
         let t = Instant::now();
-        track_into(
-            o.response,
-            o.noise,
-            &o.s.map,
-            o.edges,
-            &o.s.starts,
-            p.edges.floor,
-            p.edges.half_width as usize,
-            &p.lines,
-            &mut o.s.segs,
-            &mut o.s.lines,
-        );
+        if p.lines.draw {
+            o.s.segs.clear(); // `Workspace::draw_lines` after both directions
+        } else {
+            track_into(
+                o.response,
+                o.noise,
+                &o.s.map,
+                o.edges,
+                &o.s.starts,
+                p.edges.floor,
+                p.edges.half_width as usize,
+                &p.lines,
+                &mut o.s.segs,
+                &mut o.s.lines,
+            );
+        }
         if self.lean {
             *o.response = Response::default();
             let segs = std::mem::take(&mut o.s.segs);
@@ -535,48 +550,6 @@ fn micros(t: Instant) -> u64 {
 
 /// Checks the images (at least one, ≥ 16 × 16, one size), the ambient image
 /// and the lens map; returns the size.
-/// The image's noise σ (grey levels) by Immerkær's method ("Fast noise
-/// variance estimation", CVIU 64, 1996): the mean magnitude of the
-/// difference of two Laplacians, `σ = √(π/2) / 6 · mean |I ∗ N|`, which
-/// cancels straight edges and smooth shading and keeps what changes from
-/// pixel to pixel. Texture raises it too, which is what a wider kernel is
-/// also for; pixels whose 3 × 3 window is not all valid are left out.
-pub fn noise_level(img: &GreyImage) -> f64 {
-    let (w, h) = img.size();
-    if w < 3 || h < 3 {
-        return 0.0;
-    }
-    let d = img.data();
-    let mask = img.valid_mask();
-    let (mut sum, mut n) = (0u64, 0u64);
-    for y in 1..h - 1 {
-        let (r0, r1, r2) = (
-            &d[(y - 1) * w..y * w],
-            &d[y * w..(y + 1) * w],
-            &d[(y + 1) * w..(y + 2) * w],
-        );
-        for x in 1..w - 1 {
-            if let Some(m) = mask
-                && !(y - 1..=y + 1).all(|v| m[v * w + x - 1] && m[v * w + x] && m[v * w + x + 1])
-            {
-                continue;
-            }
-            let c = |r: &[u8], i: usize| i32::from(r[i]);
-            let v = c(r0, x - 1) - 2 * c(r0, x) + c(r0, x + 1) - 2 * c(r1, x - 1) + 4 * c(r1, x)
-                - 2 * c(r1, x + 1)
-                + c(r2, x - 1)
-                - 2 * c(r2, x)
-                + c(r2, x + 1);
-            sum += u64::from(v.unsigned_abs());
-            n += 1;
-        }
-    }
-    if n == 0 {
-        return 0.0;
-    }
-    (std::f64::consts::PI / 2.0).sqrt() / 6.0 * sum as f64 / n as f64
-}
-
 fn check_input(input: &Input) -> Result<(usize, usize), LlvError> {
     let first = input.images.first().ok_or(LlvError::BufferSize {
         width: 0,

@@ -1,0 +1,467 @@
+//! A drawing front end (`lines.draw`, experimental): instead of following
+//! every peak of each scan direction's response with its own tracker, edge
+//! chains are drawn from anchors over both responses at once, in the
+//! manner of EDLines and ELSED, and their straight pieces go to the
+//! tracker's validation (`keep_pieces`: weak ends, split, NFA, fit), so the
+//! same segments come out and CONNECT runs unchanged.
+//!
+//! - **Which response**: a pixel whose `|E_H|` is at least its `|E_V|`
+//!   lies on a steep edge (within 45° of the columns) and is drawn on the
+//!   horizontal response, row by row; the others on the vertical one,
+//!   column by column. A chain keeps the response it started on, so its
+//!   points are one a scan line, in the tracker's scan coordinates.
+//! - **Anchors** are the edge points (peaks above `edges.noise_sigmas`
+//!   noise sigmas) of every [`ANCHOR_EVERY`]-th scan line whose response
+//!   is the dominant one there, strongest first (by half-sigma buckets).
+//! - **Drawing**: from the anchor both ways, each step goes to the
+//!   strongest pixel of the anchor's polarity among the three ahead on the
+//!   next scan line, then up the ridge along the scan to its peak; it must
+//!   beat `lines.track_sigmas` noise sigmas of its tile (and the floor).
+//!   Where no pixel does, up to `lines.max_gap` further scan lines are
+//!   tried at the position the last points predict. A chain stops there,
+//!   and at a pixel a chain of its own response has drawn. Chains of the
+//!   other response may cross it: a diagonal edge is drawn on both, as
+//!   both trackers followed it, and CONNECT merges the two (a mask shared
+//!   by both responses lost recall: F 0.737 against 0.741, docs/performance.md).
+//! - **Pieces**: a least-squares line `u = a + b v` grows with the chain;
+//!   once it has [`CUT_AFTER`] points, [`CUT_RUN`] points in a row more
+//!   than [`CUT_DISTANCE`] px from it end the piece, and the next starts
+//!   at them (ELSED's rule). In a noisy image (`edges.noisy_sigma`, which
+//!   also widens the kernel) "off" is also beyond 3 RMS residuals of the
+//!   piece, as the tracker's stray test: a faint edge at σ 10 scatters
+//!   more than 1 px (yard σ 10: F 0.636 with the fixed 1 px, 0.811 with
+//!   it; applied to every photograph, most of them clean, it cost F
+//!   0.013). A piece shorter than `lines.min_length`
+//!   between its ends is dropped at once; the others go to `keep_pieces`.
+//! - Points carry the peak's parabolic subpixel position across the edge,
+//!   its response and noise sigmas, as the tracker's do.
+
+use super::nfa::Nfa;
+use super::{STRAY_SCATTER_SQ, TrackPoint, Tracks, keep_pieces, pack};
+use crate::Segment;
+use crate::edges::peaks::{key_floor, subpixel};
+use crate::edges::{NONE, NoiseMap, Response, key};
+use crate::params::LineParams;
+
+/// Anchors are taken on every this many scan lines.
+pub const ANCHOR_EVERY: usize = 4;
+
+/// Points a piece needs before points may end it; the distance (px) from
+/// its line beyond which a point is off it; the points off it in a row
+/// that end it.
+const CUT_AFTER: usize = 8;
+const CUT_DISTANCE: f64 = 1.0;
+const CUT_RUN: usize = 3;
+
+/// Points of a chain whose slope predicts the position across a gap.
+const SLOPE_POINTS: usize = 8;
+
+/// Strength buckets of the anchors (half a noise sigma each).
+const BUCKETS: usize = 64;
+
+/// One scan direction's input: its response, noise map and edge points'
+/// pixels.
+#[derive(Clone, Copy)]
+pub struct DrawDir<'a> {
+    pub resp: &'a Response,
+    pub noise: &'a NoiseMap,
+    pub starts: &'a [[u16; 2]],
+}
+
+/// Reusable buffers of [`draw_into`].
+#[derive(Clone, Debug, Default)]
+pub struct DrawScratch {
+    planes: [PlaneBufs; 2],
+    /// Per pixel, a bit per response: drawn by a chain on it.
+    drawn: Vec<u8>,
+    /// Anchors packed `dir << 63 | v << 32 | u`, and per bucket counts.
+    anchors: Vec<u64>,
+    sorted: Vec<u64>,
+    counts: Vec<u32>,
+    fwd: Vec<TrackPoint>,
+    back: Vec<TrackPoint>,
+    chain: Vec<TrackPoint>,
+    cuts: Vec<std::ops::Range<usize>>,
+    tracks: Tracks,
+}
+
+/// The per-tile tables of a [`Plane`].
+#[derive(Clone, Debug, Default)]
+struct PlaneBufs {
+    inv_sigma: Vec<f32>,
+    thr: Vec<i32>,
+    tile_u: Vec<u32>,
+    tile_v: Vec<u32>,
+}
+
+/// One response read in scan coordinates `(u, v)`, with per tile its
+/// `scale / σ` and the largest key that does not pass the tracking level.
+struct Plane<'a> {
+    sums: &'a [i16],
+    scale: f32,
+    step_u: usize,
+    step_v: usize,
+    len_u: usize,
+    lines: usize,
+    b: PlaneBufs,
+}
+
+impl<'a> Plane<'a> {
+    fn new(d: &DrawDir<'a>, floor: f64, sigmas: f64, mut b: PlaneBufs) -> Self {
+        let (r, noise) = (d.resp, d.noise);
+        let (w, h, scale) = (r.width, r.height, r.scale());
+        let vertical = r.dir == crate::ScanDir::Vertical;
+        let (nx, ny) = noise.tiles();
+        b.inv_sigma.clear();
+        b.thr.clear();
+        for t in 0..nx * ny {
+            let sg = noise.sigma(t);
+            b.inv_sigma
+                .push(if sg > 0.0 { scale / sg } else { f32::INFINITY });
+            b.thr
+                .push(key_floor((floor as f32).max(sigmas as f32 * sg), scale));
+        }
+        let (cols, rows) = if vertical {
+            (&mut b.tile_v, &mut b.tile_u)
+        } else {
+            (&mut b.tile_u, &mut b.tile_v)
+        };
+        noise.columns_into(w, cols);
+        rows.clear();
+        rows.extend((0..h).map(|y| noise.row_of(y) as u32));
+        let (step_u, step_v, len_u, lines) = if vertical { (w, 1, h, w) } else { (1, w, w, h) };
+        Plane {
+            sums: r.sums(),
+            scale,
+            step_u,
+            step_v,
+            len_u,
+            lines,
+            b,
+        }
+    }
+
+    #[inline]
+    fn tile(&self, u: usize, v: usize) -> usize {
+        (self.b.tile_u[u] + self.b.tile_v[v]) as usize
+    }
+
+    /// The key at image index `i` if its sign is `positive`'s (0 otherwise
+    /// and where there is no response).
+    #[inline]
+    fn signed_key(&self, i: usize, positive: bool) -> i16 {
+        let s = self.sums[i];
+        if s == NONE || (s > 0) != positive {
+            0
+        } else {
+            key(s)
+        }
+    }
+
+    /// The point at `(u, v)`, image index `i` (`1 ≤ u < len_u − 1`).
+    #[inline]
+    fn point(&self, u: usize, v: usize, i: usize) -> TrackPoint {
+        let mag = |j: usize| {
+            let s = self.sums[j];
+            if s == NONE { 0.0 } else { f32::from(key(s)) }
+        };
+        let k0 = mag(i);
+        let d = subpixel(mag(i - self.step_u), k0, mag(i + self.step_u));
+        TrackPoint {
+            u: f64::from(u as f32 + d),
+            v: v as f64,
+            response: f32::from(self.sums[i]) * self.scale,
+            z: k0 * self.b.inv_sigma[self.tile(u, v)],
+            id: i,
+        }
+    }
+
+    /// The pixel drawn next on scan line `v`, around `u`: the strongest of
+    /// `u − 1 ..= u + 1` of the polarity, moved to the peak of the ridge
+    /// along the scan if a neighbour is stronger, if it passes the
+    /// tracking level (`(u, image index)`).
+    #[inline]
+    fn step(&self, u: usize, v: usize, positive: bool) -> Option<(usize, usize)> {
+        if v >= self.lines || u < 1 || u + 1 >= self.len_u {
+            return None;
+        }
+        let base = v * self.step_v;
+        let k = |u: usize| self.signed_key(base + u * self.step_u, positive);
+        let (mut best, mut kb) = (u, k(u));
+        for c in [u - 1, u + 1] {
+            let kc = k(c);
+            if kc > kb {
+                (best, kb) = (c, kc);
+            }
+        }
+        // Climb to the ridge's peak (at most two pixels).
+        for _ in 0..2 {
+            if best < 2 || best + 2 >= self.len_u {
+                break;
+            }
+            let (l, r) = (k(best - 1), k(best + 1));
+            if l > kb && l >= r {
+                (best, kb) = (best - 1, l);
+            } else if r > kb {
+                (best, kb) = (best + 1, r);
+            } else {
+                break;
+            }
+        }
+        (i32::from(kb) > self.b.thr[self.tile(best, v)])
+            .then_some((best, base + best * self.step_u))
+    }
+}
+
+/// Segments of an image drawn from its two responses (module doc),
+/// appended to `out`: those of the horizontal response in image
+/// coordinates like the tracker's. `floor` is the edges' floor `T`,
+/// `half_width` the kernel's `A`.
+#[allow(clippy::too_many_arguments)]
+pub fn draw_into(
+    h: DrawDir,
+    v: DrawDir,
+    floor: f64,
+    (half_width, noisy): (usize, bool),
+    p: &LineParams,
+    out: &mut Vec<Segment>,
+    s: &mut DrawScratch,
+) {
+    let (w, ht) = (h.resp.width, h.resp.height);
+    if w < 3 || ht < 3 || !h.resp.covers(w, ht) || !v.resp.covers(w, ht) {
+        return;
+    }
+    let [bh, bv] = std::mem::take(&mut s.planes);
+    let planes = [
+        Plane::new(&h, floor, p.track_sigmas, bh),
+        Plane::new(&v, floor, p.track_sigmas, bv),
+    ];
+    anchors(h, v, &planes, s);
+    s.drawn.clear();
+    s.drawn.resize(w * ht, 0);
+    let nfa = Nfa::new(w, ht, half_width, p.search_width, p.track_sigmas);
+    let min_angle = p.min_scan_angle_deg.to_radians();
+    let min_sq = p.min_length * p.min_length * (1.0 - 1e-9);
+    let gap = p.max_gap.max(1) as usize;
+    let sorted = std::mem::take(&mut s.sorted);
+    for &a in &sorted {
+        let vertical = a >> 63 != 0;
+        let (u, line) = ((a & 0xFFFF_FFFF) as usize, (a >> 32 & 0x7FFF_FFFF) as usize);
+        let pl = &planes[usize::from(vertical)];
+        let i = u * pl.step_u + line * pl.step_v;
+        let own = 1u8 << u8::from(vertical);
+        if s.drawn[i] & own != 0 {
+            continue;
+        }
+        s.drawn[i] |= own;
+        let seed = pl.point(u, line, i);
+        let positive = seed.response > 0.0;
+        draw_half(
+            pl,
+            (u, line),
+            1,
+            positive,
+            gap,
+            own,
+            &mut s.drawn,
+            &mut s.fwd,
+        );
+        draw_half(
+            pl,
+            (u, line),
+            -1,
+            positive,
+            gap,
+            own,
+            &mut s.drawn,
+            &mut s.back,
+        );
+        s.chain.clear();
+        s.chain.extend(s.back.iter().rev());
+        s.chain.push(seed);
+        s.chain.extend(s.fwd.iter());
+        cut(&s.chain, noisy, &mut s.cuts);
+
+        for r in s.cuts.drain(..) {
+            let piece = &s.chain[r];
+            let (a, b) = (piece[0], piece[piece.len() - 1]);
+            // `segment_of` refuses it (weak ends only shorten a piece).
+            if (b.u - a.u).powi(2) + (b.v - a.v).powi(2) < min_sq {
+                continue;
+            }
+            let t = &mut s.tracks;
+            t.chain.clear();
+            t.chain.extend_from_slice(piece);
+            keep_pieces(t, half_width, p, Some(&nfa), min_angle, vertical, out);
+        }
+    }
+    s.sorted = sorted;
+    let [ph, pv] = planes;
+    s.planes = [ph.b, pv.b];
+}
+
+/// The anchors of both responses, strongest bucket first, into `s.sorted`.
+fn anchors(h: DrawDir, v: DrawDir, planes: &[Plane; 2], s: &mut DrawScratch) {
+    let (sh, sv) = (h.resp.sums(), v.resp.sums());
+    let (kh, kv) = (h.resp.scale(), v.resp.scale());
+    let w = h.resp.width;
+    s.anchors.clear();
+    s.counts.clear();
+    s.counts.resize(BUCKETS + 1, 0);
+    for (d, dir) in [h, v].iter().enumerate() {
+        let vertical = d == 1;
+        let pl = &planes[d];
+        for &[x, y] in dir.starts {
+            let (x, y) = (usize::from(x), usize::from(y));
+            let (u, line) = if vertical { (y, x) } else { (x, y) };
+            if line % ANCHOR_EVERY != 0 || u < 1 || u + 1 >= pl.len_u {
+                continue;
+            }
+            let i = y * w + x;
+            let (eh, ev) = (mag(sh[i]) * kh, mag(sv[i]) * kv);
+            // The dominant response draws the pixel.
+            if (eh >= ev) == vertical {
+                continue;
+            }
+            let z = mag(pl.sums[i]) * pl.b.inv_sigma[pl.tile(u, line)];
+            let b = ((2.0 * z) as usize).min(BUCKETS - 1);
+            s.counts[BUCKETS - b] += 1;
+            s.anchors
+                .push(pack(u, line) | u64::from(vertical) << 63 | (b as u64) << 56);
+        }
+    }
+    // Counting sort, strongest bucket first, stable (scan order within).
+    for k in 0..BUCKETS {
+        s.counts[k + 1] += s.counts[k];
+    }
+    s.sorted.clear();
+    s.sorted.resize(s.anchors.len(), 0);
+    for &a in &s.anchors {
+        let b = (a >> 56 & 0x3F) as usize;
+        let k = &mut s.counts[BUCKETS - 1 - b];
+        s.sorted[*k as usize] = a & !(0x3F << 56);
+        *k += 1;
+    }
+}
+
+/// `|E|` of a sum in units, 0 where there is none.
+fn mag(s: i16) -> f32 {
+    if s == NONE { 0.0 } else { f32::from(key(s)) }
+}
+
+/// Draws from the anchor at `at` in direction `dir` (+1 or −1 scan
+/// lines) into `list`; `own` is the response's bit of `drawn`.
+#[allow(clippy::too_many_arguments)]
+fn draw_half(
+    pl: &Plane,
+    at: (usize, usize),
+    dir: i64,
+    positive: bool,
+    gap: usize,
+    own: u8,
+    drawn: &mut [u8],
+    list: &mut Vec<TrackPoint>,
+) {
+    list.clear();
+    let (mut pix, mut v) = at;
+    let mut u = pix as f64;
+    loop {
+        let mut found = None;
+        for i in 1..=gap as i64 {
+            let next = v as i64 + dir * i;
+            if next < 0 || next as usize >= pl.lines {
+                break;
+            }
+            let next = next as usize;
+            let c = if i == 1 {
+                pix
+            } else {
+                let pred = u + slope(list, u, v) * (next as f64 - v as f64);
+                if !(pred >= 1.0 && pred < (pl.len_u - 1) as f64) {
+                    break;
+                }
+                pred.round() as usize
+            };
+            if let Some(q) = pl.step(c, next, positive) {
+                found = Some((q, next));
+                break;
+            }
+        }
+        let Some(((np, i), nv)) = found else { break };
+        if drawn[i] & own != 0 {
+            break;
+        }
+        drawn[i] |= own;
+        let q = pl.point(np, nv, i);
+        (pix, u, v) = (np, q.u, nv);
+        list.push(q);
+    }
+}
+
+/// The slope `du/dv` of the last [`SLOPE_POINTS`] points of `list`, whose
+/// last is at `(u, v)` (0 with fewer than two).
+fn slope(list: &[TrackPoint], u: f64, v: usize) -> f64 {
+    let k = list.len().min(SLOPE_POINTS);
+    if k < 2 {
+        return 0.0;
+    }
+    let q = &list[list.len() - k];
+    let dv = v as f64 - q.v;
+    if dv == 0.0 { 0.0 } else { (u - q.u) / dv }
+}
+
+/// The straight pieces of a chain (module doc), as ranges into `chain`;
+/// `noisy`: the image is, and the piece's own scatter widens the limit.
+fn cut(chain: &[TrackPoint], noisy: bool, out: &mut Vec<std::ops::Range<usize>>) {
+    let scatter = if noisy { STRAY_SCATTER_SQ } else { 0.0 };
+    out.clear();
+    let Some(o) = chain.first() else { return };
+    let (u0, v0) = (o.u, o.v);
+    let mut start = 0;
+    // Sums of the piece's points kept in its line: n, v, u, vv, vu, uu.
+    let mut f = [0f64; 6];
+    let add = |f: &mut [f64; 6], q: &TrackPoint| {
+        let (u, v) = (q.u - u0, q.v - v0);
+        f[0] += 1.0;
+        f[1] += v;
+        f[2] += u;
+        f[3] += v * v;
+        f[4] += v * u;
+        f[5] += u * u;
+    };
+    let mut run = 0;
+    for (j, q) in chain.iter().enumerate() {
+        if f[0] >= CUT_AFTER as f64 {
+            let den = f[0] * f[3] - f[1] * f[1];
+            let b = if den > 0.0 {
+                (f[0] * f[4] - f[1] * f[2]) / den
+            } else {
+                0.0
+            };
+            let a = (f[2] - b * f[1]) / f[0];
+            let d = (q.u - u0 - a - b * (q.v - v0)).abs();
+            let rss = (f[5] - a * f[2] - b * f[4]).max(0.0);
+            let lim = (CUT_DISTANCE * CUT_DISTANCE).max(scatter * rss / f[0]);
+            if d * d > lim * (1.0 + b * b) {
+                run += 1;
+                if run >= CUT_RUN {
+                    let first = j + 1 - run;
+                    out.push(start..first);
+                    start = first;
+                    f = [0.0; 6];
+                    for q in &chain[first..=j] {
+                        add(&mut f, q);
+                    }
+                    run = 0;
+                }
+                continue;
+            }
+        }
+        run = 0;
+        add(&mut f, q);
+    }
+    out.push(start..chain.len());
+}
+
+#[cfg(test)]
+mod tests;
