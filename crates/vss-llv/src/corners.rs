@@ -152,6 +152,8 @@ pub struct CornerScratch {
     parent: Vec<usize>,
     /// `(root, endpoint)` sorted: each cluster is one run, in root order.
     clusters: Vec<(usize, usize)>,
+    /// `(root, pair)` sorted: each cluster's pairs are one run.
+    by_root: Vec<(usize, (usize, usize))>,
     /// The lines as they were before any move: every cluster decides on
     /// these, so the result does not depend on the order of the clusters.
     original: Vec<Segment>,
@@ -196,9 +198,13 @@ pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerS
     let pts = &s.pts;
 
     // Close pairs, found through a grid of cells one radius wide so the cost
-    // stays near-linear for the few hundred lines of a real image. Each pair
-    // is found once; their order does not matter (clusters do not depend on
-    // it, and the fallback sorts its candidates on a unique key).
+    // stays near-linear for the few hundred lines of a real image: the
+    // endpoints sorted by cell, each tested against the later ones of its
+    // cell and of the cells after it among its neighbours (the next in its
+    // column, three in the next), whose runs only move forward. Each pair
+    // is found once, as `(k, m)` with `k < m`; their order does not matter
+    // (clusters do not depend on it, and the fallback sorts its candidates
+    // on a unique key).
     let cell = |p: Point| ((p.x / radius).floor() as i64, (p.y / radius).floor() as i64);
     s.by_cell.clear();
     s.by_cell
@@ -206,17 +212,30 @@ pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerS
     s.by_cell.sort_unstable();
     let by_cell = &s.by_cell;
     s.pairs.clear();
-    for (k, &p) in pts.iter().enumerate() {
-        let (cx, cy) = cell(p);
-        for gx in cx - 1..=cx + 1 {
-            for gy in cy - 1..=cy + 1 {
-                let from = by_cell.partition_point(|&(c, _)| c < (gx, gy));
-                let to = from + by_cell[from..].partition_point(|&(c, _)| c == (gx, gy));
-                for &(_, m) in &by_cell[from..to] {
-                    if m > k && ends[m].line != ends[k].line && p.dist(pts[m]) <= radius {
-                        s.pairs.push((k, m));
-                    }
+    let (mut same_end, mut next_lo, mut next_end) = (0, 0, 0);
+    for (i, &((cx, cy), k)) in by_cell.iter().enumerate() {
+        let upto = |mut at: usize, last: (i64, i64)| {
+            while by_cell.get(at).is_some_and(|&(c, _)| c <= last) {
+                at += 1;
+            }
+            at
+        };
+        same_end = upto(same_end.max(i + 1), (cx, cy.saturating_add(1)));
+        let next = match cx.checked_add(1) {
+            Some(nx) => {
+                let first = (nx, cy.saturating_sub(1));
+                while by_cell.get(next_lo).is_some_and(|&(c, _)| c < first) {
+                    next_lo += 1;
                 }
+                next_end = upto(next_end.max(next_lo), (nx, cy.saturating_add(1)));
+                &by_cell[next_lo..next_end]
+            }
+            None => &[],
+        };
+        for &(_, m) in by_cell[i + 1..same_end].iter().chain(next) {
+            let (k, m) = (k.min(m), k.max(m));
+            if ends[m].line != ends[k].line && pts[k].dist(pts[m]) <= radius {
+                s.pairs.push((k, m));
             }
         }
     }
@@ -233,23 +252,31 @@ pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerS
             s.parent[rk.max(rm)] = rk.min(rm);
         }
     }
-    // An endpoint in no pair is a cluster of one, which the `kept.len() < 2`
-    // test below skips anyway.
+    // The endpoints in a pair by cluster (an endpoint in none is a cluster
+    // of one, which the `kept.len() < 2` test below would skip), and the
+    // pairs by cluster, both in root order.
     s.clusters.clear();
-    for e in 0..ends.len() {
-        let r = find(&mut s.parent, e);
-        s.clusters.push((r, e));
+    s.by_root.clear();
+    for &(k, m) in &s.pairs {
+        let r = find(&mut s.parent, k);
+        s.clusters.extend([(r, k), (r, m)]);
+        s.by_root.push((r, (k, m)));
     }
     s.clusters.sort_unstable();
+    s.clusters.dedup();
+    s.by_root.sort_unstable();
 
     s.original.clear();
     s.original.extend_from_slice(lines);
-    let mut start = 0;
+    let (mut start, mut pairs_at) = (0, 0);
     while start < s.clusters.len() {
         let root = s.clusters[start].0;
         let len = s.clusters[start..].partition_point(|&(r, _)| r == root);
         let members = &s.clusters[start..start + len];
         start += len;
+        let npairs = s.by_root[pairs_at..].partition_point(|&(r, _)| r == root);
+        let pairs = &s.by_root[pairs_at..pairs_at + npairs];
+        pairs_at += npairs;
         // Drop stubs: lines with both ends in this cluster.
         let stub = |l: usize| members.iter().filter(|&&(_, k)| ends[k].line == l).count() > 1;
         s.kept.clear();
@@ -274,7 +301,7 @@ pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerS
             ends,
             pts,
             &s.kept,
-            &s.pairs,
+            pairs.iter().map(|p| p.1),
             radius,
             &mut s.cands,
             &mut s.used,
@@ -333,13 +360,13 @@ fn close_pairs(
     ends: &[End],
     pts: &[Point],
     kept: &[usize],
-    pairs: &[(usize, usize)],
+    pairs: impl Iterator<Item = (usize, usize)>,
     radius: f64,
     cands: &mut Vec<(f64, usize, usize, Point)>,
     used: &mut Vec<usize>,
 ) {
     cands.clear();
-    for &(k, m) in pairs {
+    for (k, m) in pairs {
         if !kept.contains(&k) || !kept.contains(&m) {
             continue;
         }
