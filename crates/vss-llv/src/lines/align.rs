@@ -307,13 +307,19 @@ pub fn keep_aligned(
         }
         let counted = v.iter().filter(|x| **x != Sample::Unknown).count();
         let aligned = v.iter().filter(|x| **x == Sample::Aligned).count();
-        if counted == 0
+        if counted == 0 {
+            out.push(*s);
+            continue;
+        }
+        parts(v, min, ps);
+        // A line that is one part from end to end is kept whole either way:
+        // the test against chance (a logarithm a term) is left unread.
+        if ps.as_slice() == [(0.0, 1.0)]
             || super::nfa::log10_binomial_tail(counted, aligned, 0.25) <= LOG10_SIGNIFICANT
         {
             out.push(*s);
             continue;
         }
-        parts(v, min, ps);
         for &(t0, t1) in ps.iter() {
             if t0 == 0.0 && t1 == 1.0 {
                 out.push(*s);
