@@ -271,7 +271,9 @@ pub fn connect(lines: &[Segment], p: &ConnectParams) -> Vec<Segment> {
 ///
 /// A pair is tested again in a later pass only if one of the two changed in
 /// the previous pass or this one: otherwise it was already tested in the
-/// same state and failed. This makes the final "nothing merges" pass cheap.
+/// same state and failed. This makes the final "nothing merges" pass cheap:
+/// a segment that did not change is looked up only among those that did
+/// (a second grid of them).
 ///
 /// The pairs are found through a grid of 32-px cells: a segment is tested
 /// against the later segments whose environments share a cell with its
@@ -280,7 +282,9 @@ pub fn connect(lines: &[Segment], p: &ConnectParams) -> Vec<Segment> {
 /// sequence of merges as testing every later segment (environments that
 /// share no cell do not meet, and such a pair fails the test), at about
 /// the cost of the pairs that are near each other: on a 2560 × 1920 photograph of 5,240 lines
-/// the quadratic scan took most of the pipeline's time.
+/// the quadratic scan took most of the pipeline's time. Only the segments
+/// in a neighbouring direction bin that pass the test's geometry are
+/// gathered (each once); merging them is the test's other half.
 pub fn connect_into(
     lines: &[Segment],
     p: &ConnectParams,
@@ -314,6 +318,7 @@ pub fn connect_into(
     for (k, g) in s.geo.iter().enumerate() {
         s.grid.insert(k as u32, g);
     }
+    s.grid.seal();
     s.seen.reset(n);
     let ConnectScratch {
         segs,
@@ -327,11 +332,15 @@ pub fn connect_into(
         ..
     } = s;
     let mut pass = 1u32;
+    // The last segment in `fresh`.
+    let mut fresh_last = 0;
     loop {
         if pass > 1 {
             fresh.reset_like(grid);
+            fresh_last = 0;
             for k in (0..n).filter(|&k| alive[k] && changed[k] + 1 == pass) {
                 fresh.insert(k as u32, &geo[k]);
+                fresh_last = k;
             }
         }
         let mut merged_any = false;
@@ -339,7 +348,7 @@ pub fn connect_into(
             if !alive[i] {
                 continue;
             }
-            let gather = |grid: &Grid,
+            let gather = |grid: &mut Grid,
                           geo: &[Geo],
                           alive: &[bool],
                           changed: &[u32],
@@ -347,12 +356,16 @@ pub fn connect_into(
                           cand: &mut Vec<u32>| {
                 let gi = &geo[i];
                 let pair = |k: usize| alive[k] && geo_mergeable(gi, &geo[k], t.0, t.1);
-                if changed[i] + 1 >= pass {
+                if pass == 1 {
+                    grid.after_in_order(i as u32, gi, seen, cand, pair);
+                } else if changed[i] + 1 >= pass {
                     grid.after(i as u32, gi, seen, cand, pair);
-                } else {
+                } else if i < fresh_last {
                     // Only a pair with a segment changed since the last pass
                     // can merge now: those are in `fresh`.
                     fresh.after(i as u32, gi, seen, cand, pair);
+                } else {
+                    cand.clear();
                 }
             };
             gather(grid, geo, alive, changed, seen, cand);

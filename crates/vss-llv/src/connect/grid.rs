@@ -21,6 +21,12 @@ pub(super) struct Grid {
     /// Direction bins over the half turn (1: directions not binned).
     bins: usize,
     cells: Vec<Vec<(u32, u8)>>,
+    /// Per cell: how many of its first entries are in ascending order
+    /// (those listed before [`Grid::seal`]).
+    sealed: Vec<u32>,
+    /// Per cell: the first of those after the segment of the first pass
+    /// that gathered last ([`Grid::after_in_order`]).
+    cursor: Vec<u32>,
 }
 
 /// Cell size (px): about an environment's length beyond an end (`wl`)
@@ -203,6 +209,51 @@ impl Grid {
                 f(cy * self.nx + cx);
             }
         }
+    }
+
+    /// Marks each cell's entries so far as its ascending prefix (the
+    /// segments were inserted in order), for [`Grid::after_in_order`].
+    pub(super) fn seal(&mut self) {
+        let n = self.nx * self.ny;
+        self.sealed.clear();
+        self.sealed
+            .extend(self.cells[..n].iter().map(|c| c.len() as u32));
+        self.cursor.clear();
+        self.cursor.resize(n, 0);
+    }
+
+    /// [`Grid::after`] for the first pass over a sealed grid, `i` never
+    /// less than at the last call: the segments after `i` are unchanged, so
+    /// their entries of the sealed prefixes are all there is to read, and
+    /// in each cell those of the segments up to `i` are skipped for good
+    /// (the entries added since are of segments up to `i`).
+    pub(super) fn after_in_order(
+        &mut self,
+        i: u32,
+        g: &Geo,
+        seen: &mut Seen,
+        out: &mut Vec<u32>,
+        mut keep: impl FnMut(usize) -> bool,
+    ) {
+        out.clear();
+        seen.next();
+        let near = self.near(g);
+        let mut cursor = std::mem::take(&mut self.cursor);
+        self.each_cell(g, |c| {
+            let (cell, end) = (&self.cells[c], self.sealed[c] as usize);
+            let mut at = cursor[c] as usize;
+            while at < end && cell[at].0 <= i {
+                at += 1;
+            }
+            cursor[c] = at as u32;
+            for &(k, b) in &cell[at..end] {
+                if near >> b & 1 != 0 && seen.first(k as usize) && keep(k as usize) {
+                    out.push(k);
+                }
+            }
+        });
+        self.cursor = cursor;
+        out.sort_unstable();
     }
 
     /// Lists segment `k` with environment `g` in its cells.
