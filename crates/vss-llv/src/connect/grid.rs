@@ -163,6 +163,18 @@ impl Grid {
         }
         let col = |x: f64| (((x - self.x0) * self.inv).max(0.0) as usize).min(self.nx - 1);
         let row = |y: f64| (((y - self.y0) * self.inv).max(0.0) as usize).min(self.ny - 1);
+        let (r0, r1) = (row(g.bounds[1] - SLACK), row(g.bounds[3] + SLACK));
+        let (c0, c1) = (col(g.bounds[0] - SLACK), col(g.bounds[2] + SLACK));
+        if r0 == r1 || c0 == c1 {
+            // Bounds of one row or one column of cells (most environments):
+            // the clipping below would keep them all.
+            for cy in r0..=r1 {
+                for cx in c0..=c1 {
+                    f(cy * self.nx + cx);
+                }
+            }
+            return;
+        }
         let r = &g.env;
         let (lx, ly) = (r.d.0 * r.hl, r.d.1 * r.hl);
         let (wx, wy) = (-r.d.1 * r.hw, r.d.0 * r.hw);
@@ -172,7 +184,6 @@ impl Grid {
             (r.c.x - lx - wx, r.c.y - ly - wy),
             (r.c.x - lx + wx, r.c.y - ly + wy),
         ];
-        let (r0, r1) = (row(g.bounds[1] - SLACK), row(g.bounds[3] + SLACK));
         for cy in r0..=r1 {
             // The band of this row (the outer rows reach to the bounds).
             let lo = if cy == r0 {
