@@ -165,9 +165,10 @@ impl Grid {
         let row = |y: f64| (((y - self.y0) * self.inv).max(0.0) as usize).min(self.ny - 1);
         let (r0, r1) = (row(g.bounds[1] - SLACK), row(g.bounds[3] + SLACK));
         let (c0, c1) = (col(g.bounds[0] - SLACK), col(g.bounds[2] + SLACK));
-        if r0 == r1 || c0 == c1 {
+        if r0 == r1 || c0 == c1 || (r1 - r0 == 1 && c1 - c0 == 1) {
             // Bounds of one row or one column of cells (most environments):
-            // the clipping below would keep them all.
+            // the clipping below would keep them all; of 2 × 2 it would
+            // drop one at most, not worth its cost.
             for cy in r0..=r1 {
                 for cx in c0..=c1 {
                     f(cy * self.nx + cx);
