@@ -205,40 +205,7 @@ pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerS
     // is found once, as `(k, m)` with `k < m`; their order does not matter
     // (clusters do not depend on it, and the fallback sorts its candidates
     // on a unique key).
-    let cell = |p: Point| ((p.x / radius).floor() as i64, (p.y / radius).floor() as i64);
-    s.by_cell.clear();
-    s.by_cell
-        .extend(pts.iter().enumerate().map(|(k, &p)| (cell(p), k)));
-    s.by_cell.sort_unstable();
-    let by_cell = &s.by_cell;
-    s.pairs.clear();
-    let (mut same_end, mut next_lo, mut next_end) = (0, 0, 0);
-    for (i, &((cx, cy), k)) in by_cell.iter().enumerate() {
-        let upto = |mut at: usize, last: (i64, i64)| {
-            while by_cell.get(at).is_some_and(|&(c, _)| c <= last) {
-                at += 1;
-            }
-            at
-        };
-        same_end = upto(same_end.max(i + 1), (cx, cy.saturating_add(1)));
-        let next = match cx.checked_add(1) {
-            Some(nx) => {
-                let first = (nx, cy.saturating_sub(1));
-                while by_cell.get(next_lo).is_some_and(|&(c, _)| c < first) {
-                    next_lo += 1;
-                }
-                next_end = upto(next_end.max(next_lo), (nx, cy.saturating_add(1)));
-                &by_cell[next_lo..next_end]
-            }
-            None => &[],
-        };
-        for &(_, m) in by_cell[i + 1..same_end].iter().chain(next) {
-            let (k, m) = (k.min(m), k.max(m));
-            if ends[m].line != ends[k].line && pts[k].dist(pts[m]) <= radius {
-                s.pairs.push((k, m));
-            }
-        }
-    }
+    find_pairs(ends, pts, radius, &mut s.by_cell, &mut s.pairs);
     if s.pairs.is_empty() {
         return;
     }
@@ -306,6 +273,51 @@ pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerS
             &mut s.cands,
             &mut s.used,
         );
+    }
+}
+
+/// Into `pairs`: each pair `(k, m)`, `k < m`, of endpoints of different
+/// lines at most `radius` apart, found through cells one radius wide (see
+/// [`close_corners_with`]); `by_cell_buf` is scratch.
+fn find_pairs(
+    ends: &[End],
+    pts: &[Point],
+    radius: f64,
+    by_cell_buf: &mut Vec<((i64, i64), usize)>,
+    pairs: &mut Vec<(usize, usize)>,
+) {
+    let cell = |p: Point| ((p.x / radius).floor() as i64, (p.y / radius).floor() as i64);
+    by_cell_buf.clear();
+    by_cell_buf.extend(pts.iter().enumerate().map(|(k, &p)| (cell(p), k)));
+    by_cell_buf.sort_unstable();
+    let by_cell = &*by_cell_buf;
+    pairs.clear();
+    let (mut same_end, mut next_lo, mut next_end) = (0, 0, 0);
+    for (i, &((cx, cy), k)) in by_cell.iter().enumerate() {
+        let upto = |mut at: usize, last: (i64, i64)| {
+            while by_cell.get(at).is_some_and(|&(c, _)| c <= last) {
+                at += 1;
+            }
+            at
+        };
+        same_end = upto(same_end.max(i + 1), (cx, cy.saturating_add(1)));
+        let next = match cx.checked_add(1) {
+            Some(nx) => {
+                let first = (nx, cy.saturating_sub(1));
+                while by_cell.get(next_lo).is_some_and(|&(c, _)| c < first) {
+                    next_lo += 1;
+                }
+                next_end = upto(next_end.max(next_lo), (nx, cy.saturating_add(1)));
+                &by_cell[next_lo..next_end]
+            }
+            None => &[],
+        };
+        for &(_, m) in by_cell[i + 1..same_end].iter().chain(next) {
+            let (k, m) = (k.min(m), k.max(m));
+            if ends[m].line != ends[k].line && pts[k].dist(pts[m]) <= radius {
+                pairs.push((k, m));
+            }
+        }
     }
 }
 
@@ -561,5 +573,43 @@ mod tests {
         assert!(fwd[1].b.dist(fwd[2].a) < 1e-9);
         assert!(fwd[2].b.dist(fwd[3].a) < 1e-9);
         assert!(fwd[3].b.dist(fwd[0].a) < 1e-9);
+    }
+
+    #[test]
+    fn the_cell_sweep_finds_every_close_pair() {
+        let mut rng = crate::rng::SplitMix64::new(7);
+        let (mut by_cell, mut pairs) = (Vec::new(), Vec::new());
+        let mut found = 0;
+        for round in 0..30 {
+            let radius = [5.0, 3.0, 0.7][round % 3];
+            // Endpoints crowded into a small square (many per cell, cells
+            // on both sides of 0) and a few spread far.
+            let n = 40 + round * 7;
+            let pts: Vec<Point> = (0..n)
+                .map(|k| {
+                    let span = if k % 9 == 0 { 1.0e4 } else { 20.0 };
+                    Point::new(rng.range(-span, span), rng.range(-span, span))
+                })
+                .collect();
+            let ends: Vec<End> = (0..n)
+                .map(|k| End {
+                    line: k / 2,
+                    b: k % 2 == 1,
+                })
+                .collect();
+            find_pairs(&ends, &pts, radius, &mut by_cell, &mut pairs);
+            pairs.sort_unstable();
+            let mut want = Vec::new();
+            for k in 0..n {
+                for m in k + 1..n {
+                    if ends[k].line != ends[m].line && pts[k].dist(pts[m]) <= radius {
+                        want.push((k, m));
+                    }
+                }
+            }
+            assert_eq!(pairs, want, "round {round}");
+            found += want.len();
+        }
+        assert!(found > 1000, "{found} pairs");
     }
 }
