@@ -22,6 +22,9 @@ use super::fit::LineFit;
 use super::params::ConnectParams;
 use super::{Point, Segment};
 
+mod grid;
+use grid::{Grid, Seen};
+
 /// An oriented rectangle: centre, unit direction, half-length, half-width.
 #[derive(Clone, Copy, Debug)]
 struct Rect {
@@ -203,6 +206,8 @@ struct Geo {
     env: Rect,
     /// Axis-aligned bounds of the environment: min x, min y, max x, max y.
     bounds: [f64; 4],
+    /// The direction's angle in `[0, π]`.
+    angle: f64,
 }
 
 impl Geo {
@@ -213,6 +218,10 @@ impl Geo {
         Geo {
             env,
             bounds: [env.c.x - ex, env.c.y - ey, env.c.x + ex, env.c.y + ey],
+            angle: {
+                let t = env.d.1.atan2(env.d.0);
+                if t < 0.0 { t + std::f64::consts::PI } else { t }
+            },
         }
     }
 }
@@ -240,153 +249,14 @@ pub struct ConnectScratch {
     /// The pass in which each segment last changed (0: never).
     changed: Vec<u32>,
     grid: Grid,
+    /// The segments that changed in the previous pass, in a grid of the
+    /// same layout.
+    fresh: Grid,
+    seen: Seen,
     /// The candidates of the segment being grown.
     cand: Vec<u32>,
     /// Segments with their lengths, for sorting.
     keyed: Vec<(f64, Segment)>,
-}
-
-/// A uniform grid over the environments' bounds: each cell lists the
-/// segments whose environments (as they are, or were before they grew)
-/// overlap it. Two environments that meet share a cell, so a segment's
-/// possible partners are the segments listed in its own cells.
-#[derive(Clone, Debug, Default)]
-struct Grid {
-    x0: f64,
-    y0: f64,
-    /// 1 / cell size.
-    inv: f64,
-    nx: usize,
-    ny: usize,
-    cells: Vec<Vec<u32>>,
-}
-
-/// Cell size (px): about an environment's length beyond an end (`wl`)
-/// plus a short line.
-const CELL: f64 = 32.0;
-/// Up to this many segments (a synthetic scene's few tens) the grid is one
-/// cell: placing them costs more than testing every pair.
-const FEW: usize = 64;
-/// The most cells along an axis (coordinates far off the image, from a
-/// damaged line file, widen the cells instead).
-const MAX_CELLS: usize = 256;
-
-impl Grid {
-    fn reset(&mut self, geo: &[Geo]) {
-        let mut b = [
-            f64::INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NEG_INFINITY,
-        ];
-        for g in geo {
-            b[0] = b[0].min(g.bounds[0]);
-            b[1] = b[1].min(g.bounds[1]);
-            b[2] = b[2].max(g.bounds[2]);
-            b[3] = b[3].max(g.bounds[3]);
-        }
-        let (w, h) = (b[2] - b[0], b[3] - b[1]);
-        if geo.len() <= FEW || !(w.is_finite() && h.is_finite()) {
-            // Few segments (or bounds that overflow): one cell holds them all.
-            (self.x0, self.y0, self.inv, self.nx, self.ny) = (0.0, 0.0, 0.0, 1, 1);
-        } else {
-            let cell = CELL.max(w.max(h) / MAX_CELLS as f64);
-            self.x0 = b[0];
-            self.y0 = b[1];
-            self.inv = 1.0 / cell;
-            self.nx = ((w * self.inv) as usize + 1).min(MAX_CELLS);
-            self.ny = ((h * self.inv) as usize + 1).min(MAX_CELLS);
-        }
-        let n = self.nx * self.ny;
-        if self.cells.len() < n {
-            self.cells.resize_with(n, Vec::new);
-        }
-        for c in &mut self.cells[..n] {
-            c.clear();
-        }
-    }
-
-    /// Calls `f` with each cell the environment `g` overlaps: for each row
-    /// of cells under its bounds, the columns of the rectangle's part in
-    /// that row's band (clipped exactly: a long oblique line covers a few
-    /// cells a row, not its whole bounding box), widened by `SLACK`.
-    fn each_cell(&self, g: &Geo, mut f: impl FnMut(usize)) {
-        const SLACK: f64 = 1e-6;
-        if self.nx * self.ny == 1 {
-            f(0);
-            return;
-        }
-        let col = |x: f64| (((x - self.x0) * self.inv).max(0.0) as usize).min(self.nx - 1);
-        let row = |y: f64| (((y - self.y0) * self.inv).max(0.0) as usize).min(self.ny - 1);
-        let r = &g.env;
-        let (lx, ly) = (r.d.0 * r.hl, r.d.1 * r.hl);
-        let (wx, wy) = (-r.d.1 * r.hw, r.d.0 * r.hw);
-        let corners = [
-            (r.c.x + lx + wx, r.c.y + ly + wy),
-            (r.c.x + lx - wx, r.c.y + ly - wy),
-            (r.c.x - lx - wx, r.c.y - ly - wy),
-            (r.c.x - lx + wx, r.c.y - ly + wy),
-        ];
-        let (r0, r1) = (row(g.bounds[1] - SLACK), row(g.bounds[3] + SLACK));
-        for cy in r0..=r1 {
-            // The band of this row (the outer rows reach to the bounds).
-            let lo = if cy == r0 {
-                f64::NEG_INFINITY
-            } else {
-                self.y0 + cy as f64 / self.inv - SLACK
-            };
-            let hi = if cy == r1 {
-                f64::INFINITY
-            } else {
-                self.y0 + (cy + 1) as f64 / self.inv + SLACK
-            };
-            let (mut xmin, mut xmax) = (f64::INFINITY, f64::NEG_INFINITY);
-            for (k, &(x, y)) in corners.iter().enumerate() {
-                if (lo..=hi).contains(&y) {
-                    xmin = xmin.min(x);
-                    xmax = xmax.max(x);
-                }
-                let (x2, y2) = corners[(k + 1) % 4];
-                for yb in [lo, hi] {
-                    if (y - yb) * (y2 - yb) < 0.0 {
-                        let xb = x + (x2 - x) * (yb - y) / (y2 - y);
-                        xmin = xmin.min(xb);
-                        xmax = xmax.max(xb);
-                    }
-                }
-            }
-            if xmin.partial_cmp(&xmax).is_none_or(|o| o.is_gt()) {
-                // A band the rectangle only touches (or coordinates too large
-                // to clip): its whole row under the bounds.
-                (xmin, xmax) = (g.bounds[0], g.bounds[2]);
-            }
-            for cx in col(xmin - SLACK)..=col(xmax + SLACK) {
-                f(cy * self.nx + cx);
-            }
-        }
-    }
-
-    fn insert(&mut self, k: u32, g: &Geo) {
-        let mut cells = std::mem::take(&mut self.cells);
-        self.each_cell(g, |c| {
-            let c = &mut cells[c];
-            if c.last() != Some(&k) {
-                c.push(k);
-            }
-        });
-        self.cells = cells;
-    }
-
-    /// Into `out`, ascending and without repeats: the segments after `i`
-    /// listed in the cells `g` overlaps.
-    fn after(&self, i: u32, g: &Geo, out: &mut Vec<u32>) {
-        out.clear();
-        self.each_cell(g, |c| {
-            out.extend(self.cells[c].iter().filter(|&&k| k > i));
-        });
-        out.sort_unstable();
-        out.dedup();
-    }
 }
 
 /// CONNECT (§4) of a line set; the result is sorted longest first.
@@ -401,7 +271,9 @@ pub fn connect(lines: &[Segment], p: &ConnectParams) -> Vec<Segment> {
 ///
 /// A pair is tested again in a later pass only if one of the two changed in
 /// the previous pass or this one: otherwise it was already tested in the
-/// same state and failed. This makes the final "nothing merges" pass cheap.
+/// same state and failed. This makes the final "nothing merges" pass cheap:
+/// a segment that did not change is looked up only among those that did
+/// (a second grid of them).
 ///
 /// The pairs are found through a grid of 32-px cells: a segment is tested
 /// against the later segments whose environments share a cell with its
@@ -410,7 +282,9 @@ pub fn connect(lines: &[Segment], p: &ConnectParams) -> Vec<Segment> {
 /// sequence of merges as testing every later segment (environments that
 /// share no cell do not meet, and such a pair fails the test), at about
 /// the cost of the pairs that are near each other: on a 2560 × 1920 photograph of 5,240 lines
-/// the quadratic scan took most of the pipeline's time.
+/// the quadratic scan took most of the pipeline's time. Only the segments
+/// in a neighbouring direction bin that pass the test's geometry are
+/// gathered (each once); merging them is the test's other half.
 pub fn connect_into(
     lines: &[Segment],
     p: &ConnectParams,
@@ -435,39 +309,78 @@ pub fn connect_into(
     s.alive.resize(n, true);
     s.changed.clear();
     s.changed.resize(n, 0);
-    s.grid.reset(&s.geo);
-    for (k, g) in s.geo.iter().enumerate() {
-        s.grid.insert(k as u32, g);
-    }
     let max = p
         .max_angle_deg
         .to_radians()
         .clamp(0.0, std::f64::consts::FRAC_PI_2);
-    let (sin_max, cos_max) = max.sin_cos();
+    let t = max.sin_cos();
+    s.grid.reset(&s.geo, max);
+    for (k, g) in s.geo.iter().enumerate() {
+        s.grid.insert(k as u32, g);
+    }
+    s.grid.seal();
+    s.seen.reset(n);
+    let ConnectScratch {
+        segs,
+        geo,
+        alive,
+        changed,
+        grid,
+        fresh,
+        seen,
+        cand,
+        ..
+    } = s;
     let mut pass = 1u32;
+    // The last segment in `fresh`.
+    let mut fresh_last = 0;
     loop {
+        if pass > 1 {
+            fresh.reset_like(grid);
+            fresh_last = 0;
+            for k in (0..n).filter(|&k| alive[k] && changed[k] + 1 == pass) {
+                fresh.insert(k as u32, &geo[k]);
+                fresh_last = k;
+            }
+        }
         let mut merged_any = false;
         for i in 0..n {
-            if !s.alive[i] {
+            if !alive[i] {
                 continue;
             }
-            s.grid.after(i as u32, &s.geo[i], &mut s.cand);
+            let gather = |grid: &mut Grid,
+                          geo: &[Geo],
+                          alive: &[bool],
+                          changed: &[u32],
+                          seen: &mut Seen,
+                          cand: &mut Vec<u32>| {
+                let gi = &geo[i];
+                let pair = |k: usize| alive[k] && geo_mergeable(gi, &geo[k], t.0, t.1);
+                if pass == 1 {
+                    grid.after_in_order(i as u32, gi, seen, cand, pair);
+                } else if changed[i] + 1 >= pass {
+                    grid.after(i as u32, gi, seen, cand, pair);
+                } else if i < fresh_last {
+                    // Only a pair with a segment changed since the last pass
+                    // can merge now: those are in `fresh`.
+                    fresh.after(i as u32, gi, seen, cand, pair);
+                } else {
+                    cand.clear();
+                }
+            };
+            gather(grid, geo, alive, changed, seen, cand);
             let mut c = 0;
-            while let Some(&j) = s.cand.get(c) {
+            while let Some(&j) = cand.get(c) {
                 let j = j as usize;
-                let fresh = s.changed[i] + 1 >= pass || s.changed[j] + 1 >= pass;
-                let joined =
-                    (s.alive[j] && fresh && geo_mergeable(&s.geo[i], &s.geo[j], sin_max, cos_max))
-                        .then(|| merge(&s.segs[i], &s.segs[j]))
-                        .filter(|m| one_edge(&s.segs[i], &s.segs[j], m));
-                if let Some(m) = joined {
-                    s.segs[i] = m;
-                    s.geo[i] = Geo::of(&s.segs[i], p);
-                    s.changed[i] = pass;
-                    s.alive[j] = false;
+                let m = merge(&segs[i], &segs[j]);
+                if one_edge(&segs[i], &segs[j], &m) {
+                    segs[i] = m;
+                    geo[i] = Geo::of(&segs[i], p);
+                    changed[i] = pass;
+                    alive[j] = false;
                     merged_any = true;
-                    s.grid.insert(i as u32, &s.geo[i]);
-                    s.grid.after(i as u32, &s.geo[i], &mut s.cand);
+                    grid.insert(i as u32, &geo[i]);
+                    gather(grid, geo, alive, changed, seen, cand);
                     c = 0;
                 } else {
                     c += 1;

@@ -152,6 +152,8 @@ pub struct CornerScratch {
     parent: Vec<usize>,
     /// `(root, endpoint)` sorted: each cluster is one run, in root order.
     clusters: Vec<(usize, usize)>,
+    /// `(root, pair)` sorted: each cluster's pairs are one run.
+    by_root: Vec<(usize, (usize, usize))>,
     /// The lines as they were before any move: every cluster decides on
     /// these, so the result does not depend on the order of the clusters.
     original: Vec<Segment>,
@@ -196,30 +198,14 @@ pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerS
     let pts = &s.pts;
 
     // Close pairs, found through a grid of cells one radius wide so the cost
-    // stays near-linear for the few hundred lines of a real image. Each pair
-    // is found once; their order does not matter (clusters do not depend on
-    // it, and the fallback sorts its candidates on a unique key).
-    let cell = |p: Point| ((p.x / radius).floor() as i64, (p.y / radius).floor() as i64);
-    s.by_cell.clear();
-    s.by_cell
-        .extend(pts.iter().enumerate().map(|(k, &p)| (cell(p), k)));
-    s.by_cell.sort_unstable();
-    let by_cell = &s.by_cell;
-    s.pairs.clear();
-    for (k, &p) in pts.iter().enumerate() {
-        let (cx, cy) = cell(p);
-        for gx in cx - 1..=cx + 1 {
-            for gy in cy - 1..=cy + 1 {
-                let from = by_cell.partition_point(|&(c, _)| c < (gx, gy));
-                let to = from + by_cell[from..].partition_point(|&(c, _)| c == (gx, gy));
-                for &(_, m) in &by_cell[from..to] {
-                    if m > k && ends[m].line != ends[k].line && p.dist(pts[m]) <= radius {
-                        s.pairs.push((k, m));
-                    }
-                }
-            }
-        }
-    }
+    // stays near-linear for the few hundred lines of a real image: the
+    // endpoints sorted by cell, each tested against the later ones of its
+    // cell and of the cells after it among its neighbours (the next in its
+    // column, three in the next), whose runs only move forward. Each pair
+    // is found once, as `(k, m)` with `k < m`; their order does not matter
+    // (clusters do not depend on it, and the fallback sorts its candidates
+    // on a unique key).
+    find_pairs(ends, pts, radius, &mut s.by_cell, &mut s.pairs);
     if s.pairs.is_empty() {
         return;
     }
@@ -233,23 +219,31 @@ pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerS
             s.parent[rk.max(rm)] = rk.min(rm);
         }
     }
-    // An endpoint in no pair is a cluster of one, which the `kept.len() < 2`
-    // test below skips anyway.
+    // The endpoints in a pair by cluster (an endpoint in none is a cluster
+    // of one, which the `kept.len() < 2` test below would skip), and the
+    // pairs by cluster, both in root order.
     s.clusters.clear();
-    for e in 0..ends.len() {
-        let r = find(&mut s.parent, e);
-        s.clusters.push((r, e));
+    s.by_root.clear();
+    for &(k, m) in &s.pairs {
+        let r = find(&mut s.parent, k);
+        s.clusters.extend([(r, k), (r, m)]);
+        s.by_root.push((r, (k, m)));
     }
     s.clusters.sort_unstable();
+    s.clusters.dedup();
+    s.by_root.sort_unstable();
 
     s.original.clear();
     s.original.extend_from_slice(lines);
-    let mut start = 0;
+    let (mut start, mut pairs_at) = (0, 0);
     while start < s.clusters.len() {
         let root = s.clusters[start].0;
         let len = s.clusters[start..].partition_point(|&(r, _)| r == root);
         let members = &s.clusters[start..start + len];
         start += len;
+        let npairs = s.by_root[pairs_at..].partition_point(|&(r, _)| r == root);
+        let pairs = &s.by_root[pairs_at..pairs_at + npairs];
+        pairs_at += npairs;
         // Drop stubs: lines with both ends in this cluster.
         let stub = |l: usize| members.iter().filter(|&&(_, k)| ends[k].line == l).count() > 1;
         s.kept.clear();
@@ -274,11 +268,56 @@ pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerS
             ends,
             pts,
             &s.kept,
-            &s.pairs,
+            pairs.iter().map(|p| p.1),
             radius,
             &mut s.cands,
             &mut s.used,
         );
+    }
+}
+
+/// Into `pairs`: each pair `(k, m)`, `k < m`, of endpoints of different
+/// lines at most `radius` apart, found through cells one radius wide (see
+/// [`close_corners_with`]); `by_cell_buf` is scratch.
+fn find_pairs(
+    ends: &[End],
+    pts: &[Point],
+    radius: f64,
+    by_cell_buf: &mut Vec<((i64, i64), usize)>,
+    pairs: &mut Vec<(usize, usize)>,
+) {
+    let cell = |p: Point| ((p.x / radius).floor() as i64, (p.y / radius).floor() as i64);
+    by_cell_buf.clear();
+    by_cell_buf.extend(pts.iter().enumerate().map(|(k, &p)| (cell(p), k)));
+    by_cell_buf.sort_unstable();
+    let by_cell = &*by_cell_buf;
+    pairs.clear();
+    let (mut same_end, mut next_lo, mut next_end) = (0, 0, 0);
+    for (i, &((cx, cy), k)) in by_cell.iter().enumerate() {
+        let upto = |mut at: usize, last: (i64, i64)| {
+            while by_cell.get(at).is_some_and(|&(c, _)| c <= last) {
+                at += 1;
+            }
+            at
+        };
+        same_end = upto(same_end.max(i + 1), (cx, cy.saturating_add(1)));
+        let next = match cx.checked_add(1) {
+            Some(nx) => {
+                let first = (nx, cy.saturating_sub(1));
+                while by_cell.get(next_lo).is_some_and(|&(c, _)| c < first) {
+                    next_lo += 1;
+                }
+                next_end = upto(next_end.max(next_lo), (nx, cy.saturating_add(1)));
+                &by_cell[next_lo..next_end]
+            }
+            None => &[],
+        };
+        for &(_, m) in by_cell[i + 1..same_end].iter().chain(next) {
+            let (k, m) = (k.min(m), k.max(m));
+            if ends[m].line != ends[k].line && pts[k].dist(pts[m]) <= radius {
+                pairs.push((k, m));
+            }
+        }
     }
 }
 
@@ -333,13 +372,13 @@ fn close_pairs(
     ends: &[End],
     pts: &[Point],
     kept: &[usize],
-    pairs: &[(usize, usize)],
+    pairs: impl Iterator<Item = (usize, usize)>,
     radius: f64,
     cands: &mut Vec<(f64, usize, usize, Point)>,
     used: &mut Vec<usize>,
 ) {
     cands.clear();
-    for &(k, m) in pairs {
+    for (k, m) in pairs {
         if !kept.contains(&k) || !kept.contains(&m) {
             continue;
         }
@@ -534,5 +573,43 @@ mod tests {
         assert!(fwd[1].b.dist(fwd[2].a) < 1e-9);
         assert!(fwd[2].b.dist(fwd[3].a) < 1e-9);
         assert!(fwd[3].b.dist(fwd[0].a) < 1e-9);
+    }
+
+    #[test]
+    fn the_cell_sweep_finds_every_close_pair() {
+        let mut rng = crate::rng::SplitMix64::new(7);
+        let (mut by_cell, mut pairs) = (Vec::new(), Vec::new());
+        let mut found = 0;
+        for round in 0..30 {
+            let radius = [5.0, 3.0, 0.7][round % 3];
+            // Endpoints crowded into a small square (many per cell, cells
+            // on both sides of 0) and a few spread far.
+            let n = 40 + round * 7;
+            let pts: Vec<Point> = (0..n)
+                .map(|k| {
+                    let span = if k % 9 == 0 { 1.0e4 } else { 20.0 };
+                    Point::new(rng.range(-span, span), rng.range(-span, span))
+                })
+                .collect();
+            let ends: Vec<End> = (0..n)
+                .map(|k| End {
+                    line: k / 2,
+                    b: k % 2 == 1,
+                })
+                .collect();
+            find_pairs(&ends, &pts, radius, &mut by_cell, &mut pairs);
+            pairs.sort_unstable();
+            let mut want = Vec::new();
+            for k in 0..n {
+                for m in k + 1..n {
+                    if ends[k].line != ends[m].line && pts[k].dist(pts[m]) <= radius {
+                        want.push((k, m));
+                    }
+                }
+            }
+            assert_eq!(pairs, want, "round {round}");
+            found += want.len();
+        }
+        assert!(found > 1000, "{found} pairs");
     }
 }

@@ -81,6 +81,9 @@ pub fn samples(images: &[GreyImage], s: &Segment, out: &mut Vec<Sample>) -> f64 
     if !(len.is_finite() && len > 0.0) {
         return 0.0;
     }
+    if images.len() == 1 && first.valid_mask().is_none() {
+        return samples_of_one(first, s, len, out);
+    }
     let (mut mag, mut counted) = (0.0, 0usize);
     let (dx, dy) = ((s.b.x - s.a.x) / len, (s.b.y - s.a.y) / len);
     let c2 = ALIGN_DEG.to_radians().cos().powi(2);
@@ -135,6 +138,70 @@ pub fn samples(images: &[GreyImage], s: &Segment, out: &mut Vec<Sample>) -> f64 
         });
     }
     // (Sobel's sum is 8 times the slope.)
+    if counted > 0 {
+        mag / (8.0 * counted as f64)
+    } else {
+        0.0
+    }
+}
+
+/// `v.round()` as a whole number, for `-1 < v < 2⁶²` (the library's
+/// `round` is a call without SSE 4.1): the truncation, moved away from 0
+/// when the remainder (exact) is at least a half.
+fn round_small(v: f64) -> i64 {
+    let t = v as i64;
+    let r = v - t as f64;
+    t + i64::from(r >= 0.5) - i64::from(r <= -0.5)
+}
+
+/// [`samples`] on one image without invalid pixels, `len` the length of
+/// `s` (finite, positive): the same samples, read with one bounds test a
+/// sample.
+fn samples_of_one(img: &GreyImage, s: &Segment, len: f64, out: &mut Vec<Sample>) -> f64 {
+    let (w, h) = img.size();
+    let d = img.data();
+    let (mut mag, mut counted) = (0.0, 0usize);
+    let (dx, dy) = ((s.b.x - s.a.x) / len, (s.b.y - s.a.y) / len);
+    let c2 = ALIGN_DEG.to_radians().cos().powi(2);
+    let n = len.ceil().max(1.0);
+    let (wf, hf) = (w as f64, h as f64);
+    // Each sample is written in place (no call in the loop keeps the sums
+    // in registers); `Unknown` stays where there is no evidence.
+    out.resize(n as usize, Sample::Unknown);
+    for (k, o) in out.iter_mut().enumerate() {
+        let t = (k as f64 + 0.5) / n * len;
+        let (x, y) = (s.a.x + dx * t, s.a.y + dy * t);
+        // Rounded into `1..w - 1` only from within `(-1, w + 1)`.
+        if !(x > -1.0 && y > -1.0 && x < wf + 1.0 && y < hf + 1.0) {
+            continue;
+        }
+        let (x, y) = (round_small(x), round_small(y));
+        if !(x >= 1 && y >= 1 && x < w as i64 - 1 && y < h as i64 - 1) {
+            continue;
+        }
+        let at = y as usize * w + x as usize;
+        let (Some(r0), Some(r1), Some(r2)) = (
+            d.get(at - w - 1..at - w + 2),
+            d.get(at - 1..at + 2),
+            d.get(at + w - 1..at + w + 2),
+        ) else {
+            continue;
+        };
+        let p = |r: &[u8], i: usize| i32::from(r[i]);
+        let gx = p(r0, 2) + 2 * p(r1, 2) + p(r2, 2) - p(r0, 0) - 2 * p(r1, 0) - p(r2, 0);
+        let gy = p(r2, 0) + 2 * p(r2, 1) + p(r2, 2) - p(r0, 0) - 2 * p(r0, 1) - p(r0, 2);
+        let (gx, gy) = (f64::from(gx), f64::from(gy));
+        let g2 = gx * gx + gy * gy;
+        mag += g2.sqrt();
+        counted += 1;
+        let across = -gx * dy + gy * dx;
+        // (`&`, not `&&`: no branch on a sample that texture makes random.)
+        *o = if (g2 > 0.0) & (across * across >= c2 * g2) {
+            Sample::Aligned
+        } else {
+            Sample::Across
+        };
+    }
     if counted > 0 {
         mag / (8.0 * counted as f64)
     } else {
@@ -240,13 +307,19 @@ pub fn keep_aligned(
         }
         let counted = v.iter().filter(|x| **x != Sample::Unknown).count();
         let aligned = v.iter().filter(|x| **x == Sample::Aligned).count();
-        if counted == 0
+        if counted == 0 {
+            out.push(*s);
+            continue;
+        }
+        parts(v, min, ps);
+        // A line that is one part from end to end is kept whole either way:
+        // the test against chance (a logarithm a term) is left unread.
+        if ps.as_slice() == [(0.0, 1.0)]
             || super::nfa::log10_binomial_tail(counted, aligned, 0.25) <= LOG10_SIGNIFICANT
         {
             out.push(*s);
             continue;
         }
-        parts(v, min, ps);
         for &(t0, t1) in ps.iter() {
             if t0 == 0.0 && t1 == 1.0 {
                 out.push(*s);

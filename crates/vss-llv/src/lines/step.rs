@@ -56,7 +56,8 @@ pub fn mean_profile(img: &GreyImage, s: &Segment) -> Option<[f64; 2 * REACH + 1]
         if !(x >= 0.0 && y >= 0.0 && x < w as f64 - 1.0 && y < h as f64 - 1.0) {
             return None;
         }
-        let (x0, y0) = (x.floor() as usize, y.floor() as usize);
+        // (Truncation is the floor here, without a library call.)
+        let (x0, y0) = (x as usize, y as usize);
         if img.valid_mask().is_some()
             && !(img.is_valid(x0, y0)
                 && img.is_valid(x0 + 1, y0)
@@ -66,10 +67,15 @@ pub fn mean_profile(img: &GreyImage, s: &Segment) -> Option<[f64; 2 * REACH + 1]
             return None;
         }
         let (fx, fy) = (x - x0 as f64, y - y0 as f64);
-        let p = |u: usize, v: usize| f64::from(d[v * w + u]);
+        let i = y0 * w + x0;
+        let (Some(&[p00, p10]), Some(&[p01, p11])) = (d.get(i..i + 2), d.get(i + w..i + w + 2))
+        else {
+            return None;
+        };
+        let p = f64::from;
         Some(
-            (p(x0, y0) * (1.0 - fx) + p(x0 + 1, y0) * fx) * (1.0 - fy)
-                + (p(x0, y0 + 1) * (1.0 - fx) + p(x0 + 1, y0 + 1) * fx) * fy,
+            (p(p00) * (1.0 - fx) + p(p10) * fx) * (1.0 - fy)
+                + (p(p01) * (1.0 - fx) + p(p11) * fx) * fy,
         )
     };
     let mut sum = [0.0; 2 * REACH + 1];
