@@ -611,30 +611,7 @@ pub fn rerun(
 mod tests {
     use super::*;
 
-    /// A bright square on a dark ground, anti-aliased by 4 × 4 supersampling.
-    fn square(w: usize, h: usize) -> GreyImage {
-        let (x0, y0, x1, y1) = (
-            w as f64 * 0.3 + 0.3,
-            h as f64 * 0.25 + 0.1,
-            w as f64 * 0.7,
-            h as f64 * 0.75 - 0.2,
-        );
-        let mut d = Vec::with_capacity(w * h);
-        for y in 0..h {
-            for x in 0..w {
-                let mut c = 0;
-                for sy in 0..4 {
-                    for sx in 0..4 {
-                        let px = x as f64 - 0.5 + (sx as f64 + 0.5) / 4.0;
-                        let py = y as f64 - 0.5 + (sy as f64 + 0.5) / 4.0;
-                        c += u32::from(px >= x0 && px < x1 && py >= y0 && py < y1);
-                    }
-                }
-                d.push((40 + c * 150 / 16) as u8);
-            }
-        }
-        GreyImage::new(w, h, d).unwrap()
-    }
+    use crate::lines::draw::tests::square;
 
     #[test]
     fn a_square_gives_four_lines() {
@@ -646,6 +623,19 @@ mod tests {
             assert!(l.length() > 40.0 && l.residual < 0.1, "{l:?}");
         }
         assert_eq!(out.params, Params::default());
+    }
+
+    /// With `lines.draw` the whole pipeline gives the square's four lines.
+    #[test]
+    fn a_square_gives_four_lines_when_drawn() {
+        let img = square(128, 128);
+        let mut p = Params::default();
+        p.lines.draw = true;
+        let out = run(&Input::single(&img), &p).unwrap();
+        assert_eq!(out.lines.len(), 4, "{:#?}", out.lines);
+        for l in &out.lines {
+            assert!(l.length() > 40.0 && l.residual < 0.1, "{l:?}");
+        }
     }
 
     #[test]

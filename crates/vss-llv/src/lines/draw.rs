@@ -24,8 +24,8 @@
 //!   both trackers followed it, and CONNECT merges the two (a mask shared
 //!   by both responses lost recall: F 0.737 against 0.741, docs/performance.md).
 //! - **Pieces**: a least-squares line `u = a + b v` grows with the chain;
-//!   once it has [`CUT_AFTER`] points, [`CUT_RUN`] points in a row more
-//!   than [`CUT_DISTANCE`] px from it end the piece, and the next starts
+//!   once it has `CUT_AFTER` points, `CUT_RUN` points in a row more
+//!   than `CUT_DISTANCE` px from it end the piece, and the next starts
 //!   at them (ELSED's rule). In a noisy image (`edges.noisy_sigma`, which
 //!   also widens the kernel) "off" is also beyond 3 RMS residuals of the
 //!   piece, as the tracker's stray test: a faint edge at σ 10 scatters
@@ -464,4 +464,4 @@ fn cut(chain: &[TrackPoint], noisy: bool, out: &mut Vec<std::ops::Range<usize>>)
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -3,10 +3,10 @@ use crate::ScanDir;
 use crate::edges::{PeakMap, PeakScratch, Starts, detect_into, response};
 use crate::image::GreyImage;
 use crate::params::Params;
-use crate::pipeline::{Input, run};
 
-/// A bright square on a dark ground, anti-aliased by 4 × 4 supersampling.
-fn square(w: usize, h: usize) -> GreyImage {
+/// A bright square on a dark ground, anti-aliased by 4 × 4 supersampling
+/// (the pipeline's tests use it too).
+pub(crate) fn square(w: usize, h: usize) -> GreyImage {
     let (x0, y0, x1, y1) = (
         w as f64 * 0.3 + 0.3,
         h as f64 * 0.25 + 0.1,
@@ -95,19 +95,6 @@ fn the_sides_of_a_square_are_drawn() {
         );
     }
     assert!(segs.len() <= 8, "{segs:#?}");
-}
-
-/// With `lines.draw` the whole pipeline gives the square's four lines.
-#[test]
-fn a_square_gives_four_lines_when_drawn() {
-    let img = square(128, 128);
-    let mut p = Params::default();
-    p.lines.draw = true;
-    let out = run(&Input::single(&img), &p).unwrap();
-    assert_eq!(out.lines.len(), 4, "{:#?}", out.lines);
-    for l in &out.lines {
-        assert!(l.length() > 40.0 && l.residual < 0.1, "{l:?}");
-    }
 }
 
 /// A chain that turns by 45° is cut where it turns.
