@@ -8,7 +8,7 @@
 //! afterwards for each scene. Printed by `cargo test --test accuracy
 //! lightings:: -- --nocapture`.
 
-use super::default_params;
+use super::{default_params, lighting_gain};
 use vss::llv::pipeline::{Input, run};
 use vss::llv::rng::mix;
 use vss::llv::{GreyImage, Segment};
@@ -29,16 +29,11 @@ fn yard_lightings(noise: YardNoise) -> (Metrics, Metrics, [Metrics; 3]) {
     let mut singles: [Tally; 3] = Default::default();
     for (k, c) in yard_cases(&cfg).iter().enumerate() {
         let (w, h) = (c.scene.width, c.scene.height);
-        let wf = w as f64;
-        let ramp = |x: f64| 0.35 + 0.65 * ((x / wf - 0.4) / 0.2).clamp(0.0, 1.0);
-        let gains: [&dyn Fn(usize) -> f64; 3] = [&|_| 0.7, &|x| ramp(x as f64), &|x| {
-            ramp(wf - 1.0 - x as f64)
-        }];
-        let lit: Vec<GreyImage> = gains
-            .iter()
-            .enumerate()
-            .map(|(l, gain)| {
-                let v: Vec<f64> = (0..w * h).map(|i| c.blurred[i] * gain(i % w)).collect();
+        let lit: Vec<GreyImage> = (0..3)
+            .map(|l| {
+                let v: Vec<f64> = (0..w * h)
+                    .map(|i| c.blurred[i] * lighting_gain(l, w, i % w))
+                    .collect();
                 c.scene
                     .expose(&v, noise, mix(k as u64, 0x11_0000 + l as u64))
             })

@@ -20,3 +20,17 @@ fn default_params() -> vss::llv::Params {
         Err(e) => panic!("the default profile does not load: {e}"),
     }
 }
+
+/// The gain at column `x` of an image `w` px wide under lighting `l` of
+/// the lightings tests (`real::three_…`, `lightings::`): 0 dimmed to 70 %;
+/// 1 a shadow to 35 % over the left half through a ramp a fifth of the
+/// width wide; 2 the same from the right.
+fn lighting_gain(l: usize, w: usize, x: usize) -> f64 {
+    let wf = w as f64;
+    let ramp = |x: f64| 0.35 + 0.65 * ((x / wf - 0.4) / 0.2).clamp(0.0, 1.0);
+    match l {
+        0 => 0.7,
+        1 => ramp(x as f64),
+        _ => ramp(wf - 1.0 - x as f64),
+    }
+}

@@ -148,23 +148,14 @@ fn lightings(sigma: Option<f64>) -> Lit {
         let img = read_photo(&ph.image).unwrap();
         let truth = read_truth(&ph.truth).unwrap();
         let (w, h) = img.size();
-        let wf = w as f64;
-        // 0.35 on the dark side, 1.0 on the lit side, a ramp a fifth of the
-        // width wide across the middle.
-        let ramp = |x: f64| 0.35 + 0.65 * ((x / wf - 0.4) / 0.2).clamp(0.0, 1.0);
-        let gains: [&dyn Fn(usize) -> f64; 3] = [&|_| 0.7, &|x| ramp(x as f64), &|x| {
-            ramp(wf - 1.0 - x as f64)
-        }];
-        let lit: Vec<GreyImage> = gains
-            .iter()
-            .enumerate()
-            .map(|(l, gain)| {
+        let lit: Vec<GreyImage> = (0..3)
+            .map(|l| {
                 let mut rng = SplitMix64::new(mix(k as u64, l as u64));
                 let d = img.data();
                 let px = (0..w * h)
                     .map(|i| {
                         let n = sigma.map_or(0.0, |s| s * rng.gauss());
-                        (f64::from(d[i]) * gain(i % w) + n)
+                        (f64::from(d[i]) * super::lighting_gain(l, w, i % w) + n)
                             .round()
                             .clamp(0.0, 255.0) as u8
                     })
