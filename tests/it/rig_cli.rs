@@ -496,6 +496,8 @@ fn a_grabber_pulled_and_plugged_back_is_found_under_its_name() {
 fn kill_mid_grab(prof: &Path, session: &Path) {
     let mut p = base();
     p.grabber.timeout_ms = 30_000;
+    // Four blocks a frame: the stall comes after the first.
+    p.grabber.block = 4096;
     let dir = prof.parent().expect("the profile's folder");
     let stalled = write_profile(dir, "stalled.toml", &p);
     let (mut child, _, _) = start_stalled_grab(&stalled, session);
@@ -538,6 +540,13 @@ fn start_stalled_grab(
             Ok(n) => seen.extend_from_slice(&buf[..n]),
         }
     }
+    // A frame of one block would end before the stall, and the grab with
+    // it, racing whatever the test does next.
+    assert!(
+        !String::from_utf8_lossy(&seen).contains("(100%)"),
+        "the frame ended before the stall (the profile's frame is one block): {}",
+        String::from_utf8_lossy(&seen)
+    );
     (child, err, seen)
 }
 
