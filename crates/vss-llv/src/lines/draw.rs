@@ -22,16 +22,16 @@
 //!   and at a pixel a chain of its own response has drawn. Chains of the
 //!   other response may cross it: a diagonal edge is drawn on both, as
 //!   both trackers followed it, and CONNECT merges the two (a mask shared
-//!   by both responses lost recall: F 0.737 against 0.741, docs/performance.md).
+//!   by both responses lost recall; docs/performance.md).
 //! - **Pieces**: a least-squares line `u = a + b v` grows with the chain;
 //!   once it has `CUT_AFTER` points, `CUT_RUN` points in a row more
 //!   than `CUT_DISTANCE` px from it end the piece, and the next starts
 //!   at them (ELSED's rule). In a noisy image (`edges.noisy_sigma`, which
 //!   also widens the kernel) "off" is also beyond 3 RMS residuals of the
-//!   piece, as the tracker's stray test: a faint edge at σ 10 scatters
-//!   more than 1 px (yard σ 10: F 0.636 with the fixed 1 px, 0.811 with
-//!   it; applied to every photograph, most of them clean, it cost F
-//!   0.013). A piece shorter than `lines.min_length`
+//!   piece, as the tracker's stray test: a faint edge in strong noise
+//!   scatters more than 1 px, while on clean images the wider bound lets
+//!   pieces run round corners (docs/performance.md has the figures). A
+//!   piece shorter than `lines.min_length`
 //!   between its ends is dropped at once; the others go to `keep_pieces`.
 //! - Points carry the peak's parabolic subpixel position across the edge,
 //!   its response and noise sigmas, as the tracker's do.
