@@ -161,12 +161,9 @@ impl<'a> Plane<'a> {
     /// The point at `(u, v)`, image index `i` (`1 ≤ u < len_u − 1`).
     #[inline]
     fn point(&self, u: usize, v: usize, i: usize) -> TrackPoint {
-        let mag = |j: usize| {
-            let s = self.sums[j];
-            if s == NONE { 0.0 } else { f32::from(key(s)) }
-        };
-        let k0 = mag(i);
-        let d = subpixel(mag(i - self.step_u), k0, mag(i + self.step_u));
+        let at = |j: usize| mag(self.sums[j]);
+        let k0 = at(i);
+        let d = subpixel(at(i - self.step_u), k0, at(i + self.step_u));
         TrackPoint {
             u: f64::from(u as f32 + d),
             v: v as f64,
