@@ -403,28 +403,8 @@ mod tests {
             let g: Vec<i32> = (0..4).map(|_| next().rem_euclid(GAIN_ONE + 1)).collect();
             let (mut sum, mut neg, mut best) = (vec![0], vec![0], vec![0]);
             for i in 0..4 {
-                let rank = (MAX_RANK - i as i32) << 1;
-                if i == 0 {
-                    combine_row::<true, false>(
-                        &r[i..=i],
-                        &[0],
-                        g[i],
-                        rank,
-                        &mut sum,
-                        &mut neg,
-                        &mut best,
-                    );
-                } else {
-                    combine_row::<false, false>(
-                        &r[i..=i],
-                        &[0],
-                        g[i],
-                        rank,
-                        &mut sum,
-                        &mut neg,
-                        &mut best,
-                    );
-                }
+                let sums = (&mut sum[..], &mut neg[..]);
+                combine((i == 0, false), i, &r[i..=i], &[0], g[i], sums, &mut best);
             }
             let term = |i: usize| (i64::from(r[i].abs()) * i64::from(g[i])) >> GAIN_BITS;
             let of_sign = |down: bool| {
@@ -456,11 +436,10 @@ mod tests {
     #[test]
     fn sign_follows_the_strongest_image() {
         let (mut sum, mut neg, mut best) = (vec![0; 3], vec![0; 3], vec![0; 3]);
-        let rank = |i: i32| (MAX_RANK - i) << 1;
-        let one = GAIN_ONE;
-        let (r0, r1) = ([10, -3, 7], [-30, 1, -7]);
-        combine_row::<true, false>(&r0, &[0; 3], one, rank(0), &mut sum, &mut neg, &mut best);
-        combine_row::<false, false>(&r1, &[0; 3], one, rank(1), &mut sum, &mut neg, &mut best);
+        for (i, r) in [[10, -3, 7], [-30, 1, -7]].iter().enumerate() {
+            let sums = (&mut sum[..], &mut neg[..]);
+            combine((i == 0, false), i, r, &[0; 3], GAIN_ONE, sums, &mut best);
+        }
         assert_eq!((&sum[..], &neg[..]), (&[10, 1, 7][..], &[30, 3, 7][..]));
         // The sign of the strongest term; of the first of two as strong.
         let signs: Vec<bool> = best.iter().map(|b| b & 1 != 0).collect();
