@@ -14,6 +14,7 @@
 //! pass's peak test runs in plain code instead of AVX2 lanes. Under
 //! valgrind the AVX2 paths are not taken (its CPU lacks features they
 //! need): count instructions for the plain paths, time the machine's own.
+//! With `DRAW=1` the runs use the drawing front end (`lines.draw`).
 //!
 //! Stages: `pipeline` (edges, lines, CONNECT; no lens), `pipelinelens` (the
 //! same after lens correction from a precomputed map), `pipeline2` (no
@@ -83,6 +84,8 @@ fn main() {
     if stage == "pipeline2" {
         p.edges.threads = 2;
     }
+    // With DRAW=1 the drawing front end replaces the trackers.
+    p.lines.draw = std::env::var_os("DRAW").is_some();
     let a = p.edges.half_width as usize;
     let mut ws = Workspace::new();
     ws.run(&Input::single(&img), &p).expect("the scene runs");

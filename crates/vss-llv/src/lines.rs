@@ -540,26 +540,30 @@ const END_LEVEL_POINTS: usize = 32;
 /// runs on over noise peaks or the flank of the next edge for a scan line
 /// or two, and the edge itself ends where its response falls to half.
 fn trim_weak_ends(chain: &mut Vec<TrackPoint>, buf: &mut Vec<f32>) {
-    let half_level = |pts: &mut dyn Iterator<Item = &TrackPoint>, buf: &mut Vec<f32>| {
-        buf.clear();
-        buf.extend(pts.take(END_LEVEL_POINTS).map(|q| q.response.abs()));
-        if buf.is_empty() {
-            return 0.0;
-        }
-        let mid = buf.len() / 2;
-        0.5 * *buf.select_nth_unstable_by(mid, f32::total_cmp).1
-    };
-    let head = half_level(&mut chain.iter(), buf);
-    let drop_head = chain.iter().take_while(|q| q.response.abs() < head).count();
+    let drop_head = weak_run(chain.iter(), buf);
     chain.drain(..drop_head);
-    let tail = half_level(&mut chain.iter().rev(), buf);
-    let keep = chain.len()
-        - chain
-            .iter()
-            .rev()
-            .take_while(|q| q.response.abs() < tail)
-            .count();
+    let keep = chain.len() - weak_run(chain.iter().rev(), buf);
     chain.truncate(keep);
+}
+
+/// How many points from the end that `pts` starts at are below half the
+/// edge's level there ([`trim_weak_ends`]).
+fn weak_run<'a>(pts: impl Iterator<Item = &'a TrackPoint> + Clone, buf: &mut Vec<f32>) -> usize {
+    buf.clear();
+    buf.extend(pts.clone().take(END_LEVEL_POINTS).map(|q| q.response.abs()));
+    let Some(&first) = buf.first() else {
+        return 0;
+    };
+    // Mostly the end point itself is at the level: it is kept, and the
+    // median is not needed. Halving is monotone, so half the median is at
+    // most `first` exactly when more than `mid` of the magnitudes, halved,
+    // are (a NaN, last in `total_cmp`'s order, is never at most `first`).
+    let mid = buf.len() / 2;
+    if buf.iter().filter(|&&m| 0.5 * m <= first).count() > mid {
+        return 0;
+    }
+    let half = 0.5 * *buf.select_nth_unstable_by(mid, f32::total_cmp).1;
+    pts.take_while(|q| q.response.abs() < half).count()
 }
 
 /// The segment of a piece of track, if it passes the tests.

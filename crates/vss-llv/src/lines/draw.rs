@@ -150,12 +150,10 @@ impl<'a> Plane<'a> {
     /// and where there is no response).
     #[inline]
     fn signed_key(&self, i: usize, positive: bool) -> i16 {
+        // Negated for the negative polarity, a sum of the other sign is
+        // at most 0, and `NONE` (`i16::MIN`) stays itself: no branch.
         let s = self.sums[i];
-        if s == NONE || (s > 0) != positive {
-            0
-        } else {
-            key(s)
-        }
+        if positive { s } else { s.wrapping_neg() }.max(0)
     }
 
     /// The point at `(u, v)`, image index `i` (`1 ≤ u < len_u − 1`).

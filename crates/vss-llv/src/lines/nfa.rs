@@ -85,9 +85,9 @@ pub fn q(a: usize, z: f64) -> f64 {
 #[derive(Clone, Debug, Default)]
 pub struct Nfa {
     log10_tests: f64,
-    /// Per level, the noise sigmas and `p` of the per-line event (a fixed
-    /// array: no allocation per image).
-    levels: [(f32, f64); LEVELS.len() + 1],
+    /// Per level, the noise sigmas and the per-line event's `p` with the
+    /// logarithms the tail needs (a fixed array: no allocation per image).
+    levels: [(f32, Chance); LEVELS.len() + 1],
     count: usize,
 }
 
@@ -99,12 +99,29 @@ impl Nfa {
         let mut t = Nfa::default();
         let first = track_sigmas as f32;
         for z in std::iter::once(first).chain(LEVELS.iter().copied().filter(|&z| z > first)) {
-            t.levels[t.count] = (z, (window * q(a, f64::from(z))).min(1.0));
+            let p = (window * q(a, f64::from(z))).min(1.0);
+            t.levels[t.count] = (z, Chance::new(p));
             t.count += 1;
         }
         let px = (w.max(1) * h.max(1)) as f64;
         t.log10_tests = (2.0 * t.count as f64).log10() + 2.0 * px.log10();
         t
+    }
+
+    /// Per level, how many of `z` reach it (one pass over the points;
+    /// the levels ascend, so the counts descend).
+    fn counts(&self, z: &[f32]) -> [usize; LEVELS.len() + 1] {
+        let mut at = [f32::INFINITY; LEVELS.len() + 1];
+        for (a, l) in at.iter_mut().zip(&self.levels[..self.count]) {
+            *a = l.0;
+        }
+        let mut k = [0u32; LEVELS.len() + 1];
+        for &v in z {
+            for (k, &a) in k.iter_mut().zip(&at) {
+                *k += u32::from(v >= a);
+            }
+        }
+        k.map(|k| k as usize)
     }
 
     /// Whether a segment spanning `n` scan lines whose points have the
@@ -113,28 +130,40 @@ impl Nfa {
     /// (most edges are significant at their own level at once).
     pub fn significant(&self, n: usize, z: &[f32], log_eps: f64) -> bool {
         let need = log_eps - self.log10_tests;
-        self.levels[..self.count].iter().rev().any(|&(level, p)| {
-            let k = z.iter().filter(|&&v| v >= level).count();
-            dense(n, k) && log10_binomial_tail(n, k, p) <= need
-        })
+        let k = self.counts(z);
+        (0..self.count)
+            .rev()
+            .any(|j| dense(n, k[j]) && self.levels[j].1.tail_at_most(n, k[j], need))
     }
 
     /// `log10 NFA` of a segment spanning `n` scan lines whose points have
     /// the noise sigmas `z` (one point a scan line at most).
     pub fn log10_nfa(&self, n: usize, z: &[f32]) -> f64 {
         let mut best = 0f64;
-        for &(level, p) in &self.levels[..self.count] {
-            let k = z.iter().filter(|&&v| v >= level).count();
-            if dense(n, k) {
-                best = best.min(log10_binomial_tail(n, k, p));
+        let k = self.counts(z);
+        for (j, (_, c)) in self.levels[..self.count].iter().enumerate() {
+            if dense(n, k[j]) {
+                best = best.min(c.log10_tail(n, k[j]));
             }
         }
         self.log10_tests + best
     }
 }
 
-/// `ln n!`: exact below 16, Stirling's series above (error below 1e-9).
+/// `ln n!`: exact below 16, Stirling's series above (error below 1e-9);
+/// from a table made once below [`LN_FACTORIALS`].
 fn ln_factorial(n: usize) -> f64 {
+    static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
+    let t = TABLE.get_or_init(|| (0..LN_FACTORIALS).map(ln_factorial_of).collect());
+    t.get(n).copied().unwrap_or_else(|| ln_factorial_of(n))
+}
+
+/// The `ln n!` [`ln_factorial`] keeps in its table (scan lines of all
+/// but large images).
+const LN_FACTORIALS: usize = 2048;
+
+/// [`ln_factorial`], computed.
+fn ln_factorial_of(n: usize) -> f64 {
     if n < 16 {
         return (2..=n).map(|i| (i as f64).ln()).sum();
     }
@@ -143,33 +172,83 @@ fn ln_factorial(n: usize) -> f64 {
         - 1.0 / (360.0 * x * x * x)
 }
 
-/// `log10 Σ_{i ≥ k} C(n, i) pⁱ (1 − p)ⁿ⁻ⁱ`.
-pub fn log10_binomial_tail(n: usize, k: usize, p: f64) -> f64 {
-    if k == 0 || p >= 1.0 {
-        return 0.0;
-    }
-    if k > n || p.is_nan() || p <= 0.0 {
-        return f64::NEG_INFINITY;
-    }
-    if (k as f64) <= n as f64 * p {
-        // At or below the mean: the tail is at least about one half.
-        return 0.0;
-    }
-    let ln_first = ln_factorial(n) - ln_factorial(k) - ln_factorial(n - k)
-        + k as f64 * p.ln()
-        + (n - k) as f64 * (-p).ln_1p();
-    // The later terms fall geometrically: term(i + 1) / term(i) =
-    // (n − i) / (i + 1) · p / (1 − p) < 1 above the mean.
-    let odds = p / (1.0 - p);
-    let (mut sum, mut term) = (1.0f64, 1.0f64);
-    for i in k..n {
-        term *= (n - i) as f64 / (i + 1) as f64 * odds;
-        sum += term;
-        if term < sum * 1e-12 {
-            break;
+/// A per-line chance `p` with the logarithms of its binomial tail, made
+/// once per level rather than once per segment.
+#[derive(Clone, Copy, Debug, Default)]
+struct Chance {
+    p: f64,
+    ln_p: f64,
+    ln_q: f64,
+    odds: f64,
+}
+
+impl Chance {
+    fn new(p: f64) -> Self {
+        Chance {
+            p,
+            ln_p: p.ln(),
+            ln_q: (-p).ln_1p(),
+            odds: p / (1.0 - p),
         }
     }
-    (ln_first + sum.ln()) / std::f64::consts::LN_10
+
+    /// The tail's value where no sum is needed (`Err`), else the log of
+    /// its first term (`Ok`).
+    fn first_term(&self, n: usize, k: usize) -> Result<f64, f64> {
+        let p = self.p;
+        if k == 0 || p >= 1.0 {
+            return Err(0.0);
+        }
+        if k > n || p.is_nan() || p <= 0.0 {
+            return Err(f64::NEG_INFINITY);
+        }
+        if (k as f64) <= n as f64 * p {
+            // At or below the mean: the tail is at least about one half.
+            return Err(0.0);
+        }
+        Ok(ln_factorial(n) - ln_factorial(k) - ln_factorial(n - k)
+            + k as f64 * self.ln_p
+            + (n - k) as f64 * self.ln_q)
+    }
+
+    /// `log10 Σ_{i ≥ k} C(n, i) pⁱ (1 − p)ⁿ⁻ⁱ`, from the log of its first
+    /// term.
+    fn summed(&self, n: usize, k: usize, ln_first: f64) -> f64 {
+        // The later terms fall geometrically: term(i + 1) / term(i) =
+        // (n − i) / (i + 1) · p / (1 − p) < 1 above the mean.
+        let (mut sum, mut term) = (1.0f64, 1.0f64);
+        for i in k..n {
+            term *= (n - i) as f64 / (i + 1) as f64 * self.odds;
+            sum += term;
+            if term < sum * 1e-12 {
+                break;
+            }
+        }
+        (ln_first + sum.ln()) / std::f64::consts::LN_10
+    }
+
+    fn log10_tail(&self, n: usize, k: usize) -> f64 {
+        match self.first_term(n, k) {
+            Ok(ln_first) => self.summed(n, k, ln_first),
+            Err(v) => v,
+        }
+    }
+
+    /// `log10_tail(n, k) <= need`, without the sum where the first term
+    /// alone exceeds `need` (the sum is at least 1, and adding its
+    /// logarithm and dividing by `ln 10` cannot lower the value).
+    fn tail_at_most(&self, n: usize, k: usize, need: f64) -> bool {
+        match self.first_term(n, k) {
+            Ok(ln_first) if ln_first / std::f64::consts::LN_10 > need => false,
+            Ok(ln_first) => self.summed(n, k, ln_first) <= need,
+            Err(v) => v <= need,
+        }
+    }
+}
+
+/// `log10 Σ_{i ≥ k} C(n, i) pⁱ (1 − p)ⁿ⁻ⁱ`.
+pub fn log10_binomial_tail(n: usize, k: usize, p: f64) -> f64 {
+    Chance::new(p).log10_tail(n, k)
 }
 
 #[cfg(test)]
@@ -199,6 +278,35 @@ mod tests {
         assert_eq!(log10_binomial_tail(10, 0, 0.3), 0.0);
         assert_eq!(log10_binomial_tail(10, 11, 0.3), f64::NEG_INFINITY);
         assert_eq!(log10_binomial_tail(10, 2, 0.5), 0.0);
+    }
+
+    /// The shortcut of the significance test (no sum where the first
+    /// term already fails) decides as the whole tail does, and the table
+    /// of `ln n!` holds what the formula gives.
+    #[test]
+    fn the_tail_shortcut_decides_as_the_tail() {
+        for p in [1e-4, 0.003, 0.05, 0.3] {
+            let c = Chance::new(p);
+            for n in 1..90 {
+                for k in 0..=n {
+                    let full = c.log10_tail(n, k);
+                    for need in [-40.0, -12.5, -3.0, -0.5, 0.0] {
+                        assert_eq!(
+                            c.tail_at_most(n, k, need),
+                            full <= need,
+                            "{p} {n} {k} {need}"
+                        );
+                    }
+                }
+            }
+        }
+        for n in [0, 1, 15, 16, 639, LN_FACTORIALS - 1, LN_FACTORIALS, 5000] {
+            assert_eq!(
+                ln_factorial(n).to_bits(),
+                ln_factorial_of(n).to_bits(),
+                "{n}"
+            );
+        }
     }
 
     #[test]
