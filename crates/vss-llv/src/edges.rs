@@ -33,7 +33,7 @@ mod reference;
 pub(crate) mod row;
 
 pub use noise::{NoiseMap, NoiseScratch};
-pub use peaks::{PeakMap, PeakScratch, Starts, detect_into, peaks};
+pub use peaks::{PeakMap, PeakScratch, Starts, detect_into, detect_unmapped_into, peaks};
 
 /// The Lee kernel `φ'(t)` for `t = -A..=A` (index `t + A`), in `f32`.
 /// It sums to zero and a unit step gives a peak of `1 - 1/A²`.

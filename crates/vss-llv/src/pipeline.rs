@@ -15,7 +15,8 @@ use serde::Serialize;
 use super::connect::{ConnectScratch, connect_into};
 use super::corners::{CornerScratch, close_corners_with};
 use super::edges::{
-    NoiseMap, PeakMap, PeakScratch, Response, ResponseScratch, Starts, detect_into, response_into,
+    NoiseMap, PeakMap, PeakScratch, Response, ResponseScratch, Starts, detect_into,
+    detect_unmapped_into, response_into,
 };
 use super::image::GreyImage;
 use super::lens::{LensMap, correct_into};
@@ -504,7 +505,12 @@ impl Job<'_> {
                 )?,
             }
         }
-        if self.from <= Stage::Edges {
+        if self.from <= Stage::Edges && p.lines.draw {
+            // The drawing reads no peak map.
+            let s = &mut *o.s;
+            let (map, starts, peaks) = (&mut s.map, &mut s.starts, &mut s.peaks);
+            detect_unmapped_into(o.response, &p.edges, o.noise, map, o.edges, starts, peaks);
+        } else if self.from <= Stage::Edges {
             detect_into(
                 o.response,
                 &p.edges,
@@ -515,6 +521,8 @@ impl Job<'_> {
                 &mut o.s.starts,
                 &mut o.s.peaks,
             );
+        }
+        if self.from <= Stage::Edges {
             self.check_edge_count(&o)?;
             edges_us = micros(t);
         }

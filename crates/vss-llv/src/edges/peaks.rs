@@ -325,6 +325,26 @@ pub fn detect_into(
     points_into(resp, noise, p, Some(map), out, starts, s);
 }
 
+/// [`detect_into`] without the peak map, for the drawing front end
+/// (`lines.draw`), which does not read it: `map` is marked as holding no
+/// response, so that a tracker given it later makes its own.
+pub fn detect_unmapped_into(
+    resp: &Response,
+    p: &EdgeParams,
+    noise: &mut NoiseMap,
+    map: &mut PeakMap,
+    out: &mut EdgePoints,
+    starts: &mut Starts,
+    s: &mut PeakScratch,
+) {
+    let mut ns = std::mem::take(&mut s.noise);
+    noise.estimate_into(resp, &mut ns);
+    noise.bound(p.noise_percentile, p.noise_cap, &mut ns);
+    s.noise = ns;
+    (map.wpr, map.dir) = (0, None);
+    points_into(resp, noise, p, None, out, starts, s);
+}
+
 /// Edge points of a response given its noise map, in image order (row by
 /// row, left to right, for either direction).
 ///
@@ -418,10 +438,12 @@ fn regions(shape: Shape, p: &EdgeParams) -> (impl Fn(&Peak) -> usize + Copy, usi
     let rl = p.region_lines.max(1) as usize;
     let m = p.per_region.max(1) as usize;
     let region = move |c: &Peak| -> usize {
-        match dir {
-            ScanDir::Horizontal => usize::from(c.y) / rl,
-            ScanDir::Vertical => usize::from(c.x) / rl,
-        }
+        let at = match dir {
+            ScanDir::Horizontal => usize::from(c.y),
+            ScanDir::Vertical => usize::from(c.x),
+        };
+        // (No division for the default region of one scan line.)
+        if rl == 1 { at } else { at / rl }
     };
     let nreg = match dir {
         ScanDir::Horizontal => h.div_ceil(rl),

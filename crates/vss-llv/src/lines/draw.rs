@@ -159,6 +159,12 @@ impl<'a> Plane<'a> {
     /// The point at `(u, v)`, image index `i` (`1 ≤ u < len_u − 1`).
     #[inline]
     fn point(&self, u: usize, v: usize, i: usize) -> TrackPoint {
+        self.point_in(u, v, i, self.tile(u, v))
+    }
+
+    /// [`Plane::point`] with its tile known.
+    #[inline]
+    fn point_in(&self, u: usize, v: usize, i: usize, tile: usize) -> TrackPoint {
         let at = |j: usize| mag(self.sums[j]);
         let k0 = at(i);
         let d = subpixel(at(i - self.step_u), k0, at(i + self.step_u));
@@ -166,7 +172,7 @@ impl<'a> Plane<'a> {
             u: f64::from(u as f32 + d),
             v: v as f64,
             response: f32::from(self.sums[i]) * self.scale,
-            z: k0 * self.b.inv_sigma[self.tile(u, v)],
+            z: k0 * self.b.inv_sigma[tile],
             id: i,
         }
     }
@@ -174,9 +180,9 @@ impl<'a> Plane<'a> {
     /// The pixel drawn next on scan line `v`, around `u`: the strongest of
     /// `u − 1 ..= u + 1` of the polarity, moved to the peak of the ridge
     /// along the scan if a neighbour is stronger, if it passes the
-    /// tracking level (`(u, image index)`).
+    /// tracking level (`(u, image index, tile)`).
     #[inline]
-    fn step(&self, u: usize, v: usize, positive: bool) -> Option<(usize, usize)> {
+    fn step(&self, u: usize, v: usize, positive: bool) -> Option<(usize, usize, usize)> {
         if v >= self.lines || u < 1 || u + 1 >= self.len_u {
             return None;
         }
@@ -203,8 +209,8 @@ impl<'a> Plane<'a> {
                 break;
             }
         }
-        (i32::from(kb) > self.b.thr[self.tile(best, v)])
-            .then_some((best, base + best * self.step_u))
+        let tile = self.tile(best, v);
+        (i32::from(kb) > self.b.thr[tile]).then_some((best, base + best * self.step_u, tile))
     }
 }
 
@@ -382,12 +388,14 @@ fn draw_half(
                 break;
             }
         }
-        let Some(((np, i), nv)) = found else { break };
+        let Some(((np, i, tile), nv)) = found else {
+            break;
+        };
         if drawn[i] & own != 0 {
             break;
         }
         drawn[i] |= own;
-        let q = pl.point(np, nv, i);
+        let q = pl.point_in(np, nv, i, tile);
         (pix, u, v) = (np, q.u, nv);
         list.push(q);
     }
@@ -408,7 +416,6 @@ fn slope(list: &[TrackPoint], u: f64, v: usize) -> f64 {
 /// The straight pieces of a chain (module doc), as ranges into `chain`;
 /// `noisy`: the image is, and the piece's own scatter widens the limit.
 fn cut(chain: &[TrackPoint], noisy: bool, out: &mut Vec<std::ops::Range<usize>>) {
-    let scatter = if noisy { STRAY_SCATTER_SQ } else { 0.0 };
     out.clear();
     let Some(o) = chain.first() else { return };
     let (u0, v0) = (o.u, o.v);
@@ -435,8 +442,12 @@ fn cut(chain: &[TrackPoint], noisy: bool, out: &mut Vec<std::ops::Range<usize>>)
             };
             let a = (f[2] - b * f[1]) / f[0];
             let d = (q.u - u0 - a - b * (q.v - v0)).abs();
-            let rss = (f[5] - a * f[2] - b * f[4]).max(0.0);
-            let lim = (CUT_DISTANCE * CUT_DISTANCE).max(scatter * rss / f[0]);
+            let lim = if noisy {
+                let rss = (f[5] - a * f[2] - b * f[4]).max(0.0);
+                (CUT_DISTANCE * CUT_DISTANCE).max(STRAY_SCATTER_SQ * rss / f[0])
+            } else {
+                CUT_DISTANCE * CUT_DISTANCE
+            };
             if d * d > lim * (1.0 + b * b) {
                 run += 1;
                 if run >= CUT_RUN {

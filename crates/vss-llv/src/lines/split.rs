@@ -44,7 +44,13 @@ impl SplitScratch {
 pub fn pieces(chain: &[TrackPoint], trim: usize, s: &mut SplitScratch) {
     s.ranges.clear();
     s.pre.clear();
+    s.stack.clear();
     let Some(o) = chain.first() else { return };
+    if chain.len() < 2 * trim + 2 * MIN_PIECE {
+        // Too short to split: no sums needed.
+        s.ranges.push(0..chain.len());
+        return;
+    }
     let mut acc = [0f64; 5];
     s.pre.push(acc);
     for q in chain {
@@ -55,11 +61,6 @@ pub fn pieces(chain: &[TrackPoint], trim: usize, s: &mut SplitScratch) {
         acc[3] += u * v;
         acc[4] += v * v;
         s.pre.push(acc);
-    }
-    s.stack.clear();
-    if chain.len() < 2 * trim + 2 * MIN_PIECE {
-        s.ranges.push(0..chain.len());
-        return;
     }
     s.stack.push(trim..chain.len() - trim);
     while let Some(r) = s.stack.pop() {

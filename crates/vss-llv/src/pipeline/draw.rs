@@ -30,3 +30,38 @@ impl Workspace {
         o.timings.lines_us += micros(t);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Input, Stage, Workspace};
+    use crate::GreyImage;
+    use crate::lines::draw::tests::square;
+    use crate::params::Params;
+
+    /// A drawn run makes no peak map, and leaves none that a tracker
+    /// could take for its image's: the trackers rerun on its edges give
+    /// what a full tracked run does, after a tracked run of another image
+    /// of the same size.
+    #[test]
+    fn a_tracker_after_a_drawn_run_makes_its_own_peak_map() {
+        let a = square(96, 80);
+        let shifted = (0..96 * 80).map(|i| a.data()[i - i % 96 + (i % 96 + 11) % 96]);
+        let b = GreyImage::new(96, 80, shifted.collect()).unwrap();
+        let tracked = Params::default();
+        let mut drawn = tracked.clone();
+        drawn.lines.draw = true;
+        let mut ws = Workspace::new();
+        ws.run(&Input::single(&a), &tracked).unwrap();
+        ws.run(&Input::single(&b), &drawn).unwrap();
+        let again = ws
+            .rerun(Stage::Lines, &Input::single(&b), &tracked)
+            .unwrap();
+        let full = Workspace::new()
+            .run(&Input::single(&b), &tracked)
+            .unwrap()
+            .clone();
+        assert_eq!(again.timings.edges_us, 0);
+        assert_eq!(again.lines_raw, full.lines_raw);
+        assert_eq!(full.lines_raw.len(), 4, "{:#?}", full.lines_raw);
+    }
+}
