@@ -407,7 +407,9 @@ fn follow<P: Peaks>(
         t.chain.extend(t.back.iter().rev());
         t.chain.push(seed_point);
         t.chain.extend(t.fwd.iter());
-        keep_pieces(t, trim, p, nfa, min_angle, vertical, out);
+        let chain = std::mem::take(&mut t.chain);
+        keep_pieces(&chain, t, trim, p, nfa, min_angle, vertical, out);
+        t.chain = chain;
     }
 }
 
@@ -508,8 +510,10 @@ fn walk<P: Peaks>(
 
 /// Splits a track (points in scan-line order) where it joins two edges and
 /// keeps the pieces that pass the tests of the module doc.
+/// `t` gives the buffers (its `chain` is not read).
 #[allow(clippy::too_many_arguments)]
 fn keep_pieces(
+    chain: &[TrackPoint],
     t: &mut Tracks,
     trim: usize,
     p: &LineParams,
@@ -518,13 +522,13 @@ fn keep_pieces(
     vertical: bool,
     out: &mut Vec<Segment>,
 ) {
-    trim_weak_ends(&mut t.chain, &mut t.z);
-    if t.chain.len() < 2 {
+    let chain = trim_weak_ends(chain, &mut t.z);
+    if chain.len() < 2 {
         return;
     }
-    split::pieces(&t.chain, trim, &mut t.split);
+    split::pieces(chain, trim, &mut t.split);
     for r in t.split.ranges() {
-        let piece = &t.chain[r.clone()];
+        let piece = &chain[r.clone()];
         if let Some(s) = segment_of(piece, p, nfa, trim, min_angle, vertical, &mut t.z) {
             out.push(s);
         }
@@ -534,16 +538,14 @@ fn keep_pieces(
 /// Points near an end whose responses set the edge's level there.
 const END_LEVEL_POINTS: usize = 32;
 
-/// Drops the points at each end of a track whose response is below half
+/// A track less the points at each end whose response is below half
 /// the edge's level near that end (the median `|E|` of the
 /// [`END_LEVEL_POINTS`] points nearest it): where the edge ends, a track
 /// runs on over noise peaks or the flank of the next edge for a scan line
 /// or two, and the edge itself ends where its response falls to half.
-fn trim_weak_ends(chain: &mut Vec<TrackPoint>, buf: &mut Vec<f32>) {
-    let drop_head = weak_run(chain.iter(), buf);
-    chain.drain(..drop_head);
-    let keep = chain.len() - weak_run(chain.iter().rev(), buf);
-    chain.truncate(keep);
+fn trim_weak_ends<'a>(chain: &'a [TrackPoint], buf: &mut Vec<f32>) -> &'a [TrackPoint] {
+    let chain = &chain[weak_run(chain.iter(), buf)..];
+    &chain[..chain.len() - weak_run(chain.iter().rev(), buf)]
 }
 
 /// How many points from the end that `pts` starts at are below half the

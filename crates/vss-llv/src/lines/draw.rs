@@ -72,8 +72,8 @@ pub struct DrawDir<'a> {
 #[derive(Clone, Debug, Default)]
 pub struct DrawScratch {
     planes: [PlaneBufs; 2],
-    /// Per pixel, a bit per response: drawn by a chain on it.
-    drawn: Vec<u8>,
+    /// Per response, the pixels a chain on it has drawn.
+    drawn: [Drawn; 2],
     /// Anchors packed `dir << 63 | v << 32 | u`, and per bucket counts.
     anchors: Vec<u64>,
     sorted: Vec<u64>,
@@ -162,8 +162,9 @@ impl<'a> Plane<'a> {
         self.point_in(u, v, i, self.tile(u, v))
     }
 
-    /// [`Plane::point`] with its tile known.
-    #[inline]
+    /// [`Plane::point`] with its tile known (inlined: built in place, a
+    /// point returned through the stack stalled its copy into the list).
+    #[inline(always)]
     fn point_in(&self, u: usize, v: usize, i: usize, tile: usize) -> TrackPoint {
         let at = |j: usize| mag(self.sums[j]);
         let k0 = at(i);
@@ -238,8 +239,9 @@ pub fn draw_into(
         Plane::new(&v, floor, p.track_sigmas, bv),
     ];
     anchors(h, v, &planes, s);
-    s.drawn.clear();
-    s.drawn.resize(w * ht, 0);
+    for (d, pl) in s.drawn.iter_mut().zip(&planes) {
+        d.reset(pl.len_u, pl.lines);
+    }
     let nfa = Nfa::new(w, ht, half_width, p.search_width, p.track_sigmas);
     let min_angle = p.min_scan_angle_deg.to_radians();
     let min_sq = p.min_length * p.min_length * (1.0 - 1e-9);
@@ -250,33 +252,14 @@ pub fn draw_into(
         let (u, line) = ((a & 0xFFFF_FFFF) as usize, (a >> 32 & 0x7FFF_FFFF) as usize);
         let pl = &planes[usize::from(vertical)];
         let i = u * pl.step_u + line * pl.step_v;
-        let own = 1u8 << u8::from(vertical);
-        if s.drawn[i] & own != 0 {
+        let drawn = &mut s.drawn[usize::from(vertical)];
+        if drawn.take(u, line) {
             continue;
         }
-        s.drawn[i] |= own;
         let seed = pl.point(u, line, i);
         let positive = seed.response > 0.0;
-        draw_half(
-            pl,
-            (u, line),
-            1,
-            positive,
-            gap,
-            own,
-            &mut s.drawn,
-            &mut s.fwd,
-        );
-        draw_half(
-            pl,
-            (u, line),
-            -1,
-            positive,
-            gap,
-            own,
-            &mut s.drawn,
-            &mut s.back,
-        );
+        draw_half(pl, (u, line), 1, positive, gap, drawn, &mut s.fwd);
+        draw_half(pl, (u, line), -1, positive, gap, drawn, &mut s.back);
         s.chain.clear();
         s.chain.extend(s.back.iter().rev());
         s.chain.push(seed);
@@ -291,9 +274,16 @@ pub fn draw_into(
                 continue;
             }
             let t = &mut s.tracks;
-            t.chain.clear();
-            t.chain.extend_from_slice(piece);
-            keep_pieces(t, half_width, p, Some(&nfa), min_angle, vertical, out);
+            keep_pieces(
+                piece,
+                t,
+                half_width,
+                p,
+                Some(&nfa),
+                min_angle,
+                vertical,
+                out,
+            );
         }
     }
     s.sorted = sorted;
@@ -351,16 +341,14 @@ fn mag(s: i16) -> f32 {
 }
 
 /// Draws from the anchor at `at` in direction `dir` (+1 or −1 scan
-/// lines) into `list`; `own` is the response's bit of `drawn`.
-#[allow(clippy::too_many_arguments)]
+/// lines) into `list`; `drawn` is the response's.
 fn draw_half(
     pl: &Plane,
     at: (usize, usize),
     dir: i64,
     positive: bool,
     gap: usize,
-    own: u8,
-    drawn: &mut [u8],
+    drawn: &mut Drawn,
     list: &mut Vec<TrackPoint>,
 ) {
     list.clear();
@@ -391,13 +379,40 @@ fn draw_half(
         let Some(((np, i, tile), nv)) = found else {
             break;
         };
-        if drawn[i] & own != 0 {
+        if drawn.take(np, nv) {
             break;
         }
-        drawn[i] |= own;
         let q = pl.point_in(np, nv, i, tile);
         (pix, u, v) = (np, q.u, nv);
         list.push(q);
+    }
+}
+
+/// The pixels of one response drawn by its chains, a bit each, scan
+/// line by scan line (a few dozen kilobytes: a step's test stays in
+/// cache).
+#[derive(Clone, Debug, Default)]
+struct Drawn {
+    /// Words a scan line.
+    wpl: usize,
+    bits: Vec<u64>,
+}
+
+impl Drawn {
+    /// None drawn, on `lines` scan lines of `len_u` pixels.
+    fn reset(&mut self, len_u: usize, lines: usize) {
+        self.wpl = len_u.div_ceil(64);
+        self.bits.clear();
+        self.bits.resize(self.wpl * lines, 0);
+    }
+
+    /// Whether `(u, v)` was drawn; it is now.
+    #[inline]
+    fn take(&mut self, u: usize, v: usize) -> bool {
+        let (w, b) = (&mut self.bits[v * self.wpl + u / 64], 1u64 << (u % 64));
+        let was = *w & b != 0;
+        *w |= b;
+        was
     }
 }
 
