@@ -389,7 +389,7 @@ fn draw_half(
 }
 
 /// The pixels of one response drawn by its chains, a bit each, scan
-/// line by scan line (a few dozen kilobytes: a step's test stays in
+/// line by scan line (small enough that a step's test stays in
 /// cache).
 #[derive(Clone, Debug, Default)]
 struct Drawn {
