@@ -42,6 +42,20 @@
 //! above ρ may still be shading's, not the line's: what counts is the
 //! gradient along the line less the shading beside it
 //! ([`super::step`]).
+//!
+//! Under twice ρ a line needs more than that, because a faint straight
+//! edge that nobody would draw (a door's panel line, wood grain, a tile
+//! seam, texture a track ran along) has the same gradient as a faint edge
+//! that matters:
+//! - The shorter the line, the more gradient: its mean over `L` samples is
+//!   as much evidence as `√L` samples' worth, so below [`SHORT`] px the bound
+//!   is `ρ √(SHORT / L)` (at most twice ρ). Long faint edges keep ρ.
+//! - Just above ρ ([`MARGINAL`]), the profile across it must be one step
+//!   ([`super::step::step_share`] at least [`MIN_STEP_SHARE`]), not a thin
+//!   ridge or valley.
+//! - A line shorter than [`SHORT`] px whose step across it changes sign
+//!   along it ([`super::step::Across::steady`] under [`MIN_STEADY`]) follows
+//!   texture, not an edge.
 
 use crate::{GreyImage, Point, Segment};
 
@@ -56,6 +70,44 @@ pub const LOG10_SIGNIFICANT: f64 = -5.0;
 /// [`min_slope`]: one grey level of quantisation over `sin ALIGN_DEG`.
 pub fn min_slope() -> f64 {
     1.0 / ALIGN_DEG.to_radians().sin()
+}
+
+/// Below this length (px) a faint line needs a gradient above ρ
+/// (module doc).
+pub const SHORT: f64 = 100.0;
+/// Under this many ρ a line's profile must be one step (module doc).
+pub const MARGINAL: f64 = 1.15;
+/// Least [`super::step::step_share`] of a line under [`MARGINAL`] ρ.
+pub const MIN_STEP_SHARE: f64 = 0.3;
+/// Least [`super::step::Across::steady`] of a faint line shorter than
+/// [`SHORT`].
+pub const MIN_STEADY: f64 = 0.3;
+
+/// The least mean gradient of a line `len` px long under twice ρ
+/// (module doc): `ρ √(SHORT / len)`, between ρ and 2 ρ.
+pub fn min_slope_of_length(len: f64) -> f64 {
+    let q = if len > 0.0 {
+        (SHORT / len).sqrt().clamp(1.0, 2.0)
+    } else {
+        2.0
+    };
+    q * min_slope()
+}
+
+/// Whether a line of mean gradient `g` (ρ ≤ `g` < 2 ρ) and length `len`,
+/// with `across` it ([`super::step::across`]; `None`: no evidence), is
+/// kept (module doc).
+pub fn faint_line_kept(g: f64, len: f64, across: Option<super::step::Across>) -> bool {
+    let rho = min_slope();
+    if g < min_slope_of_length(len) {
+        return false;
+    }
+    let Some(a) = across else {
+        return true;
+    };
+    g - a.shading >= rho
+        && (g >= MARGINAL * rho || a.step_share >= MIN_STEP_SHARE)
+        && (len >= SHORT || a.steady >= MIN_STEADY)
 }
 
 /// Non-aligned samples in a row that a part may hold.
@@ -296,13 +348,15 @@ pub fn keep_aligned(
     let AlignScratch { v, ps, out } = scratch;
     out.clear();
     for s in lines.iter() {
-        // The shading beside a line is read only where it can decide: at
-        // twice ρ, the image beside the line would have to slope at half
+        // The profiles across a line are read only where they can decide:
+        // at twice ρ, the image beside the line would have to slope at half
         // the line's own gradient on both sides, a blurred edge's shape
         // rather than shading's.
         let g = samples(images, s, v);
-        let shading = || super::step::least_shading(images, s).unwrap_or(0.0);
-        if g < min_slope() || (g < 2.0 * min_slope() && g - shading() < min_slope()) {
+        if g < min_slope()
+            || (g < 2.0 * min_slope()
+                && !faint_line_kept(g, s.length(), super::step::across(images, s)))
+        {
             continue;
         }
         let counted = v.iter().filter(|x| **x != Sample::Unknown).count();
@@ -416,6 +470,91 @@ mod tests {
         let mut lines = vec![s];
         keep_aligned(&[img], &mut lines, 0.9, 8.0, &mut AlignScratch::default());
         assert!(lines.is_empty(), "{lines:?}");
+    }
+
+    /// A 64 × 160 image whose grey level at `(x, y)` is `f(x, y)`.
+    fn tall(f: &dyn Fn(usize, usize) -> u8) -> GreyImage {
+        let (w, h) = (64, 160);
+        GreyImage::new(w, h, (0..w * h).map(|i| f(i % w, i / w)).collect()).unwrap()
+    }
+
+    fn kept(img: &GreyImage, s: Segment) -> bool {
+        let mut lines = vec![s];
+        keep_aligned(
+            std::slice::from_ref(img),
+            &mut lines,
+            0.9,
+            8.0,
+            &mut AlignScratch::default(),
+        );
+        lines == vec![s]
+    }
+
+    /// 6 grey levels on even rows, 5 on odd ones: a Sobel gradient of 2.75
+    /// grey levels a pixel at every row, just above ρ.
+    fn faint(y: usize) -> u8 {
+        100 - 6 + (y % 2) as u8
+    }
+
+    #[test]
+    fn a_short_faint_line_needs_more_gradient_than_a_long_one() {
+        let step = tall(&|x, y| if x < 32 { 100 } else { faint(y) });
+        let mut v = Vec::new();
+        let long = line(32.0, 5.0, 32.0, 150.0);
+        let g = samples(std::slice::from_ref(&step), &long, &mut v);
+        assert!((g - 2.75).abs() < 1e-9 && g < MARGINAL * min_slope(), "{g}");
+        assert!(kept(&step, long));
+        // A piece of it 40 px long: as steep, and as clean a step.
+        assert!(!kept(&step, line(32.0, 5.0, 32.0, 45.0)));
+        assert!(min_slope_of_length(40.0) > g);
+        assert_eq!(min_slope_of_length(SHORT), min_slope());
+        assert_eq!(min_slope_of_length(1.0), 2.0 * min_slope());
+    }
+
+    #[test]
+    fn a_thin_valley_as_faint_as_an_edge_is_dropped() {
+        // Two columns darker: the same Sobel gradient at the line as the
+        // faint step above, but no step across it.
+        let valley = tall(&|x, y| if (32..34).contains(&x) { faint(y) } else { 100 });
+        let s = line(32.0, 5.0, 32.0, 150.0);
+        let mut v = Vec::new();
+        let g = samples(std::slice::from_ref(&valley), &s, &mut v);
+        assert!((g - 2.75).abs() < 1e-9, "{g}");
+        assert!(!kept(&valley, s));
+        // The same valley twice as deep is strong enough to be a line (a
+        // wire, a grout line).
+        let deep = tall(&|x, y| {
+            if (32..34).contains(&x) {
+                2 * faint(y) - 100
+            } else {
+                100
+            }
+        });
+        assert!(kept(&deep, s));
+    }
+
+    #[test]
+    fn a_short_line_whose_step_changes_sign_along_it_is_dropped() {
+        // A vertical boundary that is brighter on the right for 6 rows,
+        // darker for the next 6: texture's, not an edge's.
+        let zigzag = tall(&|x, y| match (x < 32, (y / 6) % 2) {
+            (true, _) => 100,
+            (false, 0) => 108,
+            (false, _) => 92,
+        });
+        let s = line(32.0, 5.0, 32.0, 95.0);
+        let a = super::super::step::across(std::slice::from_ref(&zigzag), &s).unwrap();
+        assert!(a.steady < MIN_STEADY, "{a:?}");
+        let mut v = Vec::new();
+        let g = samples(std::slice::from_ref(&zigzag), &s, &mut v);
+        assert!(
+            g >= min_slope_of_length(s.length()) && g < 2.0 * min_slope(),
+            "{g}"
+        );
+        assert!(!kept(&zigzag, s));
+        // The same boundary with one sign is an edge.
+        let edge = tall(&|x, _| if x < 32 { 100 } else { 108 });
+        assert!(kept(&edge, s));
     }
 
     #[test]

@@ -25,6 +25,20 @@
 //! edge, the profile's step is smeared (the synthetic yard lost faint true
 //! edges so), while the Sobel magnitude is read pixel by pixel. A line
 //! without one whole profile inside the image is no evidence either way.
+//!
+//! The same profiles say two more things about a faint line
+//! ([`super::align::keep_aligned`] decides with them):
+//! - [`step_share`]: how much of the profile's change near the line is one
+//!   step. A faint edge is a step; a door's panel line or a tile seam is a
+//!   thin ridge or valley, two opposite steps whose gradient is as strong
+//!   as a faint edge's, with no net step across.
+//! - [`Across::steady`]: whether the step at the line keeps its sign from
+//!   profile to profile. Along an edge it does; a line that follows texture
+//!   (streaks on concrete, a shadow through foliage) has a strong gradient
+//!   at every pixel, but its sides change along it, and the steps cancel.
+//!   Read on single profiles at the line (±1 px), not on the mean profile's
+//!   steepest step, so that a thin line, whose steepest step may fall on
+//!   either flank, is not taken for texture.
 
 use crate::{GreyImage, Segment};
 
@@ -39,11 +53,25 @@ pub const PROFILES: usize = 16;
 /// The step is looked for within this many px of the line (the line's
 /// position error after the refit is under one pixel).
 pub const CORE: usize = 2;
+/// [`step_share`] reads this many px to either side: past a blurred
+/// edge's ramp, and past both flanks of a thin ridge.
+pub const SHARE_REACH: usize = 3;
 
-/// The mean profile across `s` on `img` (module doc): `2 REACH + 1` grey
-/// levels from the side of `-normal` to `+normal`; `None` when no profile
+/// The profiles across a line on one image (module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Profile {
+    /// The mean profile: `2 REACH + 1` grey levels from the side of
+    /// `-normal` to `+normal`.
+    pub mean: [f64; 2 * REACH + 1],
+    /// `|Σ d| / Σ |d|` over the profiles of their step across the line,
+    /// `d = p[REACH + 1] - p[REACH - 1]`: 1 when every step has one sign,
+    /// near 0 when they cancel; 1 when there is no step at all.
+    pub steady: f64,
+}
+
+/// The profiles across `s` on `img` (module doc); `None` when no profile
 /// lies wholly inside (and on valid pixels).
-pub fn mean_profile(img: &GreyImage, s: &Segment) -> Option<[f64; 2 * REACH + 1]> {
+pub fn profile(img: &GreyImage, s: &Segment) -> Option<Profile> {
     let len = s.length();
     if !(len.is_finite() && len > 0.0) {
         return None;
@@ -81,6 +109,7 @@ pub fn mean_profile(img: &GreyImage, s: &Segment) -> Option<[f64; 2 * REACH + 1]
     let mut sum = [0.0; 2 * REACH + 1];
     let mut p = [0.0; 2 * REACH + 1];
     let mut count = 0usize;
+    let (mut signed, mut size) = (0.0, 0.0);
     // Profiles spread evenly along the line, at most PROFILES of them.
     let n = len.ceil().clamp(1.0, PROFILES as f64);
     'sample: for k in 0..n as usize {
@@ -96,9 +125,24 @@ pub fn mean_profile(img: &GreyImage, s: &Segment) -> Option<[f64; 2 * REACH + 1]
         for (a, v) in sum.iter_mut().zip(&p) {
             *a += v;
         }
+        let d = p[REACH + 1] - p[REACH - 1];
+        signed += d;
+        size += d.abs();
         count += 1;
     }
-    (count > 0).then(|| sum.map(|v| v / count as f64))
+    (count > 0).then(|| Profile {
+        mean: sum.map(|v| v / count as f64),
+        steady: if size > 0.0 {
+            f64::abs(signed) / size
+        } else {
+            1.0
+        },
+    })
+}
+
+/// The mean profile across `s` on `img` ([`profile`]).
+pub fn mean_profile(img: &GreyImage, s: &Segment) -> Option<[f64; 2 * REACH + 1]> {
+    profile(img, s).map(|p| p.mean)
 }
 
 /// The shading under a line, from its mean profile (module doc): the mean
@@ -121,15 +165,51 @@ pub fn shading(m: &[f64; 2 * REACH + 1]) -> f64 {
     beside(0..r - CORE).min(beside(r + CORE..2 * r)).max(0.0)
 }
 
-/// The least [`shading`] under `s` over `images` (several lightings: the
-/// one it is an edge in counts); `None` when no image holds a whole profile
-/// of it.
-pub fn least_shading(images: &[GreyImage], s: &Segment) -> Option<f64> {
+/// How much of a mean profile's change within [`SHARE_REACH`] px of the
+/// line is one step (module doc): `|m[+k] - m[-k]|` over the sum of the
+/// 1-px changes between; 1 for a monotone step, near 0 for a thin ridge or
+/// valley; 1 on flat grey (no evidence).
+pub fn step_share(m: &[f64; 2 * REACH + 1]) -> f64 {
+    let (r, k) = (REACH, SHARE_REACH);
+    let total: f64 = (r - k..r + k).map(|j| (m[j + 1] - m[j]).abs()).sum();
+    if total > 0.0 {
+        (m[r + k] - m[r - k]).abs() / total
+    } else {
+        1.0
+    }
+}
+
+/// What the profiles across a line say, over several lightings (the one
+/// it is an edge in counts): the least [`shading`], the greatest
+/// [`step_share`] and the greatest [`Profile::steady`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Across {
+    pub shading: f64,
+    pub step_share: f64,
+    pub steady: f64,
+}
+
+/// [`Across`] for `s` over `images`; `None` when no image holds a whole
+/// profile of it.
+pub fn across(images: &[GreyImage], s: &Segment) -> Option<Across> {
     images
         .iter()
-        .filter_map(|img| mean_profile(img, s))
-        .map(|m| shading(&m))
-        .reduce(f64::min)
+        .filter_map(|img| profile(img, s))
+        .map(|p| Across {
+            shading: shading(&p.mean),
+            step_share: step_share(&p.mean),
+            steady: p.steady,
+        })
+        .reduce(|a, b| Across {
+            shading: a.shading.min(b.shading),
+            step_share: a.step_share.max(b.step_share),
+            steady: a.steady.max(b.steady),
+        })
+}
+
+/// The least [`shading`] under `s` over `images` ([`across`]).
+pub fn least_shading(images: &[GreyImage], s: &Segment) -> Option<f64> {
+    across(images, s).map(|a| a.shading)
 }
 
 #[cfg(test)]
