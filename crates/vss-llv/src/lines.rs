@@ -442,43 +442,15 @@ fn walk<P: Peaks>(
     let lines = src.lines();
     let (mut last_u, mut last_v) = (last.u, last.v as usize);
     loop {
-        let fitted = fit.mean_and_axis();
-        let slope = match fitted {
-            Some((_, (du, dv))) => {
-                if dv.abs() * MAX_SLOPE > du.abs() {
-                    du / dv
-                } else {
-                    MAX_SLOPE * du.signum() * dv.signum()
-                }
-            }
-            _ => first_slope,
-        };
-        // A point off the line of an established track is not taken: a
-        // stray peak of noise is skipped like a missing point, and where
-        // the edge turns (a shallow corner, a branching shadow) the track
-        // ends after `max_gap` lines of such points. "Off" is beyond both
-        // `STRAY_DISTANCE` and 3 RMS residuals of the track (module doc);
-        // the residual is computed only for a point beyond the fixed one.
-        // (Its distance from the line, `|cross| / |axis|`, compared
-        // squared.)
-        let stray = fitted
-            .filter(|_| fit.len() >= STRAY_AFTER)
-            .map(|(m, (du, dv))| {
-                (
-                    m,
-                    du,
-                    dv,
-                    STRAY_DISTANCE * STRAY_DISTANCE * (du * du + dv * dv),
-                )
-            });
+        let course = Course::of(fit);
         let mut found = None;
         for i in 1..=gap {
             let Some(v) = line_at(last_v, dir * i as i64, lines) else {
                 break;
             };
-            let pred = match fitted {
-                Some((m, _)) => m.x + (v as f64 - m.y) * slope,
-                _ => last_u + (v as f64 - last_v as f64) * slope,
+            let pred = match &course {
+                Some(k) => k.predict(v as f64),
+                _ => last_u + (v as f64 - last_v as f64) * first_slope,
             };
             if !pred.is_finite() {
                 break;
@@ -486,14 +458,8 @@ fn walk<P: Peaks>(
             let Some(c) = src.nearest(v, pred, sw, positive) else {
                 continue;
             };
-            if let Some((m, du, dv, lim)) = stray {
-                let cross = (c.u - m.x) * dv - (c.v as f64 - m.y) * du;
-                if cross * cross > lim
-                    && cross * cross
-                        > STRAY_SCATTER_SQ * fit.mean_square_residual() * (du * du + dv * dv)
-                {
-                    continue;
-                }
+            if course.is_some_and(|k| k.is_stray(fit, c.u, c.v as f64)) {
+                continue;
             }
             found = Some(c);
             break;
@@ -505,6 +471,65 @@ fn walk<P: Peaks>(
         // at once stalled on the stores that made it.)
         (last_u, last_v) = (c.u, c.v);
         list.push(TrackPoint::of(&c));
+    }
+}
+
+/// A track's line as its points give it: the prediction of its next point
+/// and the test of a stray one (module doc, "Following"). The tracker and
+/// the drawing front end (`draw.rs`) both follow an edge by it.
+#[derive(Clone, Copy)]
+pub(crate) struct Course {
+    mean: Point,
+    axis: (f64, f64),
+    slope: f64,
+    /// The fixed stray bound times `|axis|²`, once the track has
+    /// [`STRAY_AFTER`] points.
+    stray: Option<f64>,
+}
+
+impl Course {
+    /// The course of the points in `fit` (none before two).
+    #[inline]
+    pub(crate) fn of(fit: &LineFit) -> Option<Course> {
+        let (mean, (du, dv)) = fit.mean_and_axis()?;
+        let slope = if dv.abs() * MAX_SLOPE > du.abs() {
+            du / dv
+        } else {
+            MAX_SLOPE * du.signum() * dv.signum()
+        };
+        let stray = (fit.len() >= STRAY_AFTER)
+            .then_some(STRAY_DISTANCE * STRAY_DISTANCE * (du * du + dv * dv));
+        Some(Course {
+            mean,
+            axis: (du, dv),
+            slope,
+            stray,
+        })
+    }
+
+    /// The position along the scan predicted on scan line `v`.
+    #[inline]
+    pub(crate) fn predict(&self, v: f64) -> f64 {
+        self.mean.x + (v - self.mean.y) * self.slope
+    }
+
+    /// Whether the track is established (the stray test applies).
+    #[inline]
+    pub(crate) fn established(&self) -> bool {
+        self.stray.is_some()
+    }
+
+    /// Whether a point at `(u, v)` is off the line of an established
+    /// track: beyond both `STRAY_DISTANCE` and 3 RMS residuals of `fit`
+    /// (the residual computed only for a point beyond the fixed bound; the
+    /// distance, `|cross| / |axis|`, compared squared).
+    #[inline]
+    pub(crate) fn is_stray(&self, fit: &LineFit, u: f64, v: f64) -> bool {
+        let Some(lim) = self.stray else { return false };
+        let (du, dv) = self.axis;
+        let cross = (u - self.mean.x) * dv - (v - self.mean.y) * du;
+        cross * cross > lim
+            && cross * cross > STRAY_SCATTER_SQ * fit.mean_square_residual() * (du * du + dv * dv)
     }
 }
 

@@ -17,8 +17,17 @@
 //!   strongest pixel of the anchor's polarity among the three ahead on the
 //!   next scan line, then up the ridge along the scan to its peak; it must
 //!   beat `lines.track_sigmas` noise sigmas of its tile (and the floor).
-//!   Where no pixel does, up to `lines.max_gap` further scan lines are
-//!   tried at the position the last points predict. A chain stops there,
+//!   The three are those around the last pixel until the chain has the
+//!   tracker's `STRAY_AFTER` points; from then on, around the position its
+//!   fitted line predicts (one fit for both ways, as the tracker's), and a
+//!   pixel off that line ([`Course::is_stray`]) or drawn before is skipped
+//!   like a missing one. Stepping from the last pixel, a chain along a
+//!   faint edge wandered onto the noise beside it for a few scan lines and
+//!   was cut there into pieces too short to pass validation; the fitted
+//!   line keeps it on the edge, and unlike a looser cut it does not follow
+//!   an arch or bridge a row of windows (docs/performance.md).
+//!   Where no pixel is found, up to `lines.max_gap` further scan lines are
+//!   tried at the predicted position. A chain stops there,
 //!   and at a pixel a chain of its own response has drawn. Chains of the
 //!   other response may cross it: a diagonal edge is drawn on both, as
 //!   both trackers followed it, and CONNECT merges the two (a mask shared
@@ -37,11 +46,12 @@
 //!   its response and noise sigmas, as the tracker's do.
 
 use super::nfa::Nfa;
-use super::{STRAY_SCATTER_SQ, TrackPoint, Tracks, keep_pieces, pack};
-use crate::Segment;
+use super::{Course, STRAY_SCATTER_SQ, TrackPoint, Tracks, keep_pieces, pack};
 use crate::edges::peaks::{key_floor, subpixel};
 use crate::edges::{NONE, NoiseMap, Response, key};
+use crate::fit::LineFit;
 use crate::params::LineParams;
+use crate::{Point, Segment};
 
 /// Anchors are taken on every this many scan lines.
 pub const ANCHOR_EVERY: usize = 4;
@@ -51,7 +61,7 @@ pub const ANCHOR_EVERY: usize = 4;
 /// that end it.
 const CUT_AFTER: usize = 8;
 const CUT_DISTANCE: f64 = 1.0;
-const CUT_RUN: usize = 3;
+const CUT_RUN: usize = 5;
 
 /// Points of a chain whose slope predicts the position across a gap.
 const SLOPE_POINTS: usize = 8;
@@ -258,8 +268,11 @@ pub fn draw_into(
         }
         let seed = pl.point(u, line, i);
         let positive = seed.response > 0.0;
-        draw_half(pl, (u, line), 1, positive, gap, drawn, &mut s.fwd);
-        draw_half(pl, (u, line), -1, positive, gap, drawn, &mut s.back);
+        let mut fit = LineFit::new();
+        fit.add(Point::new(seed.u, seed.v));
+        for (dir, list) in [(1, &mut s.fwd), (-1, &mut s.back)] {
+            draw_half(pl, (u, line), dir, positive, gap, drawn, &mut fit, list);
+        }
         s.chain.clear();
         s.chain.extend(s.back.iter().rev());
         s.chain.push(seed);
@@ -341,7 +354,9 @@ fn mag(s: i16) -> f32 {
 }
 
 /// Draws from the anchor at `at` in direction `dir` (+1 or −1 scan
-/// lines) into `list`; `drawn` is the response's.
+/// lines) into `list`, adding each point to `fit` (the chain's, both
+/// ways); `drawn` is the response's.
+#[allow(clippy::too_many_arguments)]
 fn draw_half(
     pl: &Plane,
     at: (usize, usize),
@@ -349,12 +364,17 @@ fn draw_half(
     positive: bool,
     gap: usize,
     drawn: &mut Drawn,
+    fit: &mut LineFit,
     list: &mut Vec<TrackPoint>,
 ) {
     list.clear();
     let (mut pix, mut v) = at;
     let mut u = pix as f64;
     loop {
+        // An established chain steps around its fitted line's prediction
+        // and skips a stray pixel, or one drawn before, as a gap (the
+        // tracker's rule, `Course`); a young one around its last pixel.
+        let course = Course::of(fit).filter(Course::established);
         let mut found = None;
         for i in 1..=gap as i64 {
             let next = v as i64 + dir * i;
@@ -362,7 +382,13 @@ fn draw_half(
                 break;
             }
             let next = next as usize;
-            let c = if i == 1 {
+            let c = if let Some(k) = &course {
+                let pred = k.predict(next as f64);
+                if !(pred >= 1.0 && pred < (pl.len_u - 1) as f64) {
+                    break;
+                }
+                pred.round() as usize
+            } else if i == 1 {
                 pix
             } else {
                 let pred = u + slope(list, u, v) * (next as f64 - v as f64);
@@ -372,6 +398,11 @@ fn draw_half(
                 pred.round() as usize
             };
             if let Some(q) = pl.step(c, next, positive) {
+                let off =
+                    |k: &Course| drawn.has(q.0, next) || k.is_stray(fit, q.0 as f64, next as f64);
+                if course.as_ref().is_some_and(off) {
+                    continue;
+                }
                 found = Some((q, next));
                 break;
             }
@@ -384,6 +415,7 @@ fn draw_half(
         }
         let q = pl.point_in(np, nv, i, tile);
         (pix, u, v) = (np, q.u, nv);
+        fit.add(Point::new(q.u, q.v));
         list.push(q);
     }
 }
@@ -404,6 +436,12 @@ impl Drawn {
         self.wpl = len_u.div_ceil(64);
         self.bits.clear();
         self.bits.resize(self.wpl * lines, 0);
+    }
+
+    /// Whether `(u, v)` was drawn.
+    #[inline]
+    fn has(&self, u: usize, v: usize) -> bool {
+        self.bits[v * self.wpl + u / 64] & 1u64 << (u % 64) != 0
     }
 
     /// Whether `(u, v)` was drawn; it is now.
