@@ -20,7 +20,7 @@
 //!   The three are those around the last pixel until the chain has the
 //!   tracker's `STRAY_AFTER` points; from then on, around the position its
 //!   fitted line predicts (one fit for both ways, as the tracker's), and a
-//!   pixel off that line ([`Course::is_stray`]) or drawn before is skipped
+//!   pixel off that line (`Course::is_stray`) or drawn before is skipped
 //!   like a missing one. Stepping from the last pixel, a chain along a
 //!   faint edge wandered onto the noise beside it for a few scan lines and
 //!   was cut there into pieces too short to pass validation; the fitted
