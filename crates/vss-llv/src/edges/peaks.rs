@@ -317,12 +317,17 @@ pub fn detect_into(
     starts: &mut Starts,
     s: &mut PeakScratch,
 ) {
+    bounded_noise(resp, p, noise, s);
+    map.reset(resp, p.floor, track_sigmas);
+    points_into(resp, noise, p, Some(map), out, starts, s);
+}
+
+/// The response's noise map, bounded as `p` says (both detections').
+fn bounded_noise(resp: &Response, p: &EdgeParams, noise: &mut NoiseMap, s: &mut PeakScratch) {
     let mut ns = std::mem::take(&mut s.noise);
     noise.estimate_into(resp, &mut ns);
     noise.bound(p.noise_percentile, p.noise_cap, &mut ns);
     s.noise = ns;
-    map.reset(resp, p.floor, track_sigmas);
-    points_into(resp, noise, p, Some(map), out, starts, s);
 }
 
 /// [`detect_into`] without the peak map, for the drawing front end
@@ -337,10 +342,7 @@ pub fn detect_unmapped_into(
     starts: &mut Starts,
     s: &mut PeakScratch,
 ) {
-    let mut ns = std::mem::take(&mut s.noise);
-    noise.estimate_into(resp, &mut ns);
-    noise.bound(p.noise_percentile, p.noise_cap, &mut ns);
-    s.noise = ns;
+    bounded_noise(resp, p, noise, s);
     (map.wpr, map.dir) = (0, None);
     points_into(resp, noise, p, None, out, starts, s);
 }
