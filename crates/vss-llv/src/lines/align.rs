@@ -160,36 +160,61 @@ pub fn samples(images: &[GreyImage], s: &Segment, out: &mut Vec<Sample>) -> f64 
                 valid = false;
                 break;
             }
-            let d = img.data();
-            let at = |u: usize, v: usize| i32::from(d[v * w + u]);
-            let gx = at(x + 1, y - 1) + 2 * at(x + 1, y) + at(x + 1, y + 1)
-                - at(x - 1, y - 1)
-                - 2 * at(x - 1, y)
-                - at(x - 1, y + 1);
-            let gy = at(x - 1, y + 1) + 2 * at(x, y + 1) + at(x + 1, y + 1)
-                - at(x - 1, y - 1)
-                - 2 * at(x, y - 1)
-                - at(x + 1, y - 1);
-            let (gx, gy) = (f64::from(gx), f64::from(gy));
+            // (Inside: `1 ≤ x < w − 1`, `1 ≤ y < h − 1`.)
+            let Some((gx, gy)) = sobel(img.data(), w, y * w + x) else {
+                continue;
+            };
             if best.is_none_or(|(bx, by)| gx * gx + gy * gy > bx * bx + by * by) {
                 best = Some((gx, gy));
             }
         }
-        let (Some((gx, gy)), true) = (best, valid) else {
+        let (Some(g), true) = (best, valid) else {
             out.push(Sample::Unknown);
             continue;
         };
-        let g2 = gx * gx + gy * gy;
-        mag += g2.sqrt();
+        let (sample, m) = classify(g, (dx, dy), c2);
+        mag += m;
         counted += 1;
-        let across = -gx * dy + gy * dx;
-        out.push(if g2 > 0.0 && across * across >= c2 * g2 {
-            Sample::Aligned
-        } else {
-            Sample::Across
-        });
+        out.push(sample);
     }
-    // (Sobel's sum is 8 times the slope.)
+    mean_slope(mag, counted)
+}
+
+/// The Sobel gradient `(gx, gy)` at index `at` of an image `d`, `w` px a
+/// row, whose 3 × 3 window the caller knows to be inside it (`None` only
+/// should it not be).
+#[inline(always)]
+fn sobel(d: &[u8], w: usize, at: usize) -> Option<(f64, f64)> {
+    let (r0, r1, r2) = (
+        d.get(at - w - 1..at - w + 2)?,
+        d.get(at - 1..at + 2)?,
+        d.get(at + w - 1..at + w + 2)?,
+    );
+    let p = |r: &[u8], i: usize| i32::from(r[i]);
+    let gx = p(r0, 2) + 2 * p(r1, 2) + p(r2, 2) - p(r0, 0) - 2 * p(r1, 0) - p(r2, 0);
+    let gy = p(r2, 0) + 2 * p(r2, 1) + p(r2, 2) - p(r0, 0) - 2 * p(r0, 1) - p(r0, 2);
+    Some((f64::from(gx), f64::from(gy)))
+}
+
+/// A sample of gradient `g` on a line of unit direction `d` (module doc):
+/// aligned when the gradient is within [`ALIGN_DEG`] of across the line
+/// (`c2` its cosine squared), and the gradient's magnitude.
+#[inline(always)]
+fn classify((gx, gy): (f64, f64), (dx, dy): (f64, f64), c2: f64) -> (Sample, f64) {
+    let g2 = gx * gx + gy * gy;
+    let across = -gx * dy + gy * dx;
+    // (`&`, not `&&`: no branch on a sample that texture makes random.)
+    let sample = if (g2 > 0.0) & (across * across >= c2 * g2) {
+        Sample::Aligned
+    } else {
+        Sample::Across
+    };
+    (sample, g2.sqrt())
+}
+
+/// The mean slope (grey levels a pixel) of `counted` samples whose Sobel
+/// magnitudes sum to `mag` (Sobel's sum is 8 times the slope); 0 for none.
+fn mean_slope(mag: f64, counted: usize) -> f64 {
     if counted > 0 {
         mag / (8.0 * counted as f64)
     } else {
@@ -231,34 +256,15 @@ fn samples_of_one(img: &GreyImage, s: &Segment, len: f64, out: &mut Vec<Sample>)
         if !(x >= 1 && y >= 1 && x < w as i64 - 1 && y < h as i64 - 1) {
             continue;
         }
-        let at = y as usize * w + x as usize;
-        let (Some(r0), Some(r1), Some(r2)) = (
-            d.get(at - w - 1..at - w + 2),
-            d.get(at - 1..at + 2),
-            d.get(at + w - 1..at + w + 2),
-        ) else {
+        let Some(g) = sobel(d, w, y as usize * w + x as usize) else {
             continue;
         };
-        let p = |r: &[u8], i: usize| i32::from(r[i]);
-        let gx = p(r0, 2) + 2 * p(r1, 2) + p(r2, 2) - p(r0, 0) - 2 * p(r1, 0) - p(r2, 0);
-        let gy = p(r2, 0) + 2 * p(r2, 1) + p(r2, 2) - p(r0, 0) - 2 * p(r0, 1) - p(r0, 2);
-        let (gx, gy) = (f64::from(gx), f64::from(gy));
-        let g2 = gx * gx + gy * gy;
-        mag += g2.sqrt();
+        let (sample, m) = classify(g, (dx, dy), c2);
+        mag += m;
         counted += 1;
-        let across = -gx * dy + gy * dx;
-        // (`&`, not `&&`: no branch on a sample that texture makes random.)
-        *o = if (g2 > 0.0) & (across * across >= c2 * g2) {
-            Sample::Aligned
-        } else {
-            Sample::Across
-        };
+        *o = sample;
     }
-    if counted > 0 {
-        mag / (8.0 * counted as f64)
-    } else {
-        0.0
-    }
+    mean_slope(mag, counted)
 }
 
 /// The fraction of a line's samples with evidence that are aligned; `None`
