@@ -96,13 +96,18 @@ pub fn min_slope_of_length(len: f64) -> f64 {
 
 /// Whether a line of mean gradient `g` (ρ ≤ `g` < 2 ρ) and length `len`,
 /// with `across` it ([`super::step::across`]; `None`: no evidence), is
-/// kept (module doc).
-pub fn faint_line_kept(g: f64, len: f64, across: Option<super::step::Across>) -> bool {
+/// kept (module doc); the profiles are read only if the length leaves it
+/// open.
+pub fn faint_line_kept(
+    g: f64,
+    len: f64,
+    across: impl FnOnce() -> Option<super::step::Across>,
+) -> bool {
     let rho = min_slope();
     if g < min_slope_of_length(len) {
         return false;
     }
-    let Some(a) = across else {
+    let Some(a) = across() else {
         return true;
     };
     g - a.shading >= rho
@@ -361,7 +366,7 @@ pub fn keep_aligned(
         let g = samples(images, s, v);
         if g < min_slope()
             || (g < 2.0 * min_slope()
-                && !faint_line_kept(g, s.length(), super::step::across(images, s)))
+                && !faint_line_kept(g, s.length(), || super::step::across(images, s)))
         {
             continue;
         }
