@@ -116,7 +116,7 @@ mod tests {
             let data: Vec<u8> = (0..w * h).map(|_| (rng.next_u64() % 256) as u8).collect();
             let mut img = GreyImage::new(w, h, data).unwrap();
             assert_eq!(noise_level(&img), by_the_definition(&img), "{w}×{h}");
-            let mask: Vec<bool> = (0..w * h).map(|_| rng.next_u64() % 7 != 0).collect();
+            let mask: Vec<bool> = (0..w * h).map(|_| rng.below(7) != 0).collect();
             img.set_valid_mask(Some(mask)).unwrap();
             assert_eq!(noise_level(&img), by_the_definition(&img), "{w}×{h} masked");
         }
