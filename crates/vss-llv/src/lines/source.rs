@@ -261,6 +261,7 @@ impl<S: SumAt> Peaks for ResponsePeaks<'_, S> {
         self.nlines
     }
 
+    #[inline(always)]
     fn nearest(&self, v: usize, pred: f64, sw: f64, positive: bool) -> Option<Cand> {
         if v >= self.nlines {
             return None;
