@@ -364,7 +364,7 @@ fn follow<P: Peaks>(
         t.fwd.clear();
         t.back.clear();
         let mut fit = LineFit::new();
-        fit.add(Point::new(seed.u, seed.v as f64));
+        fit.add_finite(Point::new(seed.u, seed.v as f64));
         // The first step fixes the initial slope.
         let mut slope = None;
         for (dir, list) in [(1i64, &mut t.fwd), (-1, &mut t.back)] {
@@ -375,7 +375,7 @@ fn follow<P: Peaks>(
                 let reach = sw + i as f64 * steep;
                 if let Some(c) = src.strongest(v, seed.u, reach, positive) {
                     src.take(&c);
-                    fit.add(Point::new(c.u, c.v as f64));
+                    fit.add_finite(Point::new(c.u, c.v as f64));
                     list.push(TrackPoint::of(&c));
                     slope = Some((c.u - seed.u) / (dir * i as i64) as f64);
                     break;
@@ -466,7 +466,7 @@ fn walk<P: Peaks>(
         }
         let Some(c) = found else { break };
         src.take(&c);
-        fit.add(Point::new(c.u, c.v as f64));
+        fit.add_finite(Point::new(c.u, c.v as f64));
         // (Only the position is kept: a copy of the whole point read back
         // at once stalled on the stores that made it.)
         (last_u, last_v) = (c.u, c.v);
@@ -547,6 +547,9 @@ fn keep_pieces(
     vertical: bool,
     out: &mut Vec<Segment>,
 ) {
+    if too_short(chain, p.min_length) {
+        return;
+    }
     let chain = trim_weak_ends(chain, &mut t.z);
     if chain.len() < 2 {
         return;
@@ -558,6 +561,26 @@ fn keep_pieces(
             out.push(s);
         }
     }
+}
+
+/// Whether no piece of a track (points in scan-line order) can pass the
+/// length test of [`segment_of`]: each piece's `|du|` is at most the
+/// track's spread in `u` and its `|dv|` at most the track's (rounding is
+/// monotone, so the bound computed the same way bounds what it computes).
+fn too_short(chain: &[TrackPoint], min_length: f64) -> bool {
+    let (Some(first), Some(last)) = (chain.first(), chain.last()) else {
+        return true;
+    };
+    let dv = last.v - first.v;
+    let limit = min_length * min_length * (1.0 - 1e-9);
+    if !(min_length > 0.0 && dv * dv < limit) {
+        return false;
+    }
+    let (lo, hi) = chain
+        .iter()
+        .fold((first.u, first.u), |(lo, hi), q| (lo.min(q.u), hi.max(q.u)));
+    let du = hi - lo;
+    du * du + dv * dv < limit
 }
 
 /// Points near an end whose responses set the edge's level there.
@@ -634,7 +657,7 @@ fn segment_of(
     let mut fit = LineFit::new();
     for q in piece {
         if q.v >= first.v + trim && q.v <= last.v - trim {
-            fit.add(Point::new(q.u, q.v));
+            fit.add_finite(Point::new(q.u, q.v));
         }
     }
     let line = fit.line()?;

@@ -36,6 +36,7 @@
 //! does in all; `docs/performance.md` has the measurements.
 
 mod lanes;
+mod scan_layout;
 pub(crate) mod strips;
 
 use super::band::{Rows, Whole};

@@ -60,7 +60,8 @@ pub struct ResponsePeaks<'a, S: SumAt = &'a [i16]> {
     /// The tile of scan position `(u, v)` is `tile_u[u] + tile_v[v]`.
     tile_u: Vec<u32>,
     tile_v: Vec<u32>,
-    /// The peaks not yet taken (a copy of the map's, cleared as tracks
+    /// The peaks not yet taken (a copy of the map's, in scan layout for a
+    /// given map: [`PeakMap::scan_copy_from`]; cleared as tracks
     /// take them), and the map itself; without it (a map given to be
     /// used up), a seed's bit 63 says whether it was in the map.
     map: PeakMap,
@@ -102,7 +103,7 @@ impl<'a> ResponsePeaks<'a> {
         let (w, h) = (r.width, r.height);
         let sums = if r.covers(w, h) { r.sums() } else { &[] };
         let shape = (w, h, r.dir, r.scale());
-        b.map.copy_from(map);
+        b.map.scan_copy_from(map);
         let work = std::mem::take(&mut b.map);
         ResponsePeaks::with_sums(shape, sums, !sums.is_empty(), noise, work, Some(map), b)
     }
@@ -190,22 +191,42 @@ impl<'a, S: SumAt> ResponsePeaks<'a, S> {
         u * self.step_u + v * self.step_v
     }
 
-    /// The candidate of the peak at `(u, v)`, image index `i`.
-    #[inline]
-    fn cand(&self, u: usize, v: usize, i: usize) -> Cand {
-        let mag = |j: usize| f32::from(key(self.sums.sum_at(j)));
-        let k0 = mag(i);
-        let d = subpixel(mag(i - self.step_u), k0, mag(i + self.step_u));
+    /// The magnitude (key) of the sum at image index `j`.
+    #[inline(always)]
+    fn mag(&self, j: usize) -> f32 {
+        f32::from(key(self.sums.sum_at(j)))
+    }
+
+    /// The subpixel position of the peak at whole position `u`, image
+    /// index `i`, and its magnitude.
+    #[inline(always)]
+    fn position(&self, u: usize, i: usize) -> (f64, f32) {
+        let k0 = self.mag(i);
+        let d = subpixel(self.mag(i - self.step_u), k0, self.mag(i + self.step_u));
+        // (In `f32`, as edge points are: a track on the points alone then
+        // sees the same positions.)
+        (f64::from(u as f32 + d), k0)
+    }
+
+    /// The candidate of the peak at `(u, v)`, image index `i`, at
+    /// position `pos` with magnitude `k0` ([`ResponsePeaks::position`]).
+    #[inline(always)]
+    fn cand_at(&self, u: usize, v: usize, i: usize, pos: f64, k0: f32) -> Cand {
         Cand {
-            // (In `f32`, as edge points are: a track on the points alone
-            // then sees the same positions.)
-            u: f64::from(u as f32 + d),
+            u: pos,
             v,
             response: f32::from(self.sums.sum_at(i)) * self.scale,
             z: k0 * self.inv_sigma[(self.tile_u[u] + self.tile_v[v]) as usize],
             id: i,
             pix: u as u32,
         }
+    }
+
+    /// The candidate of the peak at `(u, v)`, image index `i`.
+    #[inline]
+    fn cand(&self, u: usize, v: usize, i: usize) -> Cand {
+        let (pos, k0) = self.position(u, i);
+        self.cand_at(u, v, i, pos, k0)
     }
 
     /// The candidate at scan position `(u, v)` (an edge point's pixel).
@@ -240,23 +261,26 @@ impl<S: SumAt> Peaks for ResponsePeaks<'_, S> {
         self.nlines
     }
 
+    #[inline(always)]
     fn nearest(&self, v: usize, pred: f64, sw: f64, positive: bool) -> Option<Cand> {
         if v >= self.nlines {
             return None;
         }
         let (lo, hi) = self.span(pred, sw);
         let mut bits = self.map.window(positive, v, lo, hi);
-        let mut best: Option<(f64, Cand)> = None;
+        // Only the position chooses: the candidate is made of the chosen
+        // peak alone.
+        let mut best: Option<(f64, usize, f64, f32)> = None;
         while bits != 0 {
             let u = lo + bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            let c = self.cand(u, v, self.index(u, v));
-            let d = (c.u - pred).abs();
-            if d <= sw && best.is_none_or(|(bd, _)| d < bd) {
-                best = Some((d, c));
+            let (pos, k0) = self.position(u, self.index(u, v));
+            let d = (pos - pred).abs();
+            if d <= sw && best.is_none_or(|(bd, ..)| d < bd) {
+                best = Some((d, u, pos, k0));
             }
         }
-        best.map(|(_, c)| c)
+        best.map(|(_, u, pos, k0)| self.cand_at(u, v, self.index(u, v), pos, k0))
     }
 
     fn strongest(&self, v: usize, u: f64, reach: f64, positive: bool) -> Option<Cand> {
@@ -265,18 +289,21 @@ impl<S: SumAt> Peaks for ResponsePeaks<'_, S> {
         }
         let (lo, hi) = self.span(u, reach);
         let mut bits = self.map.window(positive, v, lo, hi);
-        let mut best: Option<(f32, f64, Cand)> = None;
+        // Only the magnitude and position choose (the candidate's
+        // `response.abs()`).
+        let mut best: Option<(f32, f64, usize, f64, f32)> = None;
         while bits != 0 {
             let x = lo + bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            let c = self.cand(x, v, self.index(x, v));
-            let d = (c.u - u).abs();
-            let m = c.response.abs();
-            if d <= reach && best.is_none_or(|(bm, bd, _)| m > bm || (m == bm && d < bd)) {
-                best = Some((m, d, c));
+            let i = self.index(x, v);
+            let (pos, k0) = self.position(x, i);
+            let d = (pos - u).abs();
+            let m = (f32::from(self.sums.sum_at(i)) * self.scale).abs();
+            if d <= reach && best.is_none_or(|(bm, bd, ..)| m > bm || (m == bm && d < bd)) {
+                best = Some((m, d, x, pos, k0));
             }
         }
-        best.map(|(_, _, c)| c)
+        best.map(|(_, _, x, pos, k0)| self.cand_at(x, v, self.index(x, v), pos, k0))
     }
 
     fn take(&mut self, c: &Cand) {

@@ -262,6 +262,48 @@ fn reading_peaks_where_tracks_look_equals_listing_them_all() {
 }
 
 /// The image index of scan position `(u, v)`.
+/// A track that `too_short` rules out has no piece (no run of its
+/// points) that passes `segment_of`'s length test; one it leaves has one
+/// when its spread is along the scan lines.
+#[test]
+fn too_short_tracks_have_no_piece_long_enough() {
+    let mut rng = crate::rng::SplitMix64::new(9);
+    let min_length = 8.0;
+    let limit = min_length * min_length * (1.0 - 1e-9);
+    let (mut ruled, mut left) = (0, 0);
+    for _ in 0..2000 {
+        let n = 2 + (rng.next_u64() % 9) as usize;
+        let spread = 12.0 * rng.uniform();
+        let chain: Vec<TrackPoint> = (0..n)
+            .map(|k| TrackPoint {
+                u: 100.0 + spread * rng.uniform(),
+                v: 50.0 + k as f64,
+                ..TrackPoint::default()
+            })
+            .collect();
+        if too_short(&chain, min_length) {
+            ruled += 1;
+            for a in 0..n {
+                for b in a + 1..n {
+                    let (du, dv) = (chain[b].u - chain[a].u, chain[b].v - chain[a].v);
+                    assert!(du * du + dv * dv < limit, "{chain:?}");
+                }
+            }
+        } else {
+            left += 1;
+            let long = (0..n).any(|a| {
+                (a + 1..n).any(|b| {
+                    let (du, dv) = (chain[b].u - chain[a].u, chain[b].v - chain[a].v);
+                    du * du + dv * dv >= 0.5 * limit
+                })
+            });
+            assert!(long, "{chain:?}");
+        }
+    }
+    assert!(ruled > 100 && left > 100, "{ruled} {left}");
+    assert!(!too_short(&[TrackPoint::default(); 3], 0.0));
+}
+
 fn src_index(dir: ScanDir, w: usize, u: usize, v: usize) -> usize {
     if dir == ScanDir::Vertical {
         u * w + v

@@ -166,6 +166,9 @@ fn the_peak_map_holds_the_plain_peaks() {
             let noise = NoiseMap::estimate(&r);
             let mut map = PeakMap::default();
             map.build_into(&r, &noise, 2.0, 1.5, &mut PeakScratch::default());
+            // The copy in scan layout reads the same windows.
+            let mut scan = PeakMap::default();
+            scan.scan_copy_from(&map);
             let mut thr = Vec::new();
             tile_floors(r.scale(), &noise, 2.0, 1.5, &mut thr);
             let mut plain = Vec::new();
@@ -182,6 +185,7 @@ fn the_peak_map_holds_the_plain_peaks() {
                     while lo < len_u {
                         let hi = (lo + 23).min(len_u);
                         let mut bits = map.window(positive, v, lo, hi);
+                        assert_eq!(scan.window(positive, v, lo, hi), bits, "{dir:?}");
                         while bits != 0 {
                             let u = lo + bits.trailing_zeros() as usize;
                             bits &= bits - 1;
@@ -192,6 +196,9 @@ fn the_peak_map_holds_the_plain_peaks() {
                             };
                             let i = y * w + x;
                             assert_eq!(r.sums()[i] > 0, positive);
+                            assert!(scan.is_set(u, v));
+                            scan.clear(u, v);
+                            assert!(!scan.is_set(u, v) && map.is_set(u, v));
                             found.push(i as u32);
                         }
                         lo = hi;
