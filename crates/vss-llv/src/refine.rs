@@ -87,11 +87,15 @@ const SAMPLES: usize = 2 * R + 1;
 const SPAN: usize = 2 * R * 3 / 2 + 3;
 
 type Profile = [f64; SAMPLES];
+/// The derivatives of a profile at samples `R − 2 ..= R + 2`: all that
+/// the peak test ([`peak_near_line`]) reads, for either polarity.
+type Near = [f64; 5];
 
 /// Reusable buffers of [`refine_into`].
 #[derive(Clone, Debug, Default)]
 pub struct RefineScratch {
-    profiles: Vec<Profile>,
+    /// Per block: the derivatives near the line ([`Near`]).
+    blocks: Vec<Near>,
     centres: Vec<f64>,
     /// The lines of the last [`refine_into`] that no edge confirms (module
     /// doc, "Ghosts"), by index, ascending.
@@ -283,7 +287,7 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
         } else {
             strongest(images, &f, &kern)
         };
-        s.profiles.clear();
+        s.blocks.clear();
         s.centres.clear();
         let mut total = [0.0; SAMPLES];
         for b in 0..blocks {
@@ -295,10 +299,10 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
             for (t, v) in total.iter_mut().zip(&p) {
                 *t += v;
             }
-            s.profiles.push(p);
+            s.blocks.push(near_derivatives(&p, &kern));
             s.centres.push(f.first as f64 + 0.5 * (lo + hi - 1) as f64);
         }
-        if s.profiles.len() < MIN_BLOCKS {
+        if s.blocks.len() < MIN_BLOCKS {
             continue;
         }
         let at_line = derivative(&total, &kern, R);
@@ -307,16 +311,15 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
         }
         let pol = at_line.signum();
         let mut fit = LineFit::new();
-        for (p, &v) in s.profiles.iter().zip(&s.centres) {
-            if let Some((o, d0)) = peak_near_line(p, &kern, pol) {
+        for (p, &v) in s.blocks.iter().zip(&s.centres) {
+            if let Some((o, d0)) = peak_near_line(p, pol) {
                 fit.add_weighted(f.point(f.u_at(v) + o * f.sec, v), d0 * d0);
             }
         }
-        if fit.len() < 2 || 2 * fit.len() < s.profiles.len() {
-            let edge = |p: &Profile| {
-                peak_near_line(p, &kern, pol).is_some() || peak_near_line(p, &kern, -pol).is_some()
-            };
-            if 2 * s.profiles.iter().filter(|p| edge(p)).count() < s.profiles.len() {
+        if fit.len() < 2 || 2 * fit.len() < s.blocks.len() {
+            let edge =
+                |p: &Near| peak_near_line(p, pol).is_some() || peak_near_line(p, -pol).is_some();
+            if 2 * s.blocks.iter().filter(|p| edge(p)).count() < s.blocks.len() {
                 s.unconfirmed.push(i);
             }
             continue;
@@ -375,11 +378,18 @@ fn beside(u: &Segment, l: &Segment) -> bool {
         && overlap >= 0.5 * ulen
 }
 
+/// The derivatives of `p` that [`peak_near_line`] reads, each computed
+/// once (the peak test reads the middle three two or three times each, and a
+/// line the refit cannot place is tested for both polarities).
+fn near_derivatives(p: &Profile, kern: &[f64; 2 * KERNEL_A + 1]) -> Near {
+    std::array::from_fn(|j| derivative(p, kern, R - 2 + j))
+}
+
 /// The offset (px along the normal) of the peak of polarity `pol` nearest
 /// the line within `REACH`, and the derivative there (times `pol`), if
-/// there is such a peak.
-fn peak_near_line(p: &Profile, kern: &[f64; 2 * KERNEL_A + 1], pol: f64) -> Option<(f64, f64)> {
-    let d = |k: usize| pol * derivative(p, kern, k);
+/// there is such a peak; `near` are the profile's [`near_derivatives`].
+fn peak_near_line(near: &Near, pol: f64) -> Option<(f64, f64)> {
+    let d = |k: usize| pol * near[k + 2 - R];
     let mut best: Option<(f64, f64)> = None;
     for k in R - 1..=R + 1 {
         let (dm, d0, dp) = (d(k - 1), d(k), d(k + 1));
