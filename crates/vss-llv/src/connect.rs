@@ -268,6 +268,8 @@ pub struct ConnectScratch {
     cand: Vec<u32>,
     /// Lengths of segments and their indices, for sorting.
     keyed: Vec<(f64, u32)>,
+    /// The length of each segment as it came in.
+    lens: Vec<f64>,
 }
 
 /// CONNECT (§4) of a line set; the result is sorted longest first.
@@ -316,6 +318,8 @@ pub fn connect_into(
     sort_keys(&mut s.keyed, lines);
     s.segs.clear();
     s.segs.extend(s.keyed.iter().map(|k| lines[k.1 as usize]));
+    s.lens.clear();
+    s.lens.extend(s.keyed.iter().map(|k| k.0));
     let n = s.segs.len();
     s.geo.clear();
     s.geo.extend(s.segs.iter().map(|l| Geo::of(l, p)));
@@ -406,15 +410,42 @@ pub fn connect_into(
         }
         pass += 1;
     }
-    s.keyed.clear();
-    s.keyed.extend(
+    // The segments that never merged are still in order: only those that
+    // did are sorted, then the two runs are merged (the same order as
+    // sorting them all, ties by index).
+    let ConnectScratch {
+        segs,
+        alive,
+        changed,
+        keyed,
+        lens,
+        ..
+    } = s;
+    keyed.clear();
+    keyed.extend(
         (0..n as u32)
-            .filter(|&k| s.alive[k as usize])
-            .map(|k| (s.segs[k as usize].length(), k))
+            .filter(|&k| alive[k as usize] && changed[k as usize] > 0)
+            .map(|k| (segs[k as usize].length(), k))
             .filter(|&(len, _)| len >= p.min_line_length),
     );
-    sort_keys(&mut s.keyed, &s.segs);
-    out.extend(s.keyed.iter().map(|k| s.segs[k.1 as usize]));
+    sort_keys(keyed, segs);
+    let mut grown = keyed.iter().peekable();
+    for k in 0..n {
+        let len = lens[k];
+        if !alive[k] || changed[k] > 0 || len < p.min_line_length {
+            continue;
+        }
+        while let Some(&&(l, j)) = grown.peek() {
+            let first = keyed_order(l, &segs[j as usize], len, &segs[k]).then(j.cmp(&(k as u32)));
+            if first.is_gt() {
+                break;
+            }
+            out.push(segs[j as usize]);
+            grown.next();
+        }
+        out.push(segs[k]);
+    }
+    out.extend(grown.map(|&(_, j)| segs[j as usize]));
 }
 
 #[cfg(test)]

@@ -209,7 +209,13 @@ impl Frame {
     /// apart across the line (they also move `(k − R) · slope / sec` along
     /// it, which a straight edge does not see). False (with `p` unchanged)
     /// where a sample is outside the image or next to an invalid pixel.
-    fn add_profile(&self, img: &GreyImage, v: usize, p: &mut Profile) -> bool {
+    ///
+    /// `p` is in units of 2⁻¹⁶ grey levels ([`Sums`]): with the positions
+    /// in 2⁻¹⁶ px, an interpolated value is a whole number of such units,
+    /// and so are sums of profiles, exact in an `i64` (interpolating and
+    /// summing in `f64` gives the same numbers: below 2⁵³ units nothing
+    /// rounds), without a conversion a sample.
+    fn add_profile(&self, img: &GreyImage, v: usize, p: &mut Sums) -> bool {
         let (w, h) = img.size();
         let (len_u, len_v) = if self.steep { (w, h) } else { (h, w) };
         let u = self.u_at(v as f64);
@@ -221,7 +227,7 @@ impl Frame {
         let n = (u + reach) as usize + 2 - lo;
         // The pixels `lo..lo + n` of the scan line, in a buffer on the
         // stack (`n ≤ 2 R √2 + 2`).
-        let mut buf = [0.0f64; SPAN];
+        let mut buf = [0i64; SPAN];
         let Some(buf) = buf.get_mut(..n) else {
             return false;
         };
@@ -233,7 +239,7 @@ impl Frame {
                 return false;
             }
             for (b, &g) in buf.iter_mut().zip(&d[at..at + n]) {
-                *b = f64::from(g);
+                *b = i64::from(g);
             }
         } else {
             let at = lo * w + v;
@@ -241,7 +247,7 @@ impl Frame {
                 return false;
             }
             for (j, b) in buf.iter_mut().enumerate() {
-                *b = f64::from(d[at + j * w]);
+                *b = i64::from(d[at + j * w]);
             }
         }
         // The sample positions in the buffer in 1/2¹⁶ px (their rounding,
@@ -251,12 +257,20 @@ impl Frame {
         let step = (self.sec * ONE) as u32;
         for out in p.iter_mut() {
             let i = ((x >> 16) as usize).min(n - 2);
-            let f = f64::from(x & 0xFFFF) * (1.0 / ONE);
-            *out += buf[i] + f * (buf[i + 1] - buf[i]);
+            let f = i64::from(x & 0xFFFF);
+            *out += (buf[i] << 16) + f * (buf[i + 1] - buf[i]);
             x += step;
         }
         true
     }
+}
+
+/// Profiles summed in units of 2⁻¹⁶ grey levels ([`Frame::add_profile`]).
+type Sums = [i64; SAMPLES];
+
+/// `p` in grey levels (exact: `|p|` is far below 2⁵³).
+fn profile(p: &Sums) -> Profile {
+    p.map(|v| v as f64 * (1.0 / 65536.0))
 }
 
 /// Refits each segment of `segs` on `images` (one image, or the lightings
@@ -292,10 +306,11 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
         let mut total = [0.0; SAMPLES];
         for b in 0..blocks {
             let (lo, hi) = (b * f.count / blocks, (b + 1) * f.count / blocks);
-            let mut p = [0.0; SAMPLES];
-            if !(lo..hi).all(|i| f.add_profile(img, f.first + i, &mut p)) {
+            let mut sums = [0; SAMPLES];
+            if !(lo..hi).all(|i| f.add_profile(img, f.first + i, &mut sums)) {
                 continue;
             }
+            let p = profile(&sums);
             for (t, v) in total.iter_mut().zip(&p) {
                 *t += v;
             }
@@ -338,10 +353,10 @@ pub fn drop_ghosts(segs: &mut Vec<Segment>, s: &RefineScratch) {
         return;
     }
     let ghost = |i: usize| {
-        let u = &segs[i];
+        let (u, ul) = (&segs[i], segs[i].length());
         segs.iter()
             .enumerate()
-            .any(|(j, l)| j != i && l.length() >= u.length() && beside(u, l))
+            .any(|(j, l)| j != i && l.length() >= ul && beside(u, l))
     };
     let gone: Vec<usize> = s
         .unconfirmed
@@ -419,10 +434,10 @@ fn strongest<'a>(
 ) -> &'a GreyImage {
     let mut best = (0.0, &images[0]);
     for img in images {
-        let mut p = [0.0; SAMPLES];
-        let whole = (0..8).all(|i| f.add_profile(img, f.first + i * f.count / 8, &mut p));
+        let mut sums = [0; SAMPLES];
+        let whole = (0..8).all(|i| f.add_profile(img, f.first + i * f.count / 8, &mut sums));
         let m = if whole {
-            derivative(&p, kern, R).abs()
+            derivative(&profile(&sums), kern, R).abs()
         } else {
             0.0
         };
