@@ -223,8 +223,9 @@ impl Frame {
         if v >= len_v || !(u - reach >= 0.0 && u + reach + 1.0 < len_u as f64) {
             return false;
         }
-        let lo = (u - reach) as usize;
-        let n = (u + reach) as usize + 2 - lo;
+        // (Both positive: truncated to an `i64`, one instruction.)
+        let lo = (u - reach) as i64 as usize;
+        let n = (u + reach) as i64 as usize + 2 - lo;
         // The pixels `lo..lo + n` of the scan line, in a buffer on the
         // stack (`n ≤ 2 R √2 + 2`).
         let mut buf = [0i64; SPAN];

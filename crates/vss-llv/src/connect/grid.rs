@@ -168,8 +168,10 @@ impl Grid {
             f(0);
             return;
         }
-        let col = |x: f64| (((x - self.x0) * self.inv).max(0.0) as usize).min(self.nx - 1);
-        let row = |y: f64| (((y - self.y0) * self.inv).max(0.0) as usize).min(self.ny - 1);
+        // (Not negative, NaN made 0: truncated to an `i64`, one
+        // instruction, rather than a `usize`.)
+        let col = |x: f64| (((x - self.x0) * self.inv).max(0.0) as i64 as usize).min(self.nx - 1);
+        let row = |y: f64| (((y - self.y0) * self.inv).max(0.0) as i64 as usize).min(self.ny - 1);
         let (r0, r1) = (row(g.bounds[1] - SLACK), row(g.bounds[3] + SLACK));
         let (c0, c1) = (col(g.bounds[0] - SLACK), col(g.bounds[2] + SLACK));
         if r0 == r1 || c0 == c1 || (r1 - r0 == 1 && c1 - c0 == 1) {

@@ -247,11 +247,12 @@ fn samples_of_one(img: &GreyImage, s: &Segment, len: f64, out: &mut Vec<Sample>)
         // `x.round()` (halves away from 0) is in `1..w - 1` exactly when
         // `0.5 ≤ x < w − 1.5`, and there it is `x + 0.5` truncated (the sum
         // is exact below 2⁵¹, or rounds to the same whole number): the
-        // library's `round` is a call without SSE 4.1.
+        // library's `round` is a call without SSE 4.1. (Truncated to an
+        // `i64`, one instruction, rather than a `usize`.)
         if !(x >= 0.5 && y >= 0.5 && x < wf - 1.5 && y < hf - 1.5) {
             continue;
         }
-        let (x, y) = ((x + 0.5) as usize, (y + 0.5) as usize);
+        let (x, y) = ((x + 0.5) as i64 as usize, (y + 0.5) as i64 as usize);
         let Some(g) = sobel(d, w, y * w + x) else {
             continue;
         };
