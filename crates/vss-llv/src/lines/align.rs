@@ -327,6 +327,16 @@ fn parts(v: &[Sample], min: f64, out: &mut Vec<(f64, f64)>) {
     }
 }
 
+/// The samples with evidence and the aligned ones, in one pass.
+fn counts(v: &[Sample]) -> (usize, usize) {
+    v.iter().fold((0, 0), |(c, a), x| {
+        (
+            c + usize::from(*x != Sample::Unknown),
+            a + usize::from(*x == Sample::Aligned),
+        )
+    })
+}
+
 /// Reusable buffers of [`keep_aligned`] (a warm workspace allocates
 /// nothing).
 #[derive(Clone, Debug, Default)]
@@ -362,8 +372,7 @@ pub fn keep_aligned(
         {
             continue;
         }
-        let counted = v.iter().filter(|x| **x != Sample::Unknown).count();
-        let aligned = v.iter().filter(|x| **x == Sample::Aligned).count();
+        let (counted, aligned) = counts(v);
         if counted == 0 {
             out.push(*s);
             continue;
