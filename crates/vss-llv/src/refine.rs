@@ -87,11 +87,15 @@ const SAMPLES: usize = 2 * R + 1;
 const SPAN: usize = 2 * R * 3 / 2 + 3;
 
 type Profile = [f64; SAMPLES];
+/// The derivatives of a profile at samples `R − 2 ..= R + 2`: all that
+/// the peak test ([`peak_near_line`]) reads, for either polarity.
+type Near = [f64; 5];
 
 /// Reusable buffers of [`refine_into`].
 #[derive(Clone, Debug, Default)]
 pub struct RefineScratch {
-    profiles: Vec<Profile>,
+    /// Per block: the derivatives near the line ([`Near`]).
+    blocks: Vec<Near>,
     centres: Vec<f64>,
     /// The lines of the last [`refine_into`] that no edge confirms (module
     /// doc, "Ghosts"), by index, ascending.
@@ -205,7 +209,13 @@ impl Frame {
     /// apart across the line (they also move `(k − R) · slope / sec` along
     /// it, which a straight edge does not see). False (with `p` unchanged)
     /// where a sample is outside the image or next to an invalid pixel.
-    fn add_profile(&self, img: &GreyImage, v: usize, p: &mut Profile) -> bool {
+    ///
+    /// `p` is in units of 2⁻¹⁶ grey levels ([`Sums`]): with the positions
+    /// in 2⁻¹⁶ px, an interpolated value is a whole number of such units,
+    /// and so are sums of profiles, exact in an `i64` (interpolating and
+    /// summing in `f64` gives the same numbers: below 2⁵³ units nothing
+    /// rounds), without a conversion a sample.
+    fn add_profile(&self, img: &GreyImage, v: usize, p: &mut Sums) -> bool {
         let (w, h) = img.size();
         let (len_u, len_v) = if self.steep { (w, h) } else { (h, w) };
         let u = self.u_at(v as f64);
@@ -213,11 +223,12 @@ impl Frame {
         if v >= len_v || !(u - reach >= 0.0 && u + reach + 1.0 < len_u as f64) {
             return false;
         }
-        let lo = (u - reach) as usize;
-        let n = (u + reach) as usize + 2 - lo;
+        // (Both positive: truncated to an `i64`, one instruction.)
+        let lo = (u - reach) as i64 as usize;
+        let n = (u + reach) as i64 as usize + 2 - lo;
         // The pixels `lo..lo + n` of the scan line, in a buffer on the
         // stack (`n ≤ 2 R √2 + 2`).
-        let mut buf = [0.0f64; SPAN];
+        let mut buf = [0i64; SPAN];
         let Some(buf) = buf.get_mut(..n) else {
             return false;
         };
@@ -229,7 +240,7 @@ impl Frame {
                 return false;
             }
             for (b, &g) in buf.iter_mut().zip(&d[at..at + n]) {
-                *b = f64::from(g);
+                *b = i64::from(g);
             }
         } else {
             let at = lo * w + v;
@@ -237,7 +248,7 @@ impl Frame {
                 return false;
             }
             for (j, b) in buf.iter_mut().enumerate() {
-                *b = f64::from(d[at + j * w]);
+                *b = i64::from(d[at + j * w]);
             }
         }
         // The sample positions in the buffer in 1/2¹⁶ px (their rounding,
@@ -247,12 +258,20 @@ impl Frame {
         let step = (self.sec * ONE) as u32;
         for out in p.iter_mut() {
             let i = ((x >> 16) as usize).min(n - 2);
-            let f = f64::from(x & 0xFFFF) * (1.0 / ONE);
-            *out += buf[i] + f * (buf[i + 1] - buf[i]);
+            let f = i64::from(x & 0xFFFF);
+            *out += (buf[i] << 16) + f * (buf[i + 1] - buf[i]);
             x += step;
         }
         true
     }
+}
+
+/// Profiles summed in units of 2⁻¹⁶ grey levels ([`Frame::add_profile`]).
+type Sums = [i64; SAMPLES];
+
+/// `p` in grey levels (exact: `|p|` is far below 2⁵³).
+fn profile(p: &Sums) -> Profile {
+    p.map(|v| v as f64 * (1.0 / 65536.0))
 }
 
 /// Refits each segment of `segs` on `images` (one image, or the lightings
@@ -283,22 +302,23 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
         } else {
             strongest(images, &f, &kern)
         };
-        s.profiles.clear();
+        s.blocks.clear();
         s.centres.clear();
         let mut total = [0.0; SAMPLES];
         for b in 0..blocks {
             let (lo, hi) = (b * f.count / blocks, (b + 1) * f.count / blocks);
-            let mut p = [0.0; SAMPLES];
-            if !(lo..hi).all(|i| f.add_profile(img, f.first + i, &mut p)) {
+            let mut sums = [0; SAMPLES];
+            if !(lo..hi).all(|i| f.add_profile(img, f.first + i, &mut sums)) {
                 continue;
             }
+            let p = profile(&sums);
             for (t, v) in total.iter_mut().zip(&p) {
                 *t += v;
             }
-            s.profiles.push(p);
+            s.blocks.push(near_derivatives(&p, &kern));
             s.centres.push(f.first as f64 + 0.5 * (lo + hi - 1) as f64);
         }
-        if s.profiles.len() < MIN_BLOCKS {
+        if s.blocks.len() < MIN_BLOCKS {
             continue;
         }
         let at_line = derivative(&total, &kern, R);
@@ -307,16 +327,15 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
         }
         let pol = at_line.signum();
         let mut fit = LineFit::new();
-        for (p, &v) in s.profiles.iter().zip(&s.centres) {
-            if let Some((o, d0)) = peak_near_line(p, &kern, pol) {
+        for (p, &v) in s.blocks.iter().zip(&s.centres) {
+            if let Some((o, d0)) = peak_near_line(p, pol) {
                 fit.add_weighted(f.point(f.u_at(v) + o * f.sec, v), d0 * d0);
             }
         }
-        if fit.len() < 2 || 2 * fit.len() < s.profiles.len() {
-            let edge = |p: &Profile| {
-                peak_near_line(p, &kern, pol).is_some() || peak_near_line(p, &kern, -pol).is_some()
-            };
-            if 2 * s.profiles.iter().filter(|p| edge(p)).count() < s.profiles.len() {
+        if fit.len() < 2 || 2 * fit.len() < s.blocks.len() {
+            let edge =
+                |p: &Near| peak_near_line(p, pol).is_some() || peak_near_line(p, -pol).is_some();
+            if 2 * s.blocks.iter().filter(|p| edge(p)).count() < s.blocks.len() {
                 s.unconfirmed.push(i);
             }
             continue;
@@ -335,10 +354,10 @@ pub fn drop_ghosts(segs: &mut Vec<Segment>, s: &RefineScratch) {
         return;
     }
     let ghost = |i: usize| {
-        let u = &segs[i];
+        let (u, ul) = (&segs[i], segs[i].length());
         segs.iter()
             .enumerate()
-            .any(|(j, l)| j != i && l.length() >= u.length() && beside(u, l))
+            .any(|(j, l)| j != i && l.length() >= ul && beside(u, l))
     };
     let gone: Vec<usize> = s
         .unconfirmed
@@ -375,11 +394,18 @@ fn beside(u: &Segment, l: &Segment) -> bool {
         && overlap >= 0.5 * ulen
 }
 
+/// The derivatives of `p` that [`peak_near_line`] reads, each computed
+/// once (the peak test reads the middle three two or three times each, and a
+/// line the refit cannot place is tested for both polarities).
+fn near_derivatives(p: &Profile, kern: &[f64; 2 * KERNEL_A + 1]) -> Near {
+    std::array::from_fn(|j| derivative(p, kern, R - 2 + j))
+}
+
 /// The offset (px along the normal) of the peak of polarity `pol` nearest
 /// the line within `REACH`, and the derivative there (times `pol`), if
-/// there is such a peak.
-fn peak_near_line(p: &Profile, kern: &[f64; 2 * KERNEL_A + 1], pol: f64) -> Option<(f64, f64)> {
-    let d = |k: usize| pol * derivative(p, kern, k);
+/// there is such a peak; `near` are the profile's [`near_derivatives`].
+fn peak_near_line(near: &Near, pol: f64) -> Option<(f64, f64)> {
+    let d = |k: usize| pol * near[k + 2 - R];
     let mut best: Option<(f64, f64)> = None;
     for k in R - 1..=R + 1 {
         let (dm, d0, dp) = (d(k - 1), d(k), d(k + 1));
@@ -409,10 +435,10 @@ fn strongest<'a>(
 ) -> &'a GreyImage {
     let mut best = (0.0, &images[0]);
     for img in images {
-        let mut p = [0.0; SAMPLES];
-        let whole = (0..8).all(|i| f.add_profile(img, f.first + i * f.count / 8, &mut p));
+        let mut sums = [0; SAMPLES];
+        let whole = (0..8).all(|i| f.add_profile(img, f.first + i * f.count / 8, &mut sums));
         let m = if whole {
-            derivative(&p, kern, R).abs()
+            derivative(&profile(&sums), kern, R).abs()
         } else {
             0.0
         };

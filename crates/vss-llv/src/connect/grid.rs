@@ -20,6 +20,8 @@ pub(super) struct Grid {
     ny: usize,
     /// Direction bins over the half turn (1: directions not binned).
     bins: usize,
+    /// The [`Geo::turn`] at which each bin after the first starts.
+    starts: Vec<f64>,
     cells: Vec<Vec<(u32, u8)>>,
     /// Per cell: how many of its first entries are in ascending order
     /// (those listed before [`Grid::seal`]).
@@ -111,6 +113,10 @@ impl Grid {
         } else {
             1
         };
+        let step = std::f64::consts::PI / self.bins as f64;
+        self.starts.clear();
+        self.starts
+            .extend((1..self.bins).map(|b| 1.0 - (b as f64 * step).cos()));
         self.clear();
     }
 
@@ -130,16 +136,15 @@ impl Grid {
         (self.x0, self.y0, self.inv, self.nx, self.ny, self.bins) = (
             other.x0, other.y0, other.inv, other.nx, other.ny, other.bins,
         );
+        self.starts.clone_from(&other.starts);
         self.clear();
     }
 
-    /// The direction bin of `g`: its angle in `[0, π]` over the bins.
+    /// The direction bin of `g`: its angle in `[0, π]` over the bins
+    /// (by its [`Geo::turn`]; rounding at a bin's edge moves a direction by
+    /// far less than the bins' margin over the merge angle).
     fn bin(&self, g: &Geo) -> u8 {
-        if self.bins == 1 {
-            return 0;
-        }
-        let b = (g.angle * (self.bins as f64 / std::f64::consts::PI)) as usize;
-        b.min(self.bins - 1) as u8
+        self.starts.partition_point(|&s| s <= g.turn) as u8
     }
 
     /// The bins next to `g`'s (its own included), as a mask.
@@ -148,7 +153,9 @@ impl Grid {
             return 1;
         }
         let (b, n) = (self.bin(g) as usize, self.bins);
-        (1 << b) | (1 << ((b + 1) % n)) | (1 << ((b + n - 1) % n))
+        let next = if b + 1 == n { 0 } else { b + 1 };
+        let prev = if b == 0 { n - 1 } else { b - 1 };
+        (1 << b) | (1 << next) | (1 << prev)
     }
 
     /// Calls `f` with each cell the environment `g` overlaps: for each row
@@ -161,8 +168,10 @@ impl Grid {
             f(0);
             return;
         }
-        let col = |x: f64| (((x - self.x0) * self.inv).max(0.0) as usize).min(self.nx - 1);
-        let row = |y: f64| (((y - self.y0) * self.inv).max(0.0) as usize).min(self.ny - 1);
+        // (Not negative, NaN made 0: truncated to an `i64`, one
+        // instruction, rather than a `usize`.)
+        let col = |x: f64| (((x - self.x0) * self.inv).max(0.0) as i64 as usize).min(self.nx - 1);
+        let row = |y: f64| (((y - self.y0) * self.inv).max(0.0) as i64 as usize).min(self.ny - 1);
         let (r0, r1) = (row(g.bounds[1] - SLACK), row(g.bounds[3] + SLACK));
         let (c0, c1) = (col(g.bounds[0] - SLACK), col(g.bounds[2] + SLACK));
         if r0 == r1 || c0 == c1 || (r1 - r0 == 1 && c1 - c0 == 1) {

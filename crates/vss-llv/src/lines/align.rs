@@ -227,15 +227,6 @@ fn mean_slope(mag: f64, counted: usize) -> f64 {
     }
 }
 
-/// `v.round()` as a whole number, for `-1 < v < 2⁶²` (the library's
-/// `round` is a call without SSE 4.1): the truncation, moved away from 0
-/// when the remainder (exact) is at least a half.
-fn round_small(v: f64) -> i64 {
-    let t = v as i64;
-    let r = v - t as f64;
-    t + i64::from(r >= 0.5) - i64::from(r <= -0.5)
-}
-
 /// [`samples`] on one image without invalid pixels, `len` the length of
 /// `s` (finite, positive): the same samples, read with one bounds test a
 /// sample.
@@ -253,15 +244,16 @@ fn samples_of_one(img: &GreyImage, s: &Segment, len: f64, out: &mut Vec<Sample>)
     for (k, o) in out.iter_mut().enumerate() {
         let t = (k as f64 + 0.5) / n * len;
         let (x, y) = (s.a.x + dx * t, s.a.y + dy * t);
-        // Rounded into `1..w - 1` only from within `(-1, w + 1)`.
-        if !(x > -1.0 && y > -1.0 && x < wf + 1.0 && y < hf + 1.0) {
+        // `x.round()` (halves away from 0) is in `1..w - 1` exactly when
+        // `0.5 ≤ x < w − 1.5`, and there it is `x + 0.5` truncated (the sum
+        // is exact below 2⁵¹, or rounds to the same whole number): the
+        // library's `round` is a call without SSE 4.1. (Truncated to an
+        // `i64`, one instruction, rather than a `usize`.)
+        if !(x >= 0.5 && y >= 0.5 && x < wf - 1.5 && y < hf - 1.5) {
             continue;
         }
-        let (x, y) = (round_small(x), round_small(y));
-        if !(x >= 1 && y >= 1 && x < w as i64 - 1 && y < h as i64 - 1) {
-            continue;
-        }
-        let Some(g) = sobel(d, w, y as usize * w + x as usize) else {
+        let (x, y) = ((x + 0.5) as i64 as usize, (y + 0.5) as i64 as usize);
+        let Some(g) = sobel(d, w, y * w + x) else {
             continue;
         };
         let (sample, m) = classify(g, (dx, dy), c2);
@@ -335,6 +327,16 @@ fn parts(v: &[Sample], min: f64, out: &mut Vec<(f64, f64)>) {
     }
 }
 
+/// The samples with evidence and the aligned ones, in one pass.
+fn counts(v: &[Sample]) -> (usize, usize) {
+    v.iter().fold((0, 0), |(c, a), x| {
+        (
+            c + usize::from(*x != Sample::Unknown),
+            a + usize::from(*x == Sample::Aligned),
+        )
+    })
+}
+
 /// Reusable buffers of [`keep_aligned`] (a warm workspace allocates
 /// nothing).
 #[derive(Clone, Debug, Default)]
@@ -370,8 +372,7 @@ pub fn keep_aligned(
         {
             continue;
         }
-        let counted = v.iter().filter(|x| **x != Sample::Unknown).count();
-        let aligned = v.iter().filter(|x| **x == Sample::Aligned).count();
+        let (counted, aligned) = counts(v);
         if counted == 0 {
             out.push(*s);
             continue;
