@@ -46,9 +46,7 @@
 //! derivative as weight helps where edges fade along their length (the
 //! yard's), not where they do not (the cubes').
 //!
-//! - **Ghosts.** A line of `GHOST_BLOCKS` blocks or more (about 36 px:
-//!   shorter than the lines the refit moves, since a drifted second track is
-//!   often short) that the refit cannot place because fewer than half its
+//! - **Ghosts.** A line the refit cannot place because fewer than half its
 //!   blocks have an edge of either polarity within `REACH` is not on an
 //!   edge along most of its length. Where it also runs beside a longer line
 //!   at under [`GHOST_DEG`], touching it at one end and leaving it by a few
@@ -76,8 +74,6 @@ const TRIM: f64 = 4.0;
 const BLOCK: usize = 8;
 /// Least number of blocks for a segment to be refitted.
 const MIN_BLOCKS: usize = 6;
-/// Least number of blocks for a segment to be tested as a ghost.
-const GHOST_BLOCKS: usize = 4;
 /// Half-width of the derivative kernel across the line.
 const KERNEL_A: usize = 3;
 /// Farthest a block's peak may lie from the line (px).
@@ -294,11 +290,11 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
         // Blocks of about `BLOCK` px of line.
         let len = seg.length();
         let steps = (len - 2.0 * TRIM).floor();
-        if steps.is_nan() || steps < (GHOST_BLOCKS * BLOCK - BLOCK / 2) as f64 {
+        if steps.is_nan() || steps < (MIN_BLOCKS * BLOCK - BLOCK / 2) as f64 {
             continue;
         }
         let blocks = ((steps as usize + BLOCK / 2) / BLOCK).min(f.count);
-        if blocks < GHOST_BLOCKS {
+        if blocks < MIN_BLOCKS {
             continue;
         }
         let img = if images.len() == 1 {
@@ -322,7 +318,7 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
             s.blocks.push(near_derivatives(&p, &kern));
             s.centres.push(f.first as f64 + 0.5 * (lo + hi - 1) as f64);
         }
-        if s.blocks.len() < GHOST_BLOCKS {
+        if s.blocks.len() < MIN_BLOCKS {
             continue;
         }
         let at_line = derivative(&total, &kern, R);
@@ -342,9 +338,6 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
             if 2 * s.blocks.iter().filter(|p| edge(p)).count() < s.blocks.len() {
                 s.unconfirmed.push(i);
             }
-            continue;
-        }
-        if s.blocks.len() < MIN_BLOCKS {
             continue;
         }
         if let Some(line) = fit.line() {

@@ -225,30 +225,6 @@ fn a_drifting_second_track_beside_its_edge_is_dropped() {
     assert_eq!(alone.len(), 1);
 }
 
-/// A short second track (45 px, fewer blocks than a refit needs) that
-/// starts on the edge and leaves it by 3 px is removed too: drifted tracks
-/// are often short, and the ghost test does not need the blocks a refit
-/// does. The line on the edge stays where it was.
-#[test]
-fn a_short_drifting_second_track_is_dropped() {
-    let img = edge_image(96, 120, A, B, 60.0, 160.0, None);
-    let (dx, dy) = (B.0 - A.0, B.1 - A.1);
-    let len = dx.hypot(dy);
-    let (u, n) = ((dx / len, dy / len), (-dy / len, dx / len));
-    let start = (A.0 + 20.0 * u.0, A.1 + 20.0 * u.1);
-    let end = (
-        start.0 + 45.0 * u.0 + 3.0 * n.0,
-        start.1 + 45.0 * u.1 + 3.0 * n.1,
-    );
-    let ghost = seg(start, end);
-    let mut s = RefineScratch::default();
-    let mut lines = vec![seg(A, B), ghost];
-    refine_into(std::slice::from_ref(&img), &mut lines, &mut s);
-    drop_ghosts(&mut lines, &s);
-    assert_eq!(lines.len(), 1, "{lines:?}");
-    assert!(off_line(lines[0].a, A, B) < 0.1 && off_line(lines[0].b, A, B) < 0.1);
-}
-
 /// An edge whose contrast changes sign along it (a beam in front of a
 /// plate: lighter than the background on one part, darker than the plate
 /// on the other) is confirmed by the blocks of either polarity, and is not
