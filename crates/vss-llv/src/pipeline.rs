@@ -112,6 +112,8 @@ pub struct Workspace {
     draw: super::lines::draw::DrawScratch,
     /// Whether the last run's image was noisy (`edges.noisy_sigma`).
     noisy: bool,
+    /// The rows [`noise_level`] reads the image's noise from.
+    noise_rows: Vec<i16>,
     /// Whether `out` holds the results of a complete run.
     valid: bool,
     /// Free each direction's buffers after its lines ([`Workspace::lean`]).
@@ -219,7 +221,9 @@ impl Workspace {
                 self.out.corrected.first()
             };
             let sigma = match first {
-                Some(img) if p.edges.noisy_sigma > 0.0 => noise_level(img),
+                Some(img) if p.edges.noisy_sigma > 0.0 => {
+                    noise::noise_level_with(img, &mut self.noise_rows)
+                }
                 _ => 0.0,
             };
             self.noisy = p.edges.noisy_sigma > 0.0 && sigma >= p.edges.noisy_sigma;

@@ -14,6 +14,12 @@ use crate::GreyImage;
 /// down, in whole numbers, so the sum is exact and the loops run in vector
 /// lanes.
 pub fn noise_level(img: &GreyImage) -> f64 {
+    noise_level_with(img, &mut Vec::new())
+}
+
+/// [`noise_level`] with the rows' buffer `buf` given (the pipeline's, so
+/// that its warm runs allocate nothing).
+pub fn noise_level_with(img: &GreyImage, buf: &mut Vec<i16>) -> f64 {
     let (w, h) = img.size();
     if w < 3 || h < 3 {
         return 0.0;
@@ -22,14 +28,22 @@ pub fn noise_level(img: &GreyImage) -> f64 {
     let mask = img.valid_mask();
     let (mut sum, mut n) = (0u64, 0u64);
     // Second differences across of the three rows under the window.
-    let mut across = [vec![0i16; w - 2], vec![0i16; w - 2], vec![0i16; w - 2]];
+    buf.clear();
+    buf.resize(3 * (w - 2), 0);
+    let (r0, rest) = buf.split_at_mut(w - 2);
+    let (r1, r2) = rest.split_at_mut(w - 2);
+    let mut across = [r0, r1, r2];
     for (y, row) in across.iter_mut().enumerate().take(2) {
         second_difference(&d[y * w..(y + 1) * w], row);
     }
     for y in 1..h - 1 {
         // Rows y − 1, y, y + 1 are in `across[(y − 1) % 3]`, … .
-        second_difference(&d[(y + 1) * w..(y + 2) * w], &mut across[(y + 1) % 3]);
-        let (a, b, c) = (&across[(y - 1) % 3], &across[y % 3], &across[(y + 1) % 3]);
+        second_difference(&d[(y + 1) * w..(y + 2) * w], across[(y + 1) % 3]);
+        let (a, b, c) = (
+            &*across[(y - 1) % 3],
+            &*across[y % 3],
+            &*across[(y + 1) % 3],
+        );
         match mask {
             None => {
                 // |v| ≤ 16 · 255 fits i16, and a chunk of 2¹⁶ of them sums
