@@ -42,7 +42,9 @@ mod scan_layout;
 pub(crate) mod strips;
 
 use super::band::{Rows, Whole};
-use super::{NoiseMap, Response, key};
+#[cfg(test)]
+use super::key;
+use super::{NoiseMap, Response};
 use crate::params::EdgeParams;
 use crate::{EdgePoint, EdgePoints, ScanDir};
 #[doc(hidden)]
@@ -656,7 +658,9 @@ pub(crate) fn scan_rows<R: Rows>(
             map.pos[y * wpr..(y + 1) * wpr].copy_from_slice(pos);
             map.neg[y * wpr..(y + 1) * wpr].copy_from_slice(neg);
         }
-        let [lo, _, hi] = keys;
+        // (The key from the key row: `key(row[x])` is a branch on the
+        // sign, which a photograph's edges make unpredictable.)
+        let [lo, mid, hi] = keys;
         for (k, &word) in st.iter().enumerate() {
             let mut m = word;
             while m != 0 {
@@ -665,7 +669,7 @@ pub(crate) fn scan_rows<R: Rows>(
                 sink(Peak {
                     x: x as u16,
                     y: y as u16,
-                    key: key(row[x]),
+                    key: mid[x],
                     sum: row[x],
                     lo: lo[x],
                     hi: hi[x],
