@@ -27,8 +27,9 @@
 //! time, safe intrinsics), and the compares' sign bits (movemask) are the
 //! map's words and the candidates' bits as they are; elsewhere the same
 //! test runs in plain code, which is also the reference the tests compare
-//! the lanes with. The candidates above 3.5 σ are rare, so what follows is
-//! plain code.
+//! the lanes with. Each candidate takes along its sum and its neighbours'
+//! keys, so that its edge point is made without reading the response
+//! again (`peaks/points.rs`).
 //!
 //! Why one pass and bit masks: a call per peak to fill a map (about ten
 //! thousand a direction), a second pass for the edge points, or a test of
@@ -36,11 +37,14 @@
 //! does in all; `docs/performance.md` has the measurements.
 
 mod lanes;
+mod points;
 mod scan_layout;
 pub(crate) mod strips;
 
 use super::band::{Rows, Whole};
-use super::{NoiseMap, Response, key};
+#[cfg(test)]
+use super::key;
+use super::{NoiseMap, Response};
 use crate::params::EdgeParams;
 use crate::{EdgePoint, EdgePoints, ScanDir};
 #[doc(hidden)]
@@ -69,6 +73,8 @@ pub struct PeakScratch {
     start: Vec<u32>,
     fill: Vec<u32>,
     grouped: Vec<i16>,
+    /// The kept candidates, where a region has more than `M`.
+    kept: Vec<Peak>,
     noise: super::NoiseScratch,
 }
 
@@ -77,12 +83,17 @@ pub struct PeakScratch {
 pub type Starts = Vec<[u16; 2]>;
 
 /// A peak found by the pass: its pixel and key (images are at most 8192
-/// pixels a side, `image::MAX_PIXELS`, so coordinates fit `u16`).
+/// pixels a side, `image::MAX_PIXELS`, so coordinates fit `u16`), its sum,
+/// and the keys before and after it along the scan: all its edge point
+/// needs, taken while its rows are at hand.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Peak {
     pub x: u16,
     pub y: u16,
     pub key: i16,
+    pub sum: i16,
+    pub lo: i16,
+    pub hi: i16,
 }
 
 /// The peaks a line extractor may follow: one bit per pixel and polarity
@@ -404,34 +415,33 @@ pub fn points_into(
         h,
         dir: resp.dir,
     };
-    let sums = resp.sums();
-    select(shape, resp.scale(), p, &cand, |i| sums[i], out, starts, s);
+    select(shape, resp.scale(), p, &cand, out, starts, s);
     s.cand = cand;
 }
 
-/// The edge points among the candidates `cand` of a response (`sum(i)`
-/// its sum at image index `i`): those among the `M` strongest of their
-/// region, with their subpixel positions, into `out` and `starts`.
-#[allow(clippy::too_many_arguments)]
+/// The edge points among the candidates `cand` of a response: those
+/// among the `M` strongest of their region, with their subpixel positions,
+/// into `out` and `starts`.
 fn select(
     shape: Shape,
     scale: f32,
     p: &EdgeParams,
     cand: &[Peak],
-    sum: impl Fn(usize) -> i16,
     out: &mut EdgePoints,
     starts: &mut Starts,
     s: &mut PeakScratch,
 ) {
-    let (region, nreg, m) = regions(shape, p);
-    region_limits(cand, nreg, m, region, s);
-    for c in cand {
-        if c.key < s.lim[region(c)] {
-            continue;
-        }
-        out.points.push(point_of(c, shape, scale, &sum));
-        starts.push([c.x, c.y]);
+    if !points::crowdable(shape, p) {
+        points::emit(shape, scale, cand, out, starts);
+        return;
     }
+    let (region, nreg, m) = regions(shape, p);
+    points::region_limits(cand, nreg, m, region, s);
+    let mut kept = std::mem::take(&mut s.kept);
+    kept.clear();
+    kept.extend(cand.iter().filter(|c| c.key >= s.lim[region(c)]));
+    points::emit(shape, scale, &kept, out, starts);
+    s.kept = kept;
 }
 
 /// The region of a candidate, the number of regions, and `M`: a region
@@ -455,18 +465,12 @@ fn regions(shape: Shape, p: &EdgeParams) -> (impl Fn(&Peak) -> usize + Copy, usi
     (region, nreg, m)
 }
 
-/// The edge point of candidate `c` (`sum(i)` the response's sum at image
-/// index `i`): its subpixel position along the scan and its response.
+/// The edge point of candidate `c`: its subpixel position along the scan
+/// and its response.
 #[inline]
-fn point_of(c: &Peak, shape: Shape, scale: f32, sum: &impl Fn(usize) -> i16) -> EdgePoint {
-    let w = shape.w;
-    let step = match shape.dir {
-        ScanDir::Horizontal => 1,
-        ScanDir::Vertical => w,
-    };
-    let i = usize::from(c.y) * w + usize::from(c.x);
-    let mag = |j: usize| f32::from(key(sum(j)));
-    let d = subpixel(mag(i - step), mag(i), mag(i + step));
+fn point_of(c: &Peak, shape: Shape, scale: f32) -> EdgePoint {
+    let mag = f32::from;
+    let d = subpixel(mag(c.lo), mag(c.key), mag(c.hi));
     let (x, y) = (f32::from(c.x), f32::from(c.y));
     let (x, y) = match shape.dir {
         ScanDir::Horizontal => (x + d, y),
@@ -475,7 +479,7 @@ fn point_of(c: &Peak, shape: Shape, scale: f32, sum: &impl Fn(usize) -> i16) -> 
     EdgePoint {
         x,
         y,
-        response: f32::from(sum(i)) * scale,
+        response: f32::from(c.sum) * scale,
     }
 }
 
@@ -654,6 +658,9 @@ pub(crate) fn scan_rows<R: Rows>(
             map.pos[y * wpr..(y + 1) * wpr].copy_from_slice(pos);
             map.neg[y * wpr..(y + 1) * wpr].copy_from_slice(neg);
         }
+        // (The key from the key row: `key(row[x])` is a branch on the
+        // sign, which a photograph's edges make unpredictable.)
+        let [lo, mid, hi] = keys;
         for (k, &word) in st.iter().enumerate() {
             let mut m = word;
             while m != 0 {
@@ -662,7 +669,10 @@ pub(crate) fn scan_rows<R: Rows>(
                 sink(Peak {
                     x: x as u16,
                     y: y as u16,
-                    key: key(row[x]),
+                    key: mid[x],
+                    sum: row[x],
+                    lo: lo[x],
+                    hi: hi[x],
                 });
             }
         }
@@ -715,56 +725,11 @@ fn candidates_plain(resp: &Response, noise: &NoiseMap, thr: &[i32], cand: &mut V
                     x: x as u16,
                     y: y as u16,
                     key: k0,
+                    sum: sums[i],
+                    lo: key(sums[i - step]),
+                    hi: key(sums[i + step]),
                 });
             }
-        }
-    }
-}
-
-/// Per region, the smallest key kept: 0 where it has at most `m`
-/// candidates, else its `m`-th largest key.
-fn region_limits(
-    cand: &[Peak],
-    nreg: usize,
-    m: usize,
-    region: impl Fn(&Peak) -> usize,
-    s: &mut PeakScratch,
-) {
-    s.count.clear();
-    s.count.resize(nreg, 0);
-    s.lim.clear();
-    s.lim.resize(nreg, 0);
-    for c in cand {
-        s.count[region(c)] += 1;
-    }
-    if s.count.iter().all(|&c| c as usize <= m) {
-        return;
-    }
-    // Group the keys of the crowded regions, then select in each.
-    s.start.clear();
-    let mut at = 0u32;
-    for &c in &s.count {
-        s.start.push(at);
-        if c as usize > m {
-            at += c;
-        }
-    }
-    s.grouped.clear();
-    s.grouped.resize(at as usize, 0);
-    s.fill.clone_from(&s.start);
-    for c in cand {
-        let r = region(c);
-        if s.count[r] as usize > m {
-            s.grouped[s.fill[r] as usize] = c.key;
-            s.fill[r] += 1;
-        }
-    }
-    for r in 0..nreg {
-        let c = s.count[r] as usize;
-        if c > m {
-            let g = &mut s.grouped[s.start[r] as usize..s.start[r] as usize + c];
-            let (_, kth, _) = g.select_nth_unstable_by(m - 1, |a, b| b.cmp(a));
-            s.lim[r] = *kth;
         }
     }
 }

@@ -92,10 +92,9 @@ pub fn detect_strips<'a>(
     }
     out.points.reserve_exact(kept);
     starts.reserve_exact(kept);
-    let sum = |i| src.at(i);
     pass.run(s, &mut |c| {
         if c.key >= lim[region(&c)] {
-            out.points.push(point_of(&c, shape, scale, &sum));
+            out.points.push(point_of(&c, shape, scale));
             starts.push([c.x, c.y]);
         }
     });

@@ -223,3 +223,99 @@ fn key_floors() {
     assert_eq!(key_floor(2.0, 0.0), i32::from(i16::MAX));
     assert_eq!(key_floor(1e9, 0.5), i32::from(i16::MAX));
 }
+
+/// The edge points of the batch path equal those made a point at a time
+/// from the plain candidates, the response's sums and a sort per region,
+/// to the bit, for limits `M` below, at and above what a region can hold
+/// (the case in which the per-region count is skipped).
+#[test]
+fn points_equal_a_point_at_a_time() {
+    use crate::rng::SplitMix64;
+    let mut rng = SplitMix64::new(11);
+    for (w, h) in [(37, 53), (130, 70)] {
+        let d: Vec<u8> = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                let base = if (x / 11 + y / 9) % 2 == 0 {
+                    150.0
+                } else {
+                    70.0
+                };
+                (base + 4.0 * rng.gauss()).clamp(0.0, 255.0) as u8
+            })
+            .collect();
+        let img = GreyImage::new(w, h, d).unwrap();
+        for dir in [ScanDir::Horizontal, ScanDir::Vertical] {
+            let r = response(&img, dir, 4).unwrap();
+            let (n, step) = match dir {
+                ScanDir::Horizontal => (w, 1),
+                ScanDir::Vertical => (h, w),
+            };
+            let most = n.div_ceil(2) as u32;
+            for (rl, m) in [
+                (1, 1),
+                (1, 3),
+                (3, 5),
+                (1, most - 1),
+                (1, most),
+                (2, 2 * most),
+            ] {
+                let mut p = params();
+                (p.region_lines, p.per_region, p.floor) = (rl, m, 1.0);
+                p.noise_sigmas = 1.0;
+                let got = peaks(&r, &p);
+                // The same a point at a time.
+                let mut noise = NoiseMap::default();
+                let mut ns = crate::edges::NoiseScratch::default();
+                noise.estimate_into(&r, &mut ns);
+                noise.bound(p.noise_percentile, p.noise_cap, &mut ns);
+                let mut thr = Vec::new();
+                tile_floors(r.scale(), &noise, p.floor, p.noise_sigmas, &mut thr);
+                let mut cand = Vec::new();
+                candidates_plain(&r, &noise, &thr, &mut cand);
+                let region = |c: &Peak| match dir {
+                    ScanDir::Horizontal => usize::from(c.y) / rl as usize,
+                    ScanDir::Vertical => usize::from(c.x) / rl as usize,
+                };
+                let mut keys = vec![Vec::new(); n.max(w).max(h)];
+                for c in &cand {
+                    keys[region(c)].push(c.key);
+                }
+                let lim: Vec<i16> = keys
+                    .iter_mut()
+                    .map(|k| {
+                        k.sort_unstable_by(|a, b| b.cmp(a));
+                        if k.len() > m as usize {
+                            k[m as usize - 1]
+                        } else {
+                            0
+                        }
+                    })
+                    .collect();
+                let sums = r.sums();
+                let mag = |i: usize| f32::from(key(sums[i]));
+                let want: Vec<[u32; 3]> = cand
+                    .iter()
+                    .filter(|c| c.key >= lim[region(c)])
+                    .map(|c| {
+                        let i = usize::from(c.y) * w + usize::from(c.x);
+                        let d = subpixel(mag(i - step), mag(i), mag(i + step));
+                        let (mut x, mut y) = (f32::from(c.x), f32::from(c.y));
+                        match dir {
+                            ScanDir::Horizontal => x += d,
+                            ScanDir::Vertical => y += d,
+                        }
+                        [x, y, f32::from(sums[i]) * r.scale()].map(f32::to_bits)
+                    })
+                    .collect();
+                let bits: Vec<[u32; 3]> = got
+                    .points
+                    .iter()
+                    .map(|q| [q.x, q.y, q.response].map(f32::to_bits))
+                    .collect();
+                assert!(want.len() > 20, "{w}x{h} {dir:?}: {} points", want.len());
+                assert_eq!(bits, want, "{w}x{h} {dir:?} lines {rl} M {m}");
+            }
+        }
+    }
+}
