@@ -197,6 +197,12 @@ impl<'a, S: SumAt> ResponsePeaks<'a, S> {
         f32::from(key(self.sums.sum_at(j)))
     }
 
+    /// The signed response (grey levels) at image index `i`.
+    #[inline(always)]
+    fn response(&self, i: usize) -> f32 {
+        f32::from(self.sums.sum_at(i)) * self.scale
+    }
+
     /// The subpixel position of the peak at whole position `u`, image
     /// index `i`, and its magnitude.
     #[inline(always)]
@@ -215,7 +221,7 @@ impl<'a, S: SumAt> ResponsePeaks<'a, S> {
         Cand {
             u: pos,
             v,
-            response: f32::from(self.sums.sum_at(i)) * self.scale,
+            response: self.response(i),
             z: k0 * self.inv_sigma[(self.tile_u[u] + self.tile_v[v]) as usize],
             id: i,
             pix: u as u32,
@@ -298,7 +304,7 @@ impl<S: SumAt> Peaks for ResponsePeaks<'_, S> {
             let i = self.index(x, v);
             let (pos, k0) = self.position(x, i);
             let d = (pos - u).abs();
-            let m = (f32::from(self.sums.sum_at(i)) * self.scale).abs();
+            let m = self.response(i).abs();
             if d <= reach && best.is_none_or(|(bm, bd, ..)| m > bm || (m == bm && d < bd)) {
                 best = Some((m, d, x, pos, k0));
             }
