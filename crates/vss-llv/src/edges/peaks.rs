@@ -471,16 +471,26 @@ fn regions(shape: Shape, p: &EdgeParams) -> (impl Fn(&Peak) -> usize + Copy, usi
 fn point_of(c: &Peak, shape: Shape, scale: f32) -> EdgePoint {
     let mag = f32::from;
     let d = subpixel(mag(c.lo), mag(c.key), mag(c.hi));
+    placed(c, d, response_of(c, scale), shape)
+}
+
+/// The response (grey levels) of candidate `c`, `scale` grey levels a sum.
+#[inline(always)]
+fn response_of(c: &Peak, scale: f32) -> f32 {
+    f32::from(c.sum) * scale
+}
+
+/// The edge point of candidate `c` at subpixel offset `d` along the scan,
+/// with its response `r`: the one place a candidate becomes a point
+/// ([`point_of`], and `points::emit` for a batch).
+#[inline(always)]
+fn placed(c: &Peak, d: f32, r: f32, shape: Shape) -> EdgePoint {
     let (x, y) = (f32::from(c.x), f32::from(c.y));
     let (x, y) = match shape.dir {
         ScanDir::Horizontal => (x + d, y),
         ScanDir::Vertical => (x, y + d),
     };
-    EdgePoint {
-        x,
-        y,
-        response: f32::from(c.sum) * scale,
-    }
+    EdgePoint { x, y, response: r }
 }
 
 /// Every pixel that is a peak along the scan (`|E|` above the left/upper

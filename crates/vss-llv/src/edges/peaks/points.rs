@@ -19,9 +19,9 @@
 //! lines of `n` positions has at most `L·⌈n/2⌉`; when that is at most `M`
 //! every candidate is kept and the per-region count is not needed.
 
-use super::{Peak, PeakScratch, Shape, Starts, subpixel};
+use super::{Peak, PeakScratch, Shape, Starts, placed, response_of, subpixel};
 use crate::params::EdgeParams;
-use crate::{EdgePoint, EdgePoints, ScanDir};
+use crate::{EdgePoints, ScanDir};
 
 /// Candidates a batch.
 const BATCH: usize = 64;
@@ -56,16 +56,16 @@ pub(super) fn emit(
             em[k] = f32::from(c.lo);
             e0[k] = f32::from(c.key);
             ep[k] = f32::from(c.hi);
-            resp[k] = f32::from(c.sum) * scale;
+            resp[k] = response_of(c, scale);
         }
         subpixels(&em, &e0, &ep, &mut d);
-        let vertical = shape.dir == ScanDir::Vertical;
-        out.points
-            .extend(chunk.iter().zip(&d).zip(&resp).map(|((c, &d), &r)| {
-                let (x, y) = (f32::from(c.x), f32::from(c.y));
-                let (x, y) = if vertical { (x, y + d) } else { (x + d, y) };
-                EdgePoint { x, y, response: r }
-            }));
+        out.points.extend(
+            chunk
+                .iter()
+                .zip(&d)
+                .zip(&resp)
+                .map(|((c, &d), &r)| placed(c, d, r, shape)),
+        );
         starts.extend(chunk.iter().map(|c| [c.x, c.y]));
     }
 }
