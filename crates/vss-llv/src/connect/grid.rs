@@ -277,14 +277,18 @@ impl Grid {
         out.sort_unstable();
     }
 
-    /// Lists segment `k` with environment `g` in its cells.
+    /// Lists segment `k` with environment `g` in its cells. A segment
+    /// listed again after it grew gets its new direction's bin: where its
+    /// entry is a cell's last, that entry's bin is overwritten (an old bin
+    /// would hide the grown segment from partners of its new direction).
     pub(super) fn insert(&mut self, k: u32, g: &Geo) {
         let b = self.bin(g);
         let mut cells = std::mem::take(&mut self.cells);
         self.each_cell(g, |c| {
             let c = &mut cells[c];
-            if c.last().is_none_or(|e| e.0 != k) {
-                c.push((k, b));
+            match c.last_mut() {
+                Some(e) if e.0 == k => e.1 = b,
+                _ => c.push((k, b)),
             }
         });
         self.cells = cells;
@@ -312,5 +316,41 @@ impl Grid {
             }
         });
         out.sort_unstable();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::ConnectParams;
+    use crate::{Point, Segment};
+
+    fn geo(ax: f64, ay: f64, bx: f64, by: f64) -> Geo {
+        Geo::of(
+            &Segment::new(Point::new(ax, ay), Point::new(bx, by)),
+            &ConnectParams::default(),
+        )
+    }
+
+    #[test]
+    fn a_segment_listed_again_after_it_grew_is_found_by_its_new_direction() {
+        // Segment 1 first points 30° off segment 0, then (merged with a
+        // third, say) lies along it: a partner search from 0 must find it.
+        let g0 = geo(0.0, 0.0, 40.0, 0.0);
+        let before = geo(45.0, 0.0, 80.0, 20.2);
+        let after = geo(45.0, 0.2, 90.0, 0.5);
+        let mut grid = Grid::default();
+        grid.reset(&[g0, before], 5f64.to_radians());
+        assert!(grid.bins > 3 && grid.bin(&before) != grid.bin(&after));
+        grid.insert(0, &g0);
+        grid.insert(1, &before);
+        grid.seal();
+        let (mut seen, mut out) = (Seen::default(), Vec::new());
+        seen.reset(2);
+        grid.after(0, &g0, &mut seen, &mut out, |_| true);
+        assert!(out.is_empty(), "30° apart: not a candidate, {out:?}");
+        grid.insert(1, &after);
+        grid.after(0, &g0, &mut seen, &mut out, |_| true);
+        assert_eq!(out, [1]);
     }
 }
