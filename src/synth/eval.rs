@@ -18,11 +18,8 @@ use super::straight::Straightness;
 use super::{Camera, PointLight, RenderOptions, Scene};
 use crate::llv::lens::LensMap;
 use crate::llv::pipeline::{self, Input};
-use crate::llv::refine;
 use crate::llv::rng::mix;
-use crate::llv::{
-    EdgePoints, GreyImage, LlvError, Params, Point, Segment, connect, corners, lines,
-};
+use crate::llv::{EdgePoints, GreyImage, LlvError, Params, Point, Segment};
 
 /// Contrast (grey levels) below which an edge is no edge at all, not even
 /// a don't-care one.
@@ -184,7 +181,7 @@ pub fn evaluate(cfg: &EvalConfig, params: &Params) -> Result<EvalReport, LlvErro
                 &out.edges_v,
                 std::slice::from_ref(&img),
                 params,
-            );
+            )?;
             whole.add_with(&wp, &c.truth, &c.dont_care);
             let ident = |p: Point| p;
             st_sub.add(&c.truth, &out.edges_h, &out.edges_v, &ident);
@@ -227,31 +224,26 @@ pub(crate) fn run_one(
 }
 
 /// Lines from edge points rounded to whole pixels: what the pipeline would
-/// give without the subpixel step (llv.md §2.4): extraction, CONNECT, the
-/// refit on `images` and corner closing as in `pipeline::run`.
+/// give without the subpixel step (llv.md §2.4). The pipeline's own run
+/// from saved edge points ([`pipeline::Workspace::run_saved`]) makes them,
+/// so every stage after the edges is the one `pipeline::run` uses.
 pub fn whole_pixel_lines(
     h: &EdgePoints,
     v: &EdgePoints,
     images: &[GreyImage],
     params: &Params,
-) -> Vec<Segment> {
-    let mut raw = lines::extract(&round_points(h), &params.lines);
-    raw.extend(lines::extract(&round_points(v), &params.lines));
-    // The same stages after the edges as `pipeline::run`.
-    let mut out = if params.connect.enabled {
-        connect::connect(&raw, &params.connect)
-    } else {
-        raw
+) -> Result<Vec<Segment>, LlvError> {
+    let saved = pipeline::Saved::Edges {
+        h: round_points(h),
+        v: round_points(v),
     };
-    if params.connect.refine {
-        let mut scratch = refine::RefineScratch::default();
-        refine::refine_into(images, &mut out, &mut scratch);
-        refine::drop_ghosts(&mut out, &scratch);
-    }
-    if params.connect.corner_radius > 0.0 {
-        corners::close_corners(&mut out, params.connect.corner_radius);
-    }
-    out
+    let input = Input {
+        images,
+        ambient: None,
+        lens: None,
+    };
+    let mut ws = pipeline::Workspace::new();
+    Ok(ws.run_saved(saved, params, Some(&input))?.lines.clone())
 }
 
 /// The edge points with their positions rounded to whole pixels.
