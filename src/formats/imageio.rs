@@ -436,8 +436,13 @@ fn decode_jpeg(
     };
     let mut dec = image::codecs::jpeg::JpegDecoder::new(Cursor::new(bytes)).map_err(bad)?;
     // The decoder fills a cut-off scan with grey; a photograph without its
-    // end-of-image marker is refused instead of half read.
-    if !bytes.windows(2).any(|m| m == [0xFF, 0xD9]) {
+    // end-of-image marker is refused instead of half read. The marker must
+    // follow the picture's last scan: a camera's EXIF thumbnail, before
+    // that scan, ends with one of its own. (Neither marker can occur inside
+    // a scan's coded data, where every 0xFF byte is followed by 0x00 or a
+    // restart marker.)
+    let marker = |m: u8| bytes.windows(2).rposition(|w| w == [0xFF, m]);
+    if marker(0xD9).is_none_or(|eoi| marker(0xDA).is_some_and(|sos| eoi < sos)) {
         return Err(FormatError::new(
             path,
             Location::None,

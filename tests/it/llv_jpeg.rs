@@ -49,6 +49,18 @@ fn sof(bytes: &[u8]) -> usize {
         + 4
 }
 
+/// `bytes` with an APP1 segment after SOI holding `payload` after an
+/// `Exif` header, as a camera stores its thumbnail.
+fn with_app1(bytes: &[u8], payload: &[u8]) -> Vec<u8> {
+    let mut out = bytes[..2].to_vec();
+    out.extend_from_slice(&[0xFF, 0xE1]);
+    out.extend_from_slice(&((payload.len() + 8) as u16).to_be_bytes());
+    out.extend_from_slice(b"Exif\x00\x00");
+    out.extend_from_slice(payload);
+    out.extend_from_slice(&bytes[2..]);
+    out
+}
+
 /// `bytes` with an EXIF APP1 segment giving orientation `o` after SOI.
 fn with_orientation(bytes: &[u8], o: u16) -> Vec<u8> {
     let mut tiff = b"MM\x00\x2a\x00\x00\x00\x08".to_vec();
@@ -139,6 +151,19 @@ fn bad_jpegs_give_clear_errors() {
     cases.push((
         "cut.jpg",
         good[..good.len() / 2].to_vec(),
+        K::Truncated,
+        "truncated",
+    ));
+    // Truncated in the scan of a camera's file, whose EXIF thumbnail (a
+    // whole JPEG inside APP1, before the picture's scan) keeps its own
+    // end-of-image marker: the picture's own must follow its last scan.
+    let with_thumb = with_app1(&good, &good);
+    let whole = d.path().join("thumb.jpg");
+    std::fs::write(&whole, &with_thumb).unwrap();
+    assert_eq!(read_any_noted(&whole).unwrap().0.image.size(), (96, 64));
+    cases.push((
+        "cut-thumb.jpg",
+        with_thumb[..with_thumb.len() - good.len() / 2].to_vec(),
         K::Truncated,
         "truncated",
     ));
