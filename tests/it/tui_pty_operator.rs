@@ -1,0 +1,39 @@
+//! Found by using the console as an operator does, through the real
+//! binary in a pty at 80 × 24: a session mended while the console runs
+//! opens without a restart.
+
+use super::tui_harness::Console;
+
+/// A session whose manifest does not read is listed as damaged; the
+/// error says to mend it "then open it again", and once mended (while
+/// the console runs) Enter opens it: the list is read again, not the
+/// one from the console's start.
+#[test]
+fn a_session_mended_while_the_console_runs_opens() {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("cube");
+    let m = c.session().join("cube.toml");
+    let good = std::fs::read_to_string(&m).unwrap();
+    let mut c = c.restart_after(|dir| {
+        let m = dir.join("sessions/cube/cube.toml");
+        let half = &good[..good.len() / 2];
+        std::fs::write(m, format!("{half}\n[[[")).unwrap();
+    });
+    c.wait_text("DAMAGED", 10);
+    c.send("\r");
+    let s = c.wait_text("last message", 5);
+    assert!(s.contains("cannot be opened"), "{s}");
+    c.send("\x1b");
+    c.wait("the window closed", 5, |s| !s.contains("last message"));
+    std::fs::write(&m, &good).unwrap();
+    c.send("\r");
+    let s = c.wait("the mended session open", 10, |s| {
+        s.contains("lightings abc") || s.contains("last message")
+    });
+    assert!(
+        s.contains("┌ session cube") && !s.contains("last message"),
+        "the mended session opens:\n{s}"
+    );
+    c.send("q");
+    c.wait_exit(10);
+}
