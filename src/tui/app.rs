@@ -183,7 +183,8 @@ impl App {
     }
 
     /// Closes a question that no longer applies, saying so: "quit anyway?"
-    /// asked because a capture was under way or a lighting not saved, once
+    /// asked because a capture was under way or a lighting or an image's
+    /// outputs not saved, once
     /// neither holds (quitting is then safe, and `q` quits at once).
     fn close_stale_question(&mut self) {
         let quit_asked = matches!(
@@ -199,7 +200,8 @@ impl App {
                 .tracker
                 .current
                 .as_ref()
-                .is_some_and(|c| !c.unsaved.is_empty());
+                .is_some_and(|c| !c.unsaved.is_empty())
+            || !self.session.refused.is_empty();
         if quit_asked && !still {
             self.chrome.modal = None;
             self.ctx()
@@ -347,6 +349,12 @@ impl App {
                         ),
                         Pending::Quit,
                     );
+                } else if let Some((k, why)) = self.session.refused.first() {
+                    let q = format!(
+                        "The outputs of image {k} are not saved ({why}): quitting loses them \
+                         (its frames are kept). Quit anyway?"
+                    );
+                    self.ctx().ask(q, Pending::Quit);
                 } else {
                     self.chrome.quit = true;
                 }
