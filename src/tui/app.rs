@@ -11,7 +11,7 @@
 //! the frame, the picture, or a screen's `update(action, ctx)` — that
 //! matches its own actions exhaustively. Drawing (`screens/`) only reads.
 
-use ratatui::crossterm::event::{KeyEvent, KeyEventKind};
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyEventKind};
 
 use super::event::{Cmd, DeviceCmd, Msg, StoreCmd};
 use super::keymap::{self, Action, GlobalAction, NavAction, Scope, ScreenId};
@@ -38,7 +38,7 @@ mod tracker;
 pub use calibrate::{CalibrateScreen, Centre, Field, PLATE, short_name};
 pub use capture::CaptureScreen;
 pub use cell::{CellState, DeviceState};
-pub use chrome::{Chrome, LogView, Overlay, Search, SearchTarget};
+pub use chrome::{Chrome, LogView, MIN_SIZE, Overlay, Search, SearchTarget};
 pub use edit::{EditScreen, describe_op};
 pub use files::FilesScreen;
 pub use log::{Level, Log, LogEntry};
@@ -241,6 +241,15 @@ impl App {
             return Vec::new();
         }
         let scope = self.scope();
+        // Too small a terminal shows no screen, only what goes on and the
+        // question asked: keys act on nothing unseen. q quits, Esc stops a
+        // capture, and a question or a field on screen takes its keys.
+        if self.chrome.too_small() && !matches!(scope, Scope::Prompt | Scope::Confirm) {
+            let quit = keymap::lookup(scope, &key) == Some(Action::Global(GlobalAction::Quit));
+            if !quit && key.code != KeyCode::Esc {
+                return Vec::new();
+            }
+        }
         // A search on takes n, N and Esc while what it searches is in
         // front; once that is gone, so is the search.
         if self.chrome.search.is_some() && !matches!(scope, Scope::Prompt | Scope::Confirm) {

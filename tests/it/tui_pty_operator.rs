@@ -1,6 +1,7 @@
 //! Found by using the console as an operator does, through the real
 //! binary in a pty at 80 × 24: a session mended while the console runs
-//! opens without a restart.
+//! opens without a restart; keys typed while the terminal is too small
+//! do nothing unseen.
 
 use super::tui_harness::Console;
 
@@ -33,6 +34,33 @@ fn a_session_mended_while_the_console_runs_opens() {
     assert!(
         s.contains("┌ session cube") && !s.contains("last message"),
         "the mended session opens:\n{s}"
+    );
+    c.send("q");
+    c.wait_exit(10);
+}
+
+/// While the terminal is too small the screen says only that, q quits
+/// and Esc stops: Enter on the session list (unseen) opened the session,
+/// and any other key acted on a screen the operator could not see.
+#[test]
+fn keys_typed_in_too_small_a_terminal_act_on_nothing_unseen() {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("cube");
+    let mut c = c.restart(80, 24, &[]);
+    c.wait_text("choose a session", 10);
+    c.resize(20, 60);
+    let s = c.wait_text("terminal too small", 10);
+    assert!(s.contains("other keys wait"), "{s}");
+    c.send("\r");
+    c.send("n");
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let s = c.screen();
+    assert!(!s.contains("new session name"), "{s}");
+    c.resize(24, 80);
+    let s = c.wait_text("choose a session", 10);
+    assert!(
+        !s.contains("lightings abc"),
+        "no session opened unseen:\n{s}"
     );
     c.send("q");
     c.wait_exit(10);

@@ -26,6 +26,9 @@ pub enum Overlay {
     Message { scroll: usize },
 }
 
+/// The smallest terminal the screens are drawn in.
+pub const MIN_SIZE: (u16, u16) = (64, 18);
+
 /// How long the answer to a key stays on the message line at least, unless
 /// the operator presses another key: time to read its three rows.
 pub const HOLD: Duration = Duration::from_secs(3);
@@ -151,6 +154,11 @@ impl Chrome {
         }
         self.held = None;
         self.log.pushed() > h.seq + 1
+    }
+
+    /// The terminal is below [`MIN_SIZE`]: the screens are not drawn.
+    pub fn too_small(&self) -> bool {
+        self.size.0 < MIN_SIZE.0 || self.size.1 < MIN_SIZE.1
     }
 
     pub fn cycle_log(&mut self) {
