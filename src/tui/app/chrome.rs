@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use super::log::{Log, LogEntry};
+use super::log::{Level, Log, LogEntry};
 use super::modal::Modal;
 use crate::tui::keymap::{GlobalAction, ScreenId, ViewerAction};
 use crate::tui::mode::Look;
@@ -118,12 +118,24 @@ impl Chrome {
 
     /// The message the message line shows, and how many newer ones are in
     /// the log only: the answer to the last key while it is held, else
-    /// the newest message.
+    /// the newest message. An error that comes after a held answer that is
+    /// not one takes the line at once: it is the key's outcome (a save
+    /// that failed after "saving…", an edit not written), not background.
     pub fn shown_message(&self) -> Option<(&LogEntry, usize)> {
         if let Some(h) = self.held
             && let Some(e) = self.log.nth_pushed(h.seq)
         {
-            return Some((e, self.log.pushed() - 1 - h.seq));
+            let pushed = self.log.pushed();
+            let error = (e.level != Level::Error)
+                .then(|| {
+                    (h.seq + 1..pushed)
+                        .rev()
+                        .filter_map(|n| self.log.nth_pushed(n).map(|x| (n, x)))
+                        .find(|(_, x)| x.level == Level::Error)
+                })
+                .flatten();
+            let (n, e) = error.unwrap_or((h.seq, e));
+            return Some((e, pushed - 1 - n));
         }
         self.log.last().map(|e| (e, 0))
     }
