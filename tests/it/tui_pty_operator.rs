@@ -1,7 +1,8 @@
 //! Found by using the console as an operator does, through the real
 //! binary in a pty at 80 × 24: a session mended while the console runs
 //! opens without a restart; keys typed while the terminal is too small
-//! do nothing unseen.
+//! do nothing unseen; a frame changed since recorded is said on the
+//! Session screen.
 
 use super::tui_harness::Console;
 
@@ -61,6 +62,37 @@ fn keys_typed_in_too_small_a_terminal_act_on_nothing_unseen() {
     assert!(
         !s.contains("lightings abc"),
         "no session opened unseen:\n{s}"
+    );
+    c.send("q");
+    c.wait_exit(10);
+}
+
+/// A frame whose pixels changed since the manifest recorded it (the
+/// header intact, so it still reads) is listed on the Session screen as
+/// changed, before the files that are as recorded, as `vss session check`
+/// warns; the screen said "ok".
+#[test]
+fn a_frame_changed_since_recorded_is_said_on_the_session_screen() {
+    let mut c = Console::start(80, 24, &[]);
+    c.survey(1);
+    let mut c = c.restart_after(|dir| {
+        let img = dir.join("sessions/cube/cube1b.img");
+        let mut bytes = std::fs::read(&img).unwrap();
+        let n = bytes.len();
+        for b in &mut bytes[n - 500..] {
+            *b ^= 0x55;
+        }
+        std::fs::write(&img, bytes).unwrap();
+    });
+    c.wait_text("choose a session", 10);
+    c.send("\r");
+    c.wait_text("lightings abc", 10);
+    c.send("5");
+    let s = c.wait_text("files (", 10);
+    let flat = super::tui_harness::flat(&s.replace('│', " "));
+    assert!(
+        flat.contains("cube1b.img CHANGED since the manifest"),
+        "the changed frame is said:\n{s}"
     );
     c.send("q");
     c.wait_exit(10);
