@@ -11,7 +11,7 @@
 //! the frame, the picture, or a screen's `update(action, ctx)` — that
 //! matches its own actions exhaustively. Drawing (`screens/`) only reads.
 
-use ratatui::crossterm::event::{KeyEvent, KeyEventKind};
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyEventKind};
 
 use super::event::{Cmd, DeviceCmd, Msg, StoreCmd};
 use super::keymap::{self, Action, GlobalAction, NavAction, Scope, ScreenId};
@@ -38,7 +38,7 @@ mod tracker;
 pub use calibrate::{CalibrateScreen, Centre, Field, PLATE, short_name};
 pub use capture::CaptureScreen;
 pub use cell::{CellState, DeviceState};
-pub use chrome::{Chrome, LogView, Overlay, Search, SearchTarget};
+pub use chrome::{Chrome, LogView, MIN_SIZE, Overlay, Search, SearchTarget};
 pub use edit::{EditScreen, describe_op};
 pub use files::FilesScreen;
 pub use log::{Level, Log, LogEntry};
@@ -183,7 +183,8 @@ impl App {
     }
 
     /// Closes a question that no longer applies, saying so: "quit anyway?"
-    /// asked because a capture was under way or a lighting not saved, once
+    /// asked because a capture was under way or a lighting or an image's
+    /// outputs not saved, once
     /// neither holds (quitting is then safe, and `q` quits at once).
     fn close_stale_question(&mut self) {
         let quit_asked = matches!(
@@ -199,7 +200,8 @@ impl App {
                 .tracker
                 .current
                 .as_ref()
-                .is_some_and(|c| !c.unsaved.is_empty());
+                .is_some_and(|c| !c.unsaved.is_empty())
+            || !self.session.refused.is_empty();
         if quit_asked && !still {
             self.chrome.modal = None;
             self.ctx()
@@ -239,6 +241,15 @@ impl App {
             return Vec::new();
         }
         let scope = self.scope();
+        // Too small a terminal shows no screen, only what goes on and the
+        // question asked: keys act on nothing unseen. q quits, Esc stops a
+        // capture, and a question or a field on screen takes its keys.
+        if self.chrome.too_small() && !matches!(scope, Scope::Prompt | Scope::Confirm) {
+            let quit = keymap::lookup(scope, &key) == Some(Action::Global(GlobalAction::Quit));
+            if !quit && key.code != KeyCode::Esc {
+                return Vec::new();
+            }
+        }
         // A search on takes n, N and Esc while what it searches is in
         // front; once that is gone, so is the search.
         if self.chrome.search.is_some() && !matches!(scope, Scope::Prompt | Scope::Confirm) {
@@ -347,6 +358,12 @@ impl App {
                         ),
                         Pending::Quit,
                     );
+                } else if let Some((k, why)) = self.session.refused.first() {
+                    let q = format!(
+                        "The outputs of image {k} are not saved ({why}): quitting loses them \
+                         (its frames are kept). Quit anyway?"
+                    );
+                    self.ctx().ask(q, Pending::Quit);
                 } else {
                     self.chrome.quit = true;
                 }

@@ -230,6 +230,8 @@ pub struct FileState {
     pub name: String,
     pub state: String,
     pub ok: bool,
+    /// It reads, but is not what the manifest recorded (its hash differs).
+    pub changed: bool,
 }
 
 /// Reports of the store (session) worker.

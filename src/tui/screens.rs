@@ -22,8 +22,7 @@ mod pipeline;
 pub mod session;
 pub mod survey;
 
-/// The smallest terminal the screens are drawn in.
-pub const MIN_SIZE: (u16, u16) = (64, 18);
+pub use crate::tui::app::MIN_SIZE;
 
 /// Styles that respect `NO_COLOR`: without colour only bold, reverse and
 /// dim are used; with colour only the sixteen basic colours, which every
@@ -274,7 +273,7 @@ impl Widget for &App {
                     text.push(Line::styled(format!("{} {}", p.title, p.text), t.title()));
                     text.push(Line::raw("Enter accept  Esc cancel"));
                 }
-                None => text.push(Line::raw("q quits")),
+                None => text.push(Line::raw("q quits; other keys wait for a larger window")),
             }
             Paragraph::new(text)
                 .wrap(Wrap { trim: true })

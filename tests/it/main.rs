@@ -63,6 +63,7 @@ mod tui_pty_feedback;
 mod tui_pty_hidden;
 mod tui_pty_layout;
 mod tui_pty_narrow;
+mod tui_pty_operator;
 mod tui_pty_polish;
 mod tui_pty_review;
 mod tui_pty_search;

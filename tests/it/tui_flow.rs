@@ -379,7 +379,8 @@ fn entry(name: &str, damaged: Option<&str>) -> SessionEntry {
 }
 
 /// `o` with a session open shows the list and asks before switching; a
-/// damaged session is listed with why and cannot be opened by mistake.
+/// damaged session is listed with why and cannot be opened by mistake
+/// (Enter reads the list again, and it opens only if it now reads).
 #[test]
 fn the_session_picker_confirms_and_shows_damaged_sessions() {
     let mut app = reviewed();
@@ -408,8 +409,19 @@ fn the_session_picker_confirms_and_shows_damaged_sessions() {
     survey(&mut app, SurveyAction::OpenPicker);
     survey(&mut app, SurveyAction::Up);
     survey(&mut app, SurveyAction::Up);
+    // The listing is read again first (the folder may have been mended
+    // since): still damaged, it is not opened.
     let cmds = survey(&mut app, SurveyAction::Enter);
-    assert!(cmds.is_empty());
+    assert!(
+        matches!(cmds.as_slice(), [Cmd::Store(StoreCmd::List)]),
+        "{cmds:?}"
+    );
+    let cmds = app.update(Msg::Store(StoreEvent::Sessions(vec![
+        entry("bad", Some("bad.toml:11: planned_images: invalid type")),
+        entry("cube", None),
+        entry("other", None),
+    ])));
+    assert!(cmds.is_empty(), "not opened: {cmds:?}");
     let (s, _) = draw(&app, 80, 24);
     assert!(
         flat(&s.replace('│', " ")).contains("vss session check"),

@@ -97,6 +97,7 @@ fn session_view() -> SessionView {
         name: name.into(),
         state: state.into(),
         ok,
+        changed: false,
     };
     v.files = vec![
         file("cube.toml", "manifest", true),

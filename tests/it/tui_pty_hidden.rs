@@ -222,9 +222,12 @@ fn too_small_keeps_the_capture_and_the_question_in_sight() {
     let mut c = Console::start_with(&profile, 80, 24, &[], |_| {});
     c.create_session("cube");
     c.wait_text("Image 1: camera", 10);
+    // Keys other than q and Esc wait for a larger window: the capture
+    // starts before the window shrinks.
+    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    c.wait_text("capturing", 10);
     c.resize(20, 60);
     c.wait_text("terminal too small", 10);
-    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
     c.wait_words("capturing image 1", 10);
     c.send("q");
     let s = wait_words(&c, "A capture is under way. Quit anyway?", 10);

@@ -268,6 +268,43 @@ fn outputs_that_cannot_be_saved_keep_the_image_under_review() {
     c.wait_exit(10);
 }
 
+/// Outputs that could not be saved make `q` ask first, as the README
+/// says ("a lighting or an output cannot be saved … `q` asks first"): no
+/// quitting that silently drops them; once saved, `q` quits at once.
+#[test]
+fn q_asks_first_while_outputs_are_not_saved() {
+    let (mut c, _outside) = console_with_a_link("cube1.ldr");
+    let d = c.session();
+    c.capture_current(1);
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    c.wait_text("outputs of image 1 NOT saved", 10);
+    c.send("q");
+    let s = c.wait("the question", 10, |s| {
+        s.contains("Quit anyway") || c_exited(s)
+    });
+    assert!(
+        words(&s).contains("The outputs of image 1 are not saved"),
+        "q asks first:\n{s}"
+    );
+    c.send("n");
+    c.wait("the question closed", 5, |s| !s.contains("Quit anyway"));
+    assert_eq!(c.exit_code(), None, "still running");
+    std::fs::remove_file(d.join("cube1.ldr")).unwrap();
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    c.wait_text("Image 2: camera", 20);
+    saved_within_20_s("image 1's outputs", || {
+        vss::formats::lines::read_lines(&d.join("cube1.ldr")).is_ok()
+    });
+    c.wait_text("image 1 accepted", 20);
+    c.send("q");
+    c.wait_exit(10);
+}
+
+/// The screen of a console that has ended (no question can show).
+fn c_exited(s: &str) -> bool {
+    s.trim().is_empty()
+}
+
 #[test]
 fn too_small_a_terminal_says_so_and_recovers() {
     let mut c = Console::start(80, 24, &[]);

@@ -19,7 +19,7 @@ use vss::profile::Profile;
 use vss::tui::app::{App, Phase};
 use vss::tui::event::{
     Cmd, DeviceCmd, DeviceEvent, FramePurpose, Msg, PipelineResult, SessionView, StoreCmd,
-    StoreEvent,
+    StoreError, StoreEvent,
 };
 use vss::tui::keymap::{
     Action, EditAction, GlobalAction, KEYMAP, Key, PipelineAction, Scope, ScreenId, SurveyAction,
@@ -561,4 +561,29 @@ fn the_answer_to_a_key_is_not_replaced_by_a_background_message() {
     let (s, _) = draw(&app, 80, 24);
     assert!(s.contains("the lights answered"), "{s}");
     assert!(!s.contains("newer in the log"), "{s}");
+}
+
+/// An error that comes after the held answer to a key is not kept off the
+/// message line: a failed save said after "saving its outputs…" or after
+/// an edit's words showed only in the log for the hold's 3 s, the line
+/// reading as if all went well.
+#[test]
+fn an_error_after_the_answer_to_a_key_takes_the_message_line() {
+    let mut app = App::new(&profile(), colour());
+    survey(&mut app, SurveyAction::Accept);
+    let answer = app.chrome.log.last().unwrap().text.clone();
+    app.update(Msg::Store(StoreEvent::Error(StoreError::Report {
+        why: "the disk is full".into(),
+        old: String::new(),
+    })));
+    app.update(Msg::Device(DeviceEvent::Note("the lights answered".into())));
+    let (s, _) = draw(&app, 80, 24);
+    let message: String = s.lines().skip(20).collect::<Vec<_>>().join(" ");
+    assert!(
+        message.contains("report NOT written: the disk is full"),
+        "the error shows:\n{s}"
+    );
+    assert!(!message.contains(&answer[..answer.len().min(30)]), "{s}");
+    let words = message.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(words.contains("(+1 newer in the log)"), "{s}");
 }

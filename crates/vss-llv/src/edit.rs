@@ -224,14 +224,22 @@ pub fn corner_lines(lines: &[Segment], p: Point) -> Vec<usize> {
     ends.into_iter().take(2).map(|e| e.0).collect()
 }
 
+/// A point in whole pixels for the operator, `(12,-3)`: a coordinate that
+/// rounds to zero reads `0`, never `-0` (an endpoint a hair outside the
+/// image's edge).
+pub fn point_words(p: Point) -> String {
+    let whole = |v: f64| {
+        let r = v.round();
+        if r == 0.0 { 0.0 } else { r }
+    };
+    format!("({:.0},{:.0})", whole(p.x), whole(p.y))
+}
+
 /// An edit in words, with the lines it touched as they were before it:
 /// `connected lines 5 (10,20)-(90,20) and 4 (92,21)-(160,21)`.
 pub fn describe(op: &EditOp, before: &[Segment]) -> String {
     let line = |i: usize| match before.get(i) {
-        Some(s) => format!(
-            "{i} ({:.0},{:.0})-({:.0},{:.0})",
-            s.a.x, s.a.y, s.b.x, s.b.y
-        ),
+        Some(s) => format!("{i} {}-{}", point_words(s.a), point_words(s.b)),
         None => i.to_string(),
     };
     match op {
@@ -285,6 +293,12 @@ mod tests {
         assert_eq!(
             describe(&EditOp::Delete(vec![2]), &ls),
             "deleted line 2 (0,30)-(20,30)"
+        );
+        // An endpoint a hair left of the image reads 0, not -0.
+        let edge = [seg(-0.3, 262.0, 273.4, -0.49)];
+        assert_eq!(
+            describe(&EditOp::Delete(vec![0]), &edge),
+            "deleted line 0 (0,262)-(273,0)"
         );
         let after = apply(&ls, &EditOp::Connect(0, 1)).unwrap();
         assert_eq!(result_lines(&EditOp::Connect(0, 1), &after), vec![3]);

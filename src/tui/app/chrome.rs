@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use super::log::{Log, LogEntry};
+use super::log::{Level, Log, LogEntry};
 use super::modal::Modal;
 use crate::tui::keymap::{GlobalAction, ScreenId, ViewerAction};
 use crate::tui::mode::Look;
@@ -25,6 +25,9 @@ pub enum Overlay {
     /// The newest message in full.
     Message { scroll: usize },
 }
+
+/// The smallest terminal the screens are drawn in.
+pub const MIN_SIZE: (u16, u16) = (64, 18);
 
 /// How long the answer to a key stays on the message line at least, unless
 /// the operator presses another key: time to read its three rows.
@@ -115,12 +118,24 @@ impl Chrome {
 
     /// The message the message line shows, and how many newer ones are in
     /// the log only: the answer to the last key while it is held, else
-    /// the newest message.
+    /// the newest message. An error that comes after a held answer that is
+    /// not one takes the line at once: it is the key's outcome (a save
+    /// that failed after "saving…", an edit not written), not background.
     pub fn shown_message(&self) -> Option<(&LogEntry, usize)> {
         if let Some(h) = self.held
             && let Some(e) = self.log.nth_pushed(h.seq)
         {
-            return Some((e, self.log.pushed() - 1 - h.seq));
+            let pushed = self.log.pushed();
+            let error = (e.level != Level::Error)
+                .then(|| {
+                    (h.seq + 1..pushed)
+                        .rev()
+                        .filter_map(|n| self.log.nth_pushed(n).map(|x| (n, x)))
+                        .find(|(_, x)| x.level == Level::Error)
+                })
+                .flatten();
+            let (n, e) = error.unwrap_or((h.seq, e));
+            return Some((e, pushed - 1 - n));
         }
         self.log.last().map(|e| (e, 0))
     }
@@ -151,6 +166,11 @@ impl Chrome {
         }
         self.held = None;
         self.log.pushed() > h.seq + 1
+    }
+
+    /// The terminal is below [`MIN_SIZE`]: the screens are not drawn.
+    pub fn too_small(&self) -> bool {
+        self.size.0 < MIN_SIZE.0 || self.size.1 < MIN_SIZE.1
     }
 
     pub fn cycle_log(&mut self) {

@@ -10,7 +10,7 @@
 
 use super::{Ctx, Pending, PreviewNav};
 use crate::llv::edit::{
-    EditOp, corner_lines, describe, nearest_line, point_segment_distance, result_lines,
+    EditOp, corner_lines, describe, nearest_line, point_segment_distance, point_words, result_lines,
 };
 use crate::llv::{Point, Segment};
 use crate::tui::event::{Cmd, StoreCmd};
@@ -273,7 +273,7 @@ pub fn doubtful(op: &EditOp, lines: &[Segment], size: (usize, usize)) -> Option<
             let x = if n1.a != l1.a { n1.a } else { n1.b };
             let outside = (-x.x).max(x.x - w).max(-x.y).max(x.y - h).max(0.0);
             let far = point_segment_distance(x, l1).min(point_segment_distance(x, l2));
-            let corner = format!("lines {i} and {j} meet at ({:.0},{:.0})", x.x, x.y);
+            let corner = format!("lines {i} and {j} meet at {}", point_words(x));
             if outside > side / 8.0 {
                 Some(format!(
                     "{corner}, {outside:.0} px outside the {}×{} image ({:.0} px from the \

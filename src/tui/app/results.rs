@@ -175,9 +175,25 @@ impl App {
                         e
                     })
                     .collect();
-                let s = &mut self.screens.survey;
-                s.selected = s.selected.min(self.session.list.len().saturating_sub(1));
-                Vec::new()
+                let (screens, mut ctx) = self.parts();
+                let s = &mut screens.survey;
+                s.selected = s.selected.min(ctx.session.list.len().saturating_sub(1));
+                // A damaged session asked for: open it now if it reads, or
+                // say again why not, from the fresh listing.
+                let again = s
+                    .recheck
+                    .as_ref()
+                    .and_then(|dir| ctx.session.list.iter().position(|e| &e.dir == dir));
+                match again {
+                    Some(i) => {
+                        s.selected = i;
+                        s.open_selected(&mut ctx)
+                    }
+                    None => {
+                        s.recheck = None;
+                        Vec::new()
+                    }
+                }
             }
             StoreEvent::Opened(v) => {
                 self.screens.survey.picking = false;

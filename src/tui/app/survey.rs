@@ -50,6 +50,10 @@ pub struct SurveyScreen {
     /// The highlighted image of the checklist (`None`: the one under work).
     pub row: Option<u32>,
     pub nav: PreviewNav,
+    /// A session listed as damaged that the operator asked to open: the
+    /// list is read again and it opens if it now reads (it may have been
+    /// mended while the console ran).
+    pub recheck: Option<std::path::PathBuf>,
 }
 
 /// The rule of session names, shown before typing one.
@@ -193,11 +197,17 @@ impl SurveyScreen {
         }
     }
 
-    fn open_selected(&mut self, ctx: &mut Ctx) -> Vec<Cmd> {
+    pub(super) fn open_selected(&mut self, ctx: &mut Ctx) -> Vec<Cmd> {
         let Some(e) = ctx.session.list.get(self.selected).cloned() else {
             ctx.warn("no session to open: n creates one");
             return Vec::new();
         };
+        if e.damaged.is_some() && self.recheck.as_deref() != Some(e.dir.as_path()) {
+            // The listing may be older than a mend: read it again first.
+            self.recheck = Some(e.dir);
+            return vec![Cmd::Store(StoreCmd::List)];
+        }
+        self.recheck = None;
         if let Some(why) = &e.damaged {
             ctx.error(format!(
                 "session {} cannot be opened: {why} — `vss session check {}` lists every \

@@ -10,16 +10,15 @@ use ratatui::widgets::{Paragraph, Widget, Wrap};
 
 use super::{block, block2, split_panel};
 use crate::llv::Segment;
+use crate::llv::edit::point_words;
 use crate::tui::app::App;
 use crate::tui::widgets::preview::{Layer, Preview, stretch_of};
 
 fn describe_line(i: usize, s: &Segment) -> String {
     format!(
-        "#{i} ({:.0},{:.0})-({:.0},{:.0}) {:.0}px",
-        s.a.x,
-        s.a.y,
-        s.b.x,
-        s.b.y,
+        "#{i} {}-{} {:.0}px",
+        point_words(s.a),
+        point_words(s.b),
         s.length()
     )
 }

@@ -90,8 +90,9 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
 }
 
 /// The file list's entries at `width`: problems first, each wrapped whole
-/// (why a file is damaged is what the operator came for), then the files
-/// that read, one row each, cut at the width (the drawing and `/` both use
+/// (why a file is damaged is what the operator came for), then files that
+/// read but changed since recorded, wrapped whole, then the files that
+/// read, one row each, cut at the width (the drawing and `/` both use
 /// them; `/` searches an entry's whole text).
 pub fn file_items(app: &App, width: usize) -> Vec<Item> {
     let t = app.theme();
@@ -99,7 +100,7 @@ pub fn file_items(app: &App, width: usize) -> Vec<Item> {
         return Vec::new();
     };
     let mut files: Vec<&crate::tui::event::FileState> = s.files.iter().collect();
-    files.sort_by_key(|f| f.ok);
+    files.sort_by_key(|f| (f.ok, !f.changed));
     let mut items: Vec<Item> = Vec::new();
     for f in files {
         let text = format!("{:<16} {}", f.name, f.state);
@@ -107,6 +108,11 @@ pub fn file_items(app: &App, width: usize) -> Vec<Item> {
             super::chrome::wrap(&text, width)
                 .into_iter()
                 .map(|l| Line::styled(l, t.error()))
+                .collect()
+        } else if f.changed {
+            super::chrome::wrap(&text, width)
+                .into_iter()
+                .map(|l| Line::styled(l, t.warn()))
                 .collect()
         } else if text.chars().count() > width {
             let cut = text

@@ -24,6 +24,13 @@ pub fn view(s: &Session, check: Option<&CheckReport>, checked: bool) -> SessionV
             .find(|p| names_file(p, file))
             .map(|p| clean(p))
     };
+    let changed = |file: &str| {
+        check.is_some_and(|c| {
+            c.warnings
+                .iter()
+                .any(|w| names_file(w, file) && w.contains("changed since"))
+        })
+    };
     let images = p
         .images
         .iter()
@@ -77,15 +84,25 @@ pub fn view(s: &Session, check: Option<&CheckReport>, checked: bool) -> SessionV
         .into_iter()
         .map(|n| {
             let path = s.path(&n);
+            let changed = changed(&n);
             let (state, ok) = match (std::fs::metadata(&path), problem(&n)) {
                 (Err(_), _) => ("MISSING".to_string(), false),
                 (Ok(_), Some(p)) => (format!("DAMAGED: {p}"), false),
+                (Ok(m), None) if changed => (
+                    format!(
+                        "CHANGED since the manifest recorded it (outputs made from it may be \
+                         stale) {:.1} KiB",
+                        m.len() as f64 / 1024.0
+                    ),
+                    true,
+                ),
                 (Ok(m), None) => (format!("ok {:.1} KiB", m.len() as f64 / 1024.0), true),
             };
             FileState {
                 name: clean(&n),
                 state: clean(&state),
                 ok,
+                changed: changed && ok,
             }
         })
         .collect();

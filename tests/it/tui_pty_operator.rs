@@ -1,0 +1,99 @@
+//! Found by using the console as an operator does, through the real
+//! binary in a pty at 80 × 24: a session mended while the console runs
+//! opens without a restart; keys typed while the terminal is too small
+//! do nothing unseen; a frame changed since recorded is said on the
+//! Session screen.
+
+use super::tui_harness::Console;
+
+/// A session whose manifest does not read is listed as damaged; the
+/// error says to mend it "then open it again", and once mended (while
+/// the console runs) Enter opens it: the list is read again, not the
+/// one from the console's start.
+#[test]
+fn a_session_mended_while_the_console_runs_opens() {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("cube");
+    let m = c.session().join("cube.toml");
+    let good = std::fs::read_to_string(&m).unwrap();
+    let mut c = c.restart_after(|dir| {
+        let m = dir.join("sessions/cube/cube.toml");
+        let half = &good[..good.len() / 2];
+        std::fs::write(m, format!("{half}\n[[[")).unwrap();
+    });
+    c.wait_text("DAMAGED", 10);
+    c.send("\r");
+    let s = c.wait_text("last message", 5);
+    assert!(s.contains("cannot be opened"), "{s}");
+    c.send("\x1b");
+    c.wait("the window closed", 5, |s| !s.contains("last message"));
+    std::fs::write(&m, &good).unwrap();
+    c.send("\r");
+    let s = c.wait("the mended session open", 10, |s| {
+        s.contains("lightings abc") || s.contains("last message")
+    });
+    assert!(
+        s.contains("┌ session cube") && !s.contains("last message"),
+        "the mended session opens:\n{s}"
+    );
+    c.send("q");
+    c.wait_exit(10);
+}
+
+/// While the terminal is too small the screen says only that, q quits
+/// and Esc stops: Enter on the session list (unseen) opened the session,
+/// and any other key acted on a screen the operator could not see.
+#[test]
+fn keys_typed_in_too_small_a_terminal_act_on_nothing_unseen() {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("cube");
+    let mut c = c.restart(80, 24, &[]);
+    c.wait_text("choose a session", 10);
+    c.resize(20, 60);
+    let s = c.wait_text("terminal too small", 10);
+    assert!(s.contains("other keys wait"), "{s}");
+    c.send("\r");
+    c.send("n");
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let s = c.screen();
+    assert!(!s.contains("new session name"), "{s}");
+    c.resize(24, 80);
+    let s = c.wait_text("choose a session", 10);
+    assert!(
+        !s.contains("lightings abc"),
+        "no session opened unseen:\n{s}"
+    );
+    c.send("q");
+    c.wait_exit(10);
+}
+
+/// A frame whose pixels changed since the manifest recorded it (the
+/// header intact, so it still reads) is listed on the Session screen as
+/// changed, before the files that are as recorded, as `vss session check`
+/// warns; the screen said "ok".
+#[test]
+fn a_frame_changed_since_recorded_is_said_on_the_session_screen() {
+    let mut c = Console::start(80, 24, &[]);
+    c.survey(1);
+    let mut c = c.restart_after(|dir| {
+        let img = dir.join("sessions/cube/cube1b.img");
+        let mut bytes = std::fs::read(&img).unwrap();
+        let n = bytes.len();
+        for b in &mut bytes[n - 500..] {
+            *b ^= 0x55;
+        }
+        std::fs::write(&img, bytes).unwrap();
+    });
+    c.wait_text("choose a session", 10);
+    c.send("\r");
+    c.wait_text("lightings abc", 10);
+    c.send("5");
+    let s = c.wait_text("files (", 10);
+    let flat = super::tui_harness::flat(&s.replace('│', " "));
+    assert!(
+        flat.contains("cube1b.img CHANGED since the manifest"),
+        "the changed frame is said:\n{s}"
+    );
+    c.send("q");
+    c.wait_exit(10);
+}
