@@ -71,7 +71,13 @@ pub fn run(profile: crate::profile::Profile, look: mode::Look) -> anyhow::Result
     // leaving the alternate screen must be the last thing written.
     drop(terminal);
     leave();
-    result.map(|()| ExitCode::SUCCESS)
+    // Ended by a signal: the shell's convention, 128 + its number, so that
+    // a script or a supervisor sees the console did not end by `q`.
+    let sig = signal.load(Ordering::SeqCst);
+    result.map(|()| match u8::try_from(128 + sig) {
+        Ok(code) if sig != 0 => ExitCode::from(code),
+        _ => ExitCode::SUCCESS,
+    })
 }
 
 type Term = Terminal<CrosstermBackend<io::Stdout>>;

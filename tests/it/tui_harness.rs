@@ -254,13 +254,14 @@ impl Console {
         self.wait(text, secs, |s| flat(s).contains(text))
     }
 
-    pub fn wait_exit(&mut self, secs: u64) {
+    /// Waits for vss to exit and gives its exit code.
+    pub fn wait_exit(&mut self, secs: u64) -> u32 {
         let end = Instant::now() + Duration::from_secs(secs);
         while Instant::now() < end {
-            if self.child.try_wait().unwrap().is_some() {
+            if let Some(st) = self.child.try_wait().unwrap() {
                 // Let the reader drain the last bytes.
                 std::thread::sleep(Duration::from_millis(200));
-                return;
+                return st.exit_code();
             }
             std::thread::sleep(Duration::from_millis(20));
         }

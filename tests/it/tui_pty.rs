@@ -40,7 +40,7 @@ fn guided_survey_tweak_report_and_quit() {
     c.send("e");
     c.wait_text("report written", 30);
     c.send("q");
-    c.wait_exit(15);
+    assert_eq!(c.wait_exit(15), 0, "q ends the console with 0");
 
     let d = c.session();
     for f in [
@@ -190,7 +190,8 @@ fn idle_writes_nothing_and_hangup_restores_the_terminal() {
     let pid = c.child.process_id().expect("pid") as i32;
     let rc = send_signal(pid, libc::SIGHUP);
     assert_eq!(rc, 0);
-    c.wait_exit(10);
+    // Ended by the hang-up, not by the operator: 128 + SIGHUP.
+    assert_eq!(c.wait_exit(10), 129);
     let raw = c.raw.lock().unwrap().clone();
     let s = String::from_utf8_lossy(&raw);
     let leave = s.rfind("\x1b[?1049l").expect("left the alternate screen");
