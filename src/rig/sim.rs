@@ -359,7 +359,8 @@ impl SimCell {
         match std::fs::symlink_metadata(link) {
             Ok(m) if !m.file_type().is_symlink() => {
                 return Err(fail(format!(
-                    "{} exists and is not a symbolic link; vss replaces only a link                      (remove it or choose another name)",
+                    "{} exists and is not a symbolic link; vss replaces only a link \
+                     (remove it or choose another name)",
                     link.display()
                 )));
             }

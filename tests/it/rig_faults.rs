@@ -377,6 +377,7 @@ fn sim_link_never_replaces_or_deletes_a_file() {
     let mut sim = SimCell::start(SimOptions::new(32, 32)).expect("sim");
     let e = sim.link_grabber(&file).expect_err("a file is not a link");
     assert!(e.to_string().contains("not a symbolic link"), "{e}");
+    assert!(!e.to_string().contains("  "), "a run of spaces: {e}");
     sim.stop();
     assert_eq!(std::fs::read_to_string(&file).expect("kept"), "keep me");
     // A link left by an earlier run is replaced, and goes with the cell.
