@@ -392,3 +392,50 @@ fn llv_of_an_image_of_edges_everywhere_is_refused_at_once_within_four_times_the_
     );
     assert!(!dir.path().join("out").join("mod1.hpo").exists());
 }
+
+/// `--from-edges` of the two files swapped, of one file twice, or of the
+/// edge files of two images of different sizes ran and wrote lines mixing
+/// them, exit 0. Each is now refused, naming the file, and writes nothing.
+#[test]
+fn from_edges_refuses_swapped_or_mismatched_files() {
+    use vss::formats::edgefile::write_edges;
+    use vss::llv::{EdgePoint, EdgePoints, ScanDir};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let points: Vec<EdgePoint> = (0..40)
+        .map(|y| EdgePoint {
+            x: 30.0,
+            y: y as f32,
+            response: 50.0,
+        })
+        .collect();
+    let edges = |dir, width| EdgePoints {
+        dir: Some(dir),
+        width,
+        height: 48,
+        points: points.clone(),
+    };
+    write_edges(&d.join("a.hpo"), &edges(ScanDir::Horizontal, 64)).unwrap();
+    write_edges(&d.join("a.vpo"), &edges(ScanDir::Vertical, 64)).unwrap();
+    write_edges(&d.join("b.vpo"), &edges(ScanDir::Vertical, 96)).unwrap();
+    let run = |h: &str, v: &str| {
+        vss()
+            .current_dir(d)
+            .args(["llv", "--from-edges", h, v])
+            .output()
+            .unwrap()
+    };
+    for (h, v, names, says) in [
+        ("a.vpo", "a.hpo", "a.vpo: byte 10", "direction V"),
+        ("a.hpo", "a.hpo", "a.hpo: byte 10", "direction H"),
+        ("a.hpo", "b.vpo", "b.vpo", "96 × 48"),
+    ] {
+        let r = run(h, v);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(!r.status.success(), "{h} {v}: {err}");
+        assert!(err.contains(names) && err.contains(says), "{h} {v}: {err}");
+        assert!(!d.join("a.lex").exists() && !d.join("a.ldr").exists());
+    }
+    let r = run("a.hpo", "a.vpo");
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+}
