@@ -247,6 +247,31 @@ fn run_group(
             .check_stage_size()
             .with_context(|| path.display().to_string())?;
     }
+    // The lightings of one view and the ambient image are one picture each:
+    // a file of another size is named (the stages said only "image sizes
+    // differ", without the files).
+    let ambient_size = ambient.map(|(path, img)| (path.as_path(), img));
+    let sized = grp
+        .files
+        .iter()
+        .map(PathBuf::as_path)
+        .zip(files.iter().map(|f| &f.image));
+    let mut sized = sized.chain(ambient_size);
+    if let Some((first, img)) = sized.next() {
+        let size = (img.width(), img.height());
+        if let Some((other, o)) = sized.find(|(_, o)| (o.width(), o.height()) != size) {
+            bail!(
+                "{} is {} × {} pixels but {} is {} × {}: the lightings of one view and \
+                 the ambient image must be the same size",
+                other.display(),
+                o.width(),
+                o.height(),
+                first.display(),
+                size.0,
+                size.1
+            );
+        }
+    }
     // Files without a lighting letter come one to a group: any key will do.
     let keys: Vec<char> = grp.letters.iter().map(|l| l.unwrap_or('a')).collect();
     // The pixels move into the input (no second copy); each file's header

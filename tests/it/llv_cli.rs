@@ -439,3 +439,33 @@ fn from_edges_refuses_swapped_or_mismatched_files() {
     let r = run("a.hpo", "a.vpo");
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
 }
+
+/// Lightings of one view, or an `--ambient` image, of different sizes were
+/// refused with "image sizes differ: (96, 80) and (40, 30)", naming neither
+/// file; the file of the other size is now named with both sizes.
+#[test]
+fn images_of_different_sizes_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "cube1a.img", |x, y| rect(x, y, 200, 40));
+    let small = GreyImage::new(40, 30, vec![90; 40 * 30]).unwrap();
+    write_img(&d.join("cube1b.img"), &ImgFile::new(small.clone())).unwrap();
+    write_img(&d.join("amb.img"), &ImgFile::new(small)).unwrap();
+    for args in [
+        vec!["llv", "cube1a.img", "cube1b.img"],
+        vec!["llv", "--ambient", "amb.img", "cube1a.img"],
+    ] {
+        let r = vss().current_dir(d).args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(!r.status.success(), "{args:?}: {err}");
+        let other = if args.len() == 3 {
+            "cube1b.img"
+        } else {
+            "amb.img"
+        };
+        assert!(
+            err.contains(other) && err.contains("40 × 30") && err.contains("96 × 80"),
+            "{args:?}: {err}"
+        );
+    }
+}
