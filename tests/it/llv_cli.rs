@@ -469,3 +469,27 @@ fn images_of_different_sizes_are_named() {
         );
     }
 }
+
+/// `--set lens.enabled=maybe` said "`maybe` is not a number" of a parameter
+/// that takes true or false, and `--set bogus=abc` blamed the value, not the
+/// unknown key.
+#[test]
+fn set_names_what_a_value_should_be_and_an_unknown_key_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "cube1a.img", |x, y| rect(x, y, 200, 40));
+    for (set, says) in [
+        ("lens.enabled=maybe", "`maybe` is not true or false"),
+        ("bogus.key=abc", "unknown parameter `bogus.key`"),
+        ("edges.floor=abc", "`abc` is not a number"),
+    ] {
+        let r = vss()
+            .current_dir(d)
+            .args(["llv", "cube1a.img", "--set", set])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(!r.status.success(), "{set}: {err}");
+        assert!(err.contains(says), "{set}: {err}");
+    }
+}
