@@ -76,6 +76,23 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     let session = SessionName::new(name)
         .with_context(|| format!("{}: not a valid session name", a.session.display()))?;
     crate::session::check_image_number(a.image).context("--image")?;
+    // A letter named twice would be captured twice, the second frame
+    // replacing the first without --yes.
+    if let Some((_, &letter)) = a
+        .lighting
+        .iter()
+        .enumerate()
+        .find(|&(i, l)| a.lighting[..i].contains(l))
+    {
+        bail!(
+            "--lighting {}: lighting {letter} is named twice; name each lighting once",
+            a.lighting
+                .iter()
+                .map(char::to_string)
+                .collect::<Vec<_>>()
+                .join(",")
+        );
+    }
     let files: Vec<(char, PathBuf)> = a
         .lighting
         .iter()

@@ -247,6 +247,31 @@ fn run_group(
             .check_stage_size()
             .with_context(|| path.display().to_string())?;
     }
+    // The lightings of one view and the ambient image are one picture each:
+    // a file of another size is named (the stages said only "image sizes
+    // differ", without the files).
+    let ambient_size = ambient.map(|(path, img)| (path.as_path(), img));
+    let sized = grp
+        .files
+        .iter()
+        .map(PathBuf::as_path)
+        .zip(files.iter().map(|f| &f.image));
+    let mut sized = sized.chain(ambient_size);
+    if let Some((first, img)) = sized.next() {
+        let size = (img.width(), img.height());
+        if let Some((other, o)) = sized.find(|(_, o)| (o.width(), o.height()) != size) {
+            bail!(
+                "{} is {} × {} pixels but {} is {} × {}: the lightings of one view and \
+                 the ambient image must be the same size",
+                other.display(),
+                o.width(),
+                o.height(),
+                first.display(),
+                size.0,
+                size.1
+            );
+        }
+    }
     // Files without a lighting letter come one to a group: any key will do.
     let keys: Vec<char> = grp.letters.iter().map(|l| l.unwrap_or('a')).collect();
     // The pixels move into the input (no second copy); each file's header
@@ -377,10 +402,9 @@ fn from_edges(
     a: &Args,
     p: &Params,
 ) -> anyhow::Result<()> {
-    let saved = Saved::Edges {
-        h: edgefile::read_edges(hpo)?,
-        v: edgefile::read_edges(vpo)?,
-    };
+    let (h, v) = (edgefile::read_edges(hpo)?, edgefile::read_edges(vpo)?);
+    check_edge_pair(hpo, &h, vpo, &v)?;
+    let saved = Saved::Edges { h, v };
     let mut runner = Runner::lean();
     let out = runner.run_saved(saved, p, None)?;
     let stem = hpo
@@ -403,6 +427,49 @@ fn from_edges(
         &written,
         None,
     )?;
+    Ok(())
+}
+
+/// `--from-edges` takes the horizontal scan's file, then the vertical
+/// one's, of one image: a file whose header names the other direction (the
+/// two swapped, or one file twice) or two files of different image sizes
+/// are refused by name; the lines would mix two scans of one direction, or
+/// two images. A direction `-` or a size 0 (not known) is taken as it is.
+fn check_edge_pair(
+    hpo: &Path,
+    h: &crate::llv::EdgePoints,
+    vpo: &Path,
+    v: &crate::llv::EdgePoints,
+) -> anyhow::Result<()> {
+    use crate::llv::ScanDir::{Horizontal, Vertical};
+    let named = |d| if d == Horizontal { "H" } else { "V" };
+    for (path, e, want, which) in [(hpo, h, Horizontal, "first"), (vpo, v, Vertical, "second")] {
+        if let Some(d) = e.dir
+            && d != want
+        {
+            bail!(
+                "{}: byte {}: the header says direction {}, but the {which} file of \
+                 --from-edges must be the {} scan's (STEM.hpo STEM.vpo, in that order)",
+                path.display(),
+                edgefile::MAGIC.len() + 3,
+                named(d),
+                named(want)
+            );
+        }
+    }
+    let known = |e: &crate::llv::EdgePoints| e.width > 0 && e.height > 0;
+    if known(h) && known(v) && (h.width, h.height) != (v.width, v.height) {
+        bail!(
+            "{} holds the edges of a {} × {} image, {} of a {} × {} one: the two edge \
+             files must come from the same image",
+            hpo.display(),
+            h.width,
+            h.height,
+            vpo.display(),
+            v.width,
+            v.height
+        );
+    }
     Ok(())
 }
 

@@ -359,11 +359,20 @@ impl SimCell {
         match std::fs::symlink_metadata(link) {
             Ok(m) if !m.file_type().is_symlink() => {
                 return Err(fail(format!(
-                    "{} exists and is not a symbolic link; vss replaces only a link                      (remove it or choose another name)",
+                    "{} exists and is not a symbolic link; vss replaces only a link \
+                     (remove it or choose another name)",
                     link.display()
                 )));
             }
             _ => {}
+        }
+        if let Some(target) = held_elsewhere(link, &self.grabber.path) {
+            return Err(fail(format!(
+                "it points at {}, a terminal that was open before the link was made and \
+                 still is (another `vss sim --link` serving it?); stop that one, or remove \
+                 the link if nothing uses it, or choose another name",
+                target.display()
+            )));
         }
         let name = link.file_name().map(|n| n.to_string_lossy().into_owned());
         // A name of this process's own, made by symlink(2), which never
@@ -437,6 +446,29 @@ impl SimCell {
             let _ = std::fs::remove_file(link);
         }
     }
+}
+
+/// Where `link` points, when it is a symbolic link another simulator keeps:
+/// to a terminal other than `own` that is open and was made before the link
+/// (a pseudo-terminal's name exists only while it is open; one made after
+/// the link only reuses the number of a terminal that is gone, as after a
+/// simulator killed with SIGKILL).
+#[cfg(unix)]
+fn held_elsewhere(link: &Path, own: &str) -> Option<PathBuf> {
+    use std::os::unix::fs::{FileTypeExt, MetadataExt};
+    let target = std::fs::read_link(link).ok()?;
+    if target == Path::new(own) {
+        return None;
+    }
+    let linked = std::fs::symlink_metadata(link).ok()?;
+    let at = match link.parent() {
+        Some(dir) if target.is_relative() => dir.join(&target),
+        _ => target.clone(),
+    };
+    let tty = std::fs::metadata(at).ok()?;
+    let made = (tty.ctime(), tty.ctime_nsec());
+    (tty.file_type().is_char_device() && made <= (linked.mtime(), linked.mtime_nsec()))
+        .then_some(target)
 }
 
 /// The standard simulated cell as a profile: the embedded grabber and relay

@@ -392,3 +392,104 @@ fn llv_of_an_image_of_edges_everywhere_is_refused_at_once_within_four_times_the_
     );
     assert!(!dir.path().join("out").join("mod1.hpo").exists());
 }
+
+/// `--from-edges` of the two files swapped, of one file twice, or of the
+/// edge files of two images of different sizes ran and wrote lines mixing
+/// them, exit 0. Each is now refused, naming the file, and writes nothing.
+#[test]
+fn from_edges_refuses_swapped_or_mismatched_files() {
+    use vss::formats::edgefile::write_edges;
+    use vss::llv::{EdgePoint, EdgePoints, ScanDir};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let points: Vec<EdgePoint> = (0..40)
+        .map(|y| EdgePoint {
+            x: 30.0,
+            y: y as f32,
+            response: 50.0,
+        })
+        .collect();
+    let edges = |dir, width| EdgePoints {
+        dir: Some(dir),
+        width,
+        height: 48,
+        points: points.clone(),
+    };
+    write_edges(&d.join("a.hpo"), &edges(ScanDir::Horizontal, 64)).unwrap();
+    write_edges(&d.join("a.vpo"), &edges(ScanDir::Vertical, 64)).unwrap();
+    write_edges(&d.join("b.vpo"), &edges(ScanDir::Vertical, 96)).unwrap();
+    let run = |h: &str, v: &str| {
+        vss()
+            .current_dir(d)
+            .args(["llv", "--from-edges", h, v])
+            .output()
+            .unwrap()
+    };
+    for (h, v, names, says) in [
+        ("a.vpo", "a.hpo", "a.vpo: byte 10", "direction V"),
+        ("a.hpo", "a.hpo", "a.hpo: byte 10", "direction H"),
+        ("a.hpo", "b.vpo", "b.vpo", "96 × 48"),
+    ] {
+        let r = run(h, v);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(!r.status.success(), "{h} {v}: {err}");
+        assert!(err.contains(names) && err.contains(says), "{h} {v}: {err}");
+        assert!(!d.join("a.lex").exists() && !d.join("a.ldr").exists());
+    }
+    let r = run("a.hpo", "a.vpo");
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+}
+
+/// Lightings of one view, or an `--ambient` image, of different sizes were
+/// refused with "image sizes differ: (96, 80) and (40, 30)", naming neither
+/// file; the file of the other size is now named with both sizes.
+#[test]
+fn images_of_different_sizes_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "cube1a.img", |x, y| rect(x, y, 200, 40));
+    let small = GreyImage::new(40, 30, vec![90; 40 * 30]).unwrap();
+    write_img(&d.join("cube1b.img"), &ImgFile::new(small.clone())).unwrap();
+    write_img(&d.join("amb.img"), &ImgFile::new(small)).unwrap();
+    for args in [
+        vec!["llv", "cube1a.img", "cube1b.img"],
+        vec!["llv", "--ambient", "amb.img", "cube1a.img"],
+    ] {
+        let r = vss().current_dir(d).args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(!r.status.success(), "{args:?}: {err}");
+        let other = if args.len() == 3 {
+            "cube1b.img"
+        } else {
+            "amb.img"
+        };
+        assert!(
+            err.contains(other) && err.contains("40 × 30") && err.contains("96 × 80"),
+            "{args:?}: {err}"
+        );
+    }
+}
+
+/// `--set lens.enabled=maybe` said "`maybe` is not a number" of a parameter
+/// that takes true or false, and `--set bogus=abc` blamed the value, not the
+/// unknown key.
+#[test]
+fn set_names_what_a_value_should_be_and_an_unknown_key_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "cube1a.img", |x, y| rect(x, y, 200, 40));
+    for (set, says) in [
+        ("lens.enabled=maybe", "`maybe` is not true or false"),
+        ("bogus.key=abc", "unknown parameter `bogus.key`"),
+        ("edges.floor=abc", "`abc` is not a number"),
+    ] {
+        let r = vss()
+            .current_dir(d)
+            .args(["llv", "cube1a.img", "--set", set])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(!r.status.success(), "{set}: {err}");
+        assert!(err.contains(says), "{set}: {err}");
+    }
+}

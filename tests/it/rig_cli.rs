@@ -732,3 +732,25 @@ fn a_grab_asked_to_leave_by_a_take_over_stops_and_says_so() {
         String::from_utf8_lossy(&check.stderr)
     );
 }
+
+#[test]
+fn grab_refuses_a_lighting_named_twice() {
+    // `--lighting a,a` captured lighting a twice: the second frame replaced
+    // the first although the image did not exist before and --yes was not
+    // given. Now refused before anything is made.
+    let tmp = tempfile::tempdir().expect("tmp");
+    let prof = write_profile(tmp.path(), "p.toml", &base());
+    let session = tmp.path().join("s/twice");
+    let out = vss()
+        .arg("--profile")
+        .arg(&prof)
+        .args(["grab", "--camera", "1", "--lighting", "a,b,a"])
+        .args(["--image", "1", "--session"])
+        .arg(&session)
+        .output()
+        .expect("run grab");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("lighting a is named twice"), "{err}");
+    assert!(!session.exists(), "nothing made: {:?}", imgs(&session));
+}

@@ -377,6 +377,7 @@ fn sim_link_never_replaces_or_deletes_a_file() {
     let mut sim = SimCell::start(SimOptions::new(32, 32)).expect("sim");
     let e = sim.link_grabber(&file).expect_err("a file is not a link");
     assert!(e.to_string().contains("not a symbolic link"), "{e}");
+    assert!(!e.to_string().contains("  "), "a run of spaces: {e}");
     sim.stop();
     assert_eq!(std::fs::read_to_string(&file).expect("kept"), "keep me");
     // A link left by an earlier run is replaced, and goes with the cell.
@@ -399,4 +400,50 @@ fn sim_link_never_replaces_or_deletes_a_file() {
         .map(|e| e.file_name())
         .collect();
     assert_eq!(names.len(), 1, "{names:?}");
+}
+
+/// A second `vss sim --link PATH` while the first still serves PATH took
+/// the link over without a word, and removed it when it stopped: the first
+/// simulator, still running, was left without its stable name. A link to a
+/// live terminal made before it is now refused and left as it is; a link
+/// whose terminal number was reused after it was made (a killed simulator's)
+/// is still replaced.
+#[test]
+fn sim_link_is_not_taken_from_a_running_simulator() {
+    use vss::rig::sim::{SimCell, SimOptions};
+    let tmp = tempfile::tempdir().expect("tmp");
+    let link = tmp.path().join("ttyVSG0");
+    let mut first = SimCell::start(SimOptions::new(32, 32)).expect("sim");
+    first.link_grabber(&link).expect("link");
+    let mut second = SimCell::start(SimOptions::new(32, 32)).expect("sim");
+    let e = second
+        .link_grabber(&link)
+        .expect_err("the first simulator's link is taken");
+    assert!(e.to_string().contains(first.grabber_path()), "{e}");
+    second.stop();
+    assert_eq!(
+        std::fs::read_link(&link).expect("link kept"),
+        std::path::Path::new(first.grabber_path())
+    );
+    first.stop();
+    // A link older than the terminal it names: the number was reused.
+    let third = SimCell::start(SimOptions::new(32, 32)).expect("sim");
+    let mut fourth = SimCell::start(SimOptions::new(32, 32)).expect("sim");
+    let stale = tmp.path().join("ttyVSG1");
+    std::os::unix::fs::symlink(third.grabber_path(), &stale).expect("stale link");
+    let back = std::process::Command::new("touch")
+        .args(["-h", "-d", "2001-01-01"])
+        .arg(&stale)
+        .status()
+        .expect("touch");
+    assert!(back.success());
+    fourth
+        .link_grabber(&stale)
+        .expect("a stale link is replaced");
+    assert_eq!(
+        std::fs::read_link(&stale).expect("link"),
+        std::path::Path::new(fourth.grabber_path())
+    );
+    fourth.stop();
+    third.stop();
 }

@@ -378,12 +378,18 @@ impl Params {
             .split_once('=')
             .ok_or_else(|| ParamError::Syntax(assignment.to_string()))?;
         let (key, value) = (key.trim(), value.trim());
+        // The key first: a typo in it is named as such, whatever the value.
+        let sp = spec(key).ok_or_else(|| ParamError::UnknownKey(key.to_string()))?;
         let v = match value {
             "true" => 1.0,
             "false" => 0.0,
             _ => value.parse::<f64>().map_err(|_| ParamError::NotANumber {
                 key: key.to_string(),
                 value: value.to_string(),
+                expected: match sp.kind {
+                    Kind::Bool => "true or false",
+                    _ => "a number",
+                },
             })?,
         };
         self.set(key, v)
@@ -423,8 +429,12 @@ pub enum ParamError {
         value: f64,
         range: String,
     },
-    #[error("parameter {key}: `{value}` is not a number")]
-    NotANumber { key: String, value: String },
+    #[error("parameter {key}: `{value}` is not {expected}")]
+    NotANumber {
+        key: String,
+        value: String,
+        expected: &'static str,
+    },
     #[error("expected key=value, found `{0}`")]
     Syntax(String),
 }
