@@ -21,6 +21,9 @@ pub struct CheckReport {
     pub warnings: Vec<String>,
     /// Images whose outputs are stale, with why.
     pub stale: Vec<(u32, String)>,
+    /// The files (as the manifest names them) that read but changed since
+    /// recorded; each also has its warning.
+    pub changed: Vec<String>,
     /// Files read and parsed.
     pub checked: usize,
 }
@@ -155,6 +158,7 @@ fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) {
         Ok(()) => {
             r.checked += 1;
             if stamp::hash(&bytes) != hash {
+                r.changed.push(file.to_string());
                 r.warnings.push(format!(
                     "{}: changed since the manifest recorded it (outputs made from it may be stale)",
                     path.display()

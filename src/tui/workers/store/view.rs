@@ -24,13 +24,7 @@ pub fn view(s: &Session, check: Option<&CheckReport>, checked: bool) -> SessionV
             .find(|p| names_file(p, file))
             .map(|p| clean(p))
     };
-    let changed = |file: &str| {
-        check.is_some_and(|c| {
-            c.warnings
-                .iter()
-                .any(|w| names_file(w, file) && w.contains("changed since"))
-        })
-    };
+    let changed = |file: &str| check.is_some_and(|c| c.changed.iter().any(|f| f == file));
     let images = p
         .images
         .iter()
