@@ -304,24 +304,23 @@ pub fn refine_into(images: &[GreyImage], segs: &mut [Segment], s: &mut RefineScr
         };
         s.blocks.clear();
         s.centres.clear();
-        let mut total = [0.0; SAMPLES];
+        let mut total: Sums = [0; SAMPLES];
         for b in 0..blocks {
             let (lo, hi) = (b * f.count / blocks, (b + 1) * f.count / blocks);
             let mut sums = [0; SAMPLES];
             if !(lo..hi).all(|i| f.add_profile(img, f.first + i, &mut sums)) {
                 continue;
             }
-            let p = profile(&sums);
-            for (t, v) in total.iter_mut().zip(&p) {
+            for (t, v) in total.iter_mut().zip(&sums) {
                 *t += v;
             }
-            s.blocks.push(near_derivatives(&p, &kern));
+            s.blocks.push(near_derivatives(&profile(&sums), &kern));
             s.centres.push(f.first as f64 + 0.5 * (lo + hi - 1) as f64);
         }
         if s.blocks.len() < MIN_BLOCKS {
             continue;
         }
-        let at_line = derivative(&total, &kern, R);
+        let at_line = derivative(&profile(&total), &kern, R);
         if at_line == 0.0 || !at_line.is_finite() {
             continue;
         }
