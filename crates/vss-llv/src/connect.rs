@@ -1,7 +1,8 @@
 //! CONNECT, the automatic post-processing of extracted lines (llv.md §4):
 //! merges segments whose environments (oriented rectangles around them)
 //! intersect and whose directions agree, until nothing merges any more, then
-//! drops short segments.
+//! drops short segments: those under `min_line_length`, unless their points
+//! fix their direction within `short_line_deg` (`long_enough`).
 //!
 //! Order (so the result does not depend on the input order): segments are
 //! sorted by length, longest first, ties by their endpoint coordinates. Each
@@ -426,13 +427,13 @@ pub fn connect_into(
         (0..n as u32)
             .filter(|&k| alive[k as usize] && changed[k as usize] > 0)
             .map(|k| (segs[k as usize].length(), k))
-            .filter(|&(len, _)| len >= p.min_line_length),
+            .filter(|&(len, k)| long_enough(&segs[k as usize], len, p)),
     );
     sort_keys(keyed, segs);
     let mut grown = keyed.iter().peekable();
     for k in 0..n {
         let len = lens[k];
-        if !alive[k] || changed[k] > 0 || len < p.min_line_length {
+        if !alive[k] || changed[k] > 0 || !long_enough(&segs[k], len, p) {
             continue;
         }
         while let Some(&&(l, j)) = grown.peek() {
@@ -448,6 +449,21 @@ pub fn connect_into(
     out.extend(grown.map(|&(_, j)| segs[j as usize]));
 }
 
+/// Whether a line of length `len` stays after CONNECT: at least
+/// `min_line_length`, or shorter but with its direction sure, so that a
+/// short edge the image shows clearly is kept and a short noise track is
+/// not. A line's direction error is about its points' scatter (`residual`)
+/// times `√12 / len^1.5` (a least-squares fit to one point a pixel);
+/// under `short_line_deg` it is sure. (A merged line's residual holds its
+/// parts' spread about it, [`merge`]; a residual of 0 is unknown, as for
+/// lines read from a file, and proves nothing.)
+fn long_enough(s: &Segment, len: f64, p: &ConnectParams) -> bool {
+    len >= p.min_line_length
+        || (p.short_line_deg > 0.0
+            && s.residual > 0.0
+            && s.residual * 12f64.sqrt() <= p.short_line_deg.to_radians() * len.powf(1.5))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -458,6 +474,35 @@ mod tests {
             residual: 0.1,
             ..Segment::new(Point::new(ax, ay), Point::new(bx, by))
         }
+    }
+
+    /// A line under `min_line_length` stays when its points fix its
+    /// direction within `short_line_deg`, and only then.
+    #[test]
+    fn a_short_line_stays_when_its_direction_is_sure() {
+        let p = ConnectParams::default();
+        assert!(p.min_line_length > 10.0 && p.short_line_deg > 0.0);
+        // 10 px: √12 · 0.05 / 10^1.5 is 0.31° of direction error; 0.3 px
+        // of scatter is 1.9°.
+        let sure = Segment {
+            residual: 0.05,
+            ..seg(0.0, 0.0, 10.0, 0.0)
+        };
+        let unsure = Segment {
+            residual: 0.3,
+            ..seg(0.0, 50.0, 10.0, 50.0)
+        };
+        let unknown = Segment {
+            residual: 0.0,
+            ..seg(0.0, 90.0, 10.0, 90.0)
+        };
+        let out = connect(&[sure, unsure, unknown], &p);
+        assert_eq!(out, vec![sure]);
+        let off = ConnectParams {
+            short_line_deg: 0.0,
+            ..p
+        };
+        assert!(connect(&[sure], &off).is_empty());
     }
 
     #[test]
@@ -598,7 +643,7 @@ mod tests {
         let mut out: Vec<Segment> = segs
             .into_iter()
             .zip(alive)
-            .filter(|&(l, alive)| alive && l.length() >= p.min_line_length)
+            .filter(|&(l, alive)| alive && long_enough(&l, l.length(), p))
             .map(|(l, _)| l)
             .collect();
         out.sort_unstable_by(order);

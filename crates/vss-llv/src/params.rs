@@ -333,6 +333,16 @@ params! {
         min_line_length: f64 = 12.0,
             "px", 0.0..=1000.0, step 1.0,
             "merged segments shorter than this are dropped";
+        /// A line shorter than `min_line_length` is kept when its points
+        /// fix its direction within this many degrees (`connect.rs`,
+        /// `long_enough`): a short edge the image shows clearly (a brick, a
+        /// window's corner) stays, a short noise track does not
+        /// (docs/accuracy.md). Not in a noisy image (`edges.noisy_sigma`),
+        /// where a dozen points' scatter says too little. 0 is off: the
+        /// spec's rule alone.
+        short_line_deg: f64 = 1.0,
+            "deg", 0.0..=10.0, step 0.25,
+            "shorter lines kept when their points fix their direction within this; 0 is off";
         /// Corner closing radius (px): endpoints of different lines within it move
         /// to the lines' intersection. 0 switches corner closing off.
         corner_radius: f64 = 5.0,

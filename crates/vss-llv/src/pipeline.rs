@@ -211,8 +211,9 @@ impl Workspace {
             self.out.timings.lens_us = micros(t);
         }
         // The kernel's half-width for this image: one more where the image
-        // is noisy (`edges.noisy_sigma`, `noise_level`), and no orientation
-        // test of the lines where it is twice as noisy (`lines/align.rs`).
+        // is noisy (`edges.noisy_sigma`, `noise_level`), where also no line
+        // under `connect.min_line_length` stays; and no orientation test of
+        // the lines where it is twice as noisy (`lines/align.rs`).
         let widened;
         let p = {
             let first = if self.out.corrected.is_empty() {
@@ -231,6 +232,10 @@ impl Workspace {
                 widened = {
                     let mut q = p.clone();
                     q.edges.half_width = (q.edges.half_width + 1).min(7);
+                    // A short line's scatter, from a dozen points, says
+                    // little of its direction where many noise tracks
+                    // pass it by chance (`connect::long_enough`).
+                    q.connect.short_line_deg = 0.0;
                     // At twice that noise the Sobel direction of a faint
                     // edge is unreliable (docs/accuracy.md): the measured
                     // noise alone guards there.
