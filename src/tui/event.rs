@@ -340,6 +340,11 @@ pub struct PipelineRequest {
 #[derive(Debug)]
 pub enum StoreCmd {
     List,
+    /// The list read again while it is shown (another console or a `vss
+    /// grab` may have opened, captured into or closed a session): said
+    /// only when it differs from the one last said, so an unchanged list
+    /// costs the screen nothing.
+    Relist,
     Create(String),
     Open(PathBuf),
     /// Open, taking the lock of a console that still runs (asked first).

@@ -67,6 +67,7 @@ mod tui_pty_operator;
 mod tui_pty_polish;
 mod tui_pty_review;
 mod tui_pty_search;
+mod tui_pty_shared;
 mod tui_pty_takeover;
 mod tui_pty_trouble;
 mod tui_pty_tuning;

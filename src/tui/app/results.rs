@@ -166,6 +166,13 @@ impl App {
     pub(super) fn on_store(&mut self, ev: StoreEvent) -> Vec<Cmd> {
         match ev {
             StoreEvent::Sessions(list) => {
+                // The highlight stays on its session (by folder) when the
+                // list comes again in another order or with others.
+                let chosen = self
+                    .session
+                    .list
+                    .get(self.screens.survey.selected)
+                    .map(|e| e.dir.clone());
                 self.session.list = list
                     .into_iter()
                     .map(|mut e| {
@@ -177,7 +184,10 @@ impl App {
                     .collect();
                 let (screens, mut ctx) = self.parts();
                 let s = &mut screens.survey;
-                s.selected = s.selected.min(ctx.session.list.len().saturating_sub(1));
+                let kept = chosen.and_then(|d| ctx.session.list.iter().position(|e| e.dir == d));
+                s.selected = kept
+                    .unwrap_or(s.selected)
+                    .min(ctx.session.list.len().saturating_sub(1));
                 // A damaged session asked for: open it now if it reads, or
                 // say again why not, from the fresh listing.
                 let again = s

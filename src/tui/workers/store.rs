@@ -19,8 +19,9 @@ use crate::profile::Profile;
 use crate::report;
 use crate::session::takeover::LEAVE_POLL;
 use crate::session::{CheckReport, FrameSettings, Session, SessionError};
-use crate::tui::event::{Msg, SessionEntry, StoreCmd, StoreError, StoreEvent};
+use crate::tui::event::{Msg, StoreCmd, StoreError, StoreEvent};
 
+mod list;
 mod load;
 mod logfile;
 mod view;
@@ -76,6 +77,7 @@ pub struct Store {
     /// as files are rewritten.
     check: Option<CheckReport>,
     log: logfile::LogFile,
+    lister: list::Lister,
 }
 
 impl Store {
@@ -86,6 +88,7 @@ impl Store {
             session: None,
             check: None,
             log: logfile::LogFile::default(),
+            lister: list::Lister::default(),
         }
     }
 
@@ -129,8 +132,7 @@ impl Store {
                     dir,
                     by: asker.to_string(),
                 });
-                let list = self.list();
-                self.reply(StoreEvent::Sessions(list));
+                self.say_list(false);
             }
             Some(Err(why)) => self.reply(StoreEvent::Note(format!(
                 "a request to leave session {} was ignored: {why}",
@@ -193,9 +195,10 @@ impl Store {
     fn try_handle(&mut self, cmd: StoreCmd) -> Result<(), StoreError> {
         match cmd {
             StoreCmd::List => {
-                let list = self.list();
-                self.reply(StoreEvent::Sessions(list));
+                self.lister.forget();
+                self.say_list(false);
             }
+            StoreCmd::Relist => self.say_list(true),
             StoreCmd::Log(lines) => {
                 let path = self.log.path().map(Path::to_path_buf);
                 if let Err(source) = self.log.append(&lines)
@@ -401,8 +404,7 @@ impl Store {
         self.check = Some(check);
         self.use_log(log);
         self.reply(StoreEvent::Opened(v));
-        let list = self.list();
-        self.reply(StoreEvent::Sessions(list));
+        self.say_list(false);
     }
 
     fn use_log(&mut self, path: PathBuf) {
@@ -426,66 +428,14 @@ impl Store {
         }
     }
 
-    /// Sessions under the survey folder: name, folder, checklist summary;
-    /// a folder whose manifest does not read is listed with why.
-    fn list(&self) -> Vec<SessionEntry> {
-        let Ok(rd) = std::fs::read_dir(&self.profile.survey.dir) else {
-            return Vec::new();
-        };
+    /// Says the sessions of the survey folder ([`list::Lister::list`]);
+    /// `if_changed`: only when they differ from the list said last.
+    fn say_list(&mut self, if_changed: bool) {
         let here = self.session.as_ref().map(|s| s.dir().to_path_buf());
-        let mut out: Vec<(std::time::SystemTime, SessionEntry)> = rd
-            .flatten()
-            .filter(|e| e.path().is_dir())
-            .filter_map(|e| {
-                let dir = e.path();
-                let folder = e.file_name().to_string_lossy().into_owned();
-                match Session::inspect(&dir) {
-                    Ok(s) => {
-                        let (done, all) = s.progress().done();
-                        let name = s.name().as_str().to_string();
-                        // The session this console has open is ours, not
-                        // "in use by" someone.
-                        let busy = if here.as_deref() == Some(dir.as_path()) {
-                            " (open here)".to_string()
-                        } else {
-                            s.lock_holder()
-                                .map_or(String::new(), |h| format!(" (in use by {})", h.user))
-                        };
-                        let when = std::fs::metadata(dir.join(format!("{name}.toml")))
-                            .and_then(|m| m.modified())
-                            .unwrap_or(std::time::UNIX_EPOCH);
-                        Some((
-                            when,
-                            SessionEntry {
-                                name,
-                                dir,
-                                summary: format!("{done}/{all} done{busy}"),
-                                damaged: None,
-                            },
-                        ))
-                    }
-                    Err(SessionError::NotASession { .. }) => None,
-                    Err(e) => Some((
-                        std::time::UNIX_EPOCH,
-                        SessionEntry {
-                            name: folder,
-                            dir,
-                            summary: "DAMAGED".into(),
-                            damaged: Some(e.to_string()),
-                        },
-                    )),
-                }
-            })
-            .collect();
-        // Damaged sessions first (they need a look), then the most recently
-        // worked on: after a dropped connection the session just worked on
-        // is the one chosen.
-        out.sort_by(|a, b| {
-            (b.1.damaged.is_some(), b.0)
-                .cmp(&(a.1.damaged.is_some(), a.0))
-                .then_with(|| a.1.name.cmp(&b.1.name))
-        });
-        out.into_iter().map(|(_, e)| e).collect()
+        let list = self.lister.list(&self.profile.survey.dir, here.as_deref());
+        if self.lister.say(&list) || !if_changed {
+            self.reply(StoreEvent::Sessions(list));
+        }
     }
 
     /// Opens a session another vss holds, by the rule every take-over
