@@ -29,6 +29,7 @@ mod modal;
 mod mouse;
 mod nav;
 mod pipeline;
+mod readonly;
 mod results;
 mod search;
 mod session;
@@ -45,6 +46,7 @@ pub use log::{Level, Log, LogEntry};
 pub use modal::{Modal, Pending, Prompt, PromptPurpose};
 pub use nav::PreviewNav;
 pub use pipeline::{GreySource, PipelineScreen, StageView};
+pub use readonly::READ_ONLY;
 pub use session::{SessionEntry, SessionState};
 pub use survey::{Phase, SurveyScreen, Work};
 pub use tracker::{Loaded, Tracker};
@@ -301,6 +303,9 @@ impl App {
 
     /// Carries out one action through its owner.
     pub fn act(&mut self, a: Action) -> Vec<Cmd> {
+        if self.refused_read_only(a) {
+            return Vec::new();
+        }
         let screen = self.chrome.screen;
         match a {
             Action::Global(g) => self.global(g),

@@ -78,6 +78,8 @@ pub struct Store {
     check: Option<CheckReport>,
     log: logfile::LogFile,
     lister: list::Lister,
+    /// The open session was opened only to look: nothing is written.
+    read_only: bool,
 }
 
 impl Store {
@@ -89,6 +91,7 @@ impl Store {
             check: None,
             log: logfile::LogFile::default(),
             lister: list::Lister::default(),
+            read_only: false,
         }
     }
 
@@ -229,8 +232,29 @@ impl Store {
                         self.reply(StoreEvent::Locked { dir, holder });
                         return Ok(());
                     }
+                    // The lock cannot be written: the folder is read-only
+                    // (a mount, permissions). Looking is offered, not done.
+                    Err(SessionError::Io { path, source })
+                        if path.extension().is_some_and(|e| e == "lock")
+                            && matches!(
+                                source.kind(),
+                                std::io::ErrorKind::PermissionDenied
+                                    | std::io::ErrorKind::ReadOnlyFilesystem
+                            ) =>
+                    {
+                        let why = format!("{}: {source}", path.display());
+                        self.reply(StoreEvent::Unwritable { dir, why });
+                        return Ok(());
+                    }
                     Err(e) => return Err(session_err(format!("cannot open {}", dir.display()))(e)),
                 };
+                self.opened(s);
+            }
+            StoreCmd::OpenReadOnly(dir) => {
+                self.close();
+                let s = Session::inspect(&dir)
+                    .map_err(session_err(format!("cannot open {}", dir.display())))?;
+                self.read_only = true;
                 self.opened(s);
             }
             StoreCmd::TakeOver(dir) => {
@@ -359,6 +383,9 @@ impl Store {
                 }
                 crate::calib::write_cdf_keeping(&path, &cdf).map_err(cdf_err)?;
                 let recorded = match self.session.as_mut() {
+                    Some(s) if self.read_only => {
+                        format!("; not recorded in session {} (open only to look)", s.name())
+                    }
                     Some(s) => {
                         s.record_calibration(camera, &path, &calibration)
                             .map_err(session_err(format!(
@@ -381,28 +408,41 @@ impl Store {
         Ok(())
     }
 
+    /// The open session, to write; refused when it is open only to look.
     fn session_mut(&mut self) -> Result<&mut Session, StoreError> {
-        self.session.as_mut().ok_or(StoreError::NoSession)
+        let s = self.session.as_mut().ok_or(StoreError::NoSession)?;
+        if self.read_only {
+            return Err(StoreError::ReadOnly {
+                name: s.name().to_string(),
+            });
+        }
+        Ok(s)
     }
 
     /// Closes the open session (its lock released); the log goes back to
     /// the state folder.
     fn close(&mut self) {
         if self.session.take().is_some()
+            && !self.read_only
             && let Some(p) = logfile::state_path()
         {
             self.use_log(p);
         }
         self.check = None;
+        self.read_only = false;
     }
 
     fn opened(&mut self, s: Session) {
         let check = s.check();
-        let v = view(&s, Some(&check), true);
+        let mut v = view(&s, Some(&check), true);
+        v.read_only = self.read_only;
         let log = s.path(&format!("{}.log", s.name()));
         self.session = Some(s);
         self.check = Some(check);
-        self.use_log(log);
+        // A session open only to look keeps the state folder's log.
+        if !self.read_only {
+            self.use_log(log);
+        }
         self.reply(StoreEvent::Opened(v));
         self.say_list(false);
     }
@@ -416,7 +456,9 @@ impl Store {
 
     fn updated(&self) {
         if let Some(s) = &self.session {
-            self.reply(StoreEvent::Updated(view(s, self.check.as_ref(), false)));
+            let mut v = view(s, self.check.as_ref(), false);
+            v.read_only = self.read_only;
+            self.reply(StoreEvent::Updated(v));
         }
     }
 
@@ -474,7 +516,7 @@ impl Store {
     /// the session folder, through the one report writer (`vss report`
     /// writes the same pages). A failure says which file on disk is old.
     fn export(&mut self) -> Result<Vec<PathBuf>, StoreError> {
-        let s = self.session.as_ref().ok_or(StoreError::NoSession)?;
+        let s = &*self.session_mut()?;
         let targets = report::survey::Targets::in_session(s);
         let ps = targets.ps.clone().unwrap_or_default();
         report::survey::write(s, None, &targets).map_err(|e| {
