@@ -212,6 +212,7 @@ fn run_loop(
             Err(RecvTimeoutError::Timeout) => dirty |= app.release_held(Instant::now()),
             Err(RecvTimeoutError::Disconnected) => break,
         }
+        workers.dispatch(app.due(Instant::now()));
     }
     // The log says why the console ended: the operator, a signal, or the
     // terminal gone.

@@ -29,6 +29,7 @@ mod modal;
 mod mouse;
 mod nav;
 mod pipeline;
+mod readonly;
 mod results;
 mod search;
 mod session;
@@ -45,9 +46,13 @@ pub use log::{Level, Log, LogEntry};
 pub use modal::{Modal, Pending, Prompt, PromptPurpose};
 pub use nav::PreviewNav;
 pub use pipeline::{GreySource, PipelineScreen, StageView};
+pub use readonly::READ_ONLY;
 pub use session::{SessionEntry, SessionState};
 pub use survey::{Phase, SurveyScreen, Work};
 pub use tracker::{Loaded, Tracker};
+
+/// How often the session list is read again while it is shown.
+pub const RELIST: std::time::Duration = std::time::Duration::from_secs(2);
 
 /// Each screen's own state.
 #[derive(Debug, Default)]
@@ -150,7 +155,28 @@ impl App {
         let (name, file) = (&self.cell.profile_name, &self.cell.profile_file);
         let text = format!("profile {name}: {file}");
         self.ctx().info(text);
+        self.session.listed = Some(std::time::Instant::now());
         vec![Cmd::Store(StoreCmd::List)]
+    }
+
+    /// Work the clock makes due (the shell calls it as it goes, keys or
+    /// none): while the session list is on screen it is read again every
+    /// [`RELIST`], so a session another console or a `vss grab` opened,
+    /// captured into or closed shows as it is without a key pressed. The
+    /// store says the list only when it changed; nothing is written.
+    pub fn due(&mut self, now: std::time::Instant) -> Vec<Cmd> {
+        let shown = self.chrome.screen == ScreenId::Survey
+            && !self.chrome.too_small()
+            && (self.session.view.is_none() || self.screens.survey.picking);
+        let recent = self
+            .session
+            .listed
+            .is_some_and(|t| now.saturating_duration_since(t) < RELIST);
+        if !shown || recent {
+            return Vec::new();
+        }
+        self.session.listed = Some(now);
+        vec![Cmd::Store(StoreCmd::Relist)]
     }
 
     pub fn quit(&self) -> bool {
@@ -277,6 +303,9 @@ impl App {
 
     /// Carries out one action through its owner.
     pub fn act(&mut self, a: Action) -> Vec<Cmd> {
+        if self.refused_read_only(a) {
+            return Vec::new();
+        }
         let screen = self.chrome.screen;
         match a {
             Action::Global(g) => self.global(g),

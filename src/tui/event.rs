@@ -128,6 +128,9 @@ pub struct SessionView {
     /// Whether the files were read and checked for this view (not only
     /// the manifest).
     pub checked: bool,
+    /// Opened only to look (its folder cannot be written): every action
+    /// that would write is refused, and nothing is written into it.
+    pub read_only: bool,
 }
 
 impl SessionView {
@@ -253,6 +256,13 @@ pub enum StoreEvent {
     /// A note worth a log line (a stale lock taken over).
     Note(String),
     Reports(Vec<PathBuf>),
+    /// The session's folder cannot be written (a read-only mount, no
+    /// write permission): it can be opened only to look
+    /// ([`StoreCmd::OpenReadOnly`]), if the operator says so.
+    Unwritable {
+        dir: PathBuf,
+        why: String,
+    },
     /// The session is held by a console that still runs.
     Locked {
         dir: PathBuf,
@@ -340,8 +350,16 @@ pub struct PipelineRequest {
 #[derive(Debug)]
 pub enum StoreCmd {
     List,
+    /// The list read again while it is shown (another console or a `vss
+    /// grab` may have opened, captured into or closed a session): said
+    /// only when it differs from the one last said, so an unchanged list
+    /// costs the screen nothing.
+    Relist,
     Create(String),
     Open(PathBuf),
+    /// Open only to look, without the lock: nothing is written into the
+    /// folder, every command that would write is refused.
+    OpenReadOnly(PathBuf),
     /// Open, taking the lock of a console that still runs (asked first).
     TakeOver(PathBuf),
     /// Lines for the log file (the session's, or the state folder's).
@@ -395,6 +413,11 @@ pub enum StoreCmd {
 pub enum StoreError {
     #[error("no session open: create or open one on the Survey screen (1)")]
     NoSession,
+    #[error(
+        "read-only: nothing will be saved — session {name} is open only to look (its folder \
+         cannot be written); o opens another session"
+    )]
+    ReadOnly { name: String },
     #[error("{what}: {source}")]
     Session {
         what: String,

@@ -127,6 +127,7 @@ pub fn view() -> SessionView {
         next: Some((1, Some('a'))),
         files: Vec::new(),
         checked: true,
+        read_only: false,
     }
 }
 

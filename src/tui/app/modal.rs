@@ -30,6 +30,8 @@ pub enum Pending {
     Switch(std::path::PathBuf),
     /// Take the lock of a session held by a console that still runs.
     TakeOver(std::path::PathBuf),
+    /// Open, only to look, a session whose folder cannot be written.
+    OpenReadOnly(std::path::PathBuf),
     /// Start an image beyond the survey's plan.
     ExtraImage(u32),
     /// Go on with the edit of an accepted image's lines.
@@ -297,6 +299,7 @@ impl App {
             Pending::SaveOutputs => self.ctx().save_outputs(true).unwrap_or_default(),
             Pending::Switch(dir) => vec![Cmd::Store(StoreCmd::Open(dir))],
             Pending::TakeOver(dir) => vec![Cmd::Store(StoreCmd::TakeOver(dir))],
+            Pending::OpenReadOnly(dir) => vec![Cmd::Store(StoreCmd::OpenReadOnly(dir))],
             Pending::ExtraImage(k) => self.ctx().extra_image(k),
             Pending::CreateSession(name) => vec![Cmd::Store(StoreCmd::Create(name))],
             Pending::Edit => {

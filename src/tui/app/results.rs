@@ -166,6 +166,13 @@ impl App {
     pub(super) fn on_store(&mut self, ev: StoreEvent) -> Vec<Cmd> {
         match ev {
             StoreEvent::Sessions(list) => {
+                // The highlight stays on its session (by folder) when the
+                // list comes again in another order or with others.
+                let chosen = self
+                    .session
+                    .list
+                    .get(self.screens.survey.selected)
+                    .map(|e| e.dir.clone());
                 self.session.list = list
                     .into_iter()
                     .map(|mut e| {
@@ -177,7 +184,10 @@ impl App {
                     .collect();
                 let (screens, mut ctx) = self.parts();
                 let s = &mut screens.survey;
-                s.selected = s.selected.min(ctx.session.list.len().saturating_sub(1));
+                let kept = chosen.and_then(|d| ctx.session.list.iter().position(|e| e.dir == d));
+                s.selected = kept
+                    .unwrap_or(s.selected)
+                    .min(ctx.session.list.len().saturating_sub(1));
                 // A damaged session asked for: open it now if it reads, or
                 // say again why not, from the fresh listing.
                 let again = s
@@ -199,8 +209,16 @@ impl App {
                 self.screens.survey.picking = false;
                 self.screens.survey.row = None;
                 let problems = v.problems();
+                let read_only = v.read_only.then(|| v.name.clone());
                 let mut ctx = self.ctx();
                 let cmds = ctx.session_opened(v);
+                if let Some(name) = read_only {
+                    ctx.warn(format!(
+                        "{} — session {name} is open only to look: capture, accept, edit, \
+                         save and reports are refused",
+                        super::READ_ONLY
+                    ));
+                }
                 if problems > 0 {
                     ctx.error(format!(
                         "{problems} damaged or missing file(s) in this session: the checklist \
@@ -289,6 +307,20 @@ impl App {
                         problems.join(", ")
                     ));
                 }
+                Vec::new()
+            }
+            StoreEvent::Unwritable { dir, why } => {
+                let (shown, why) = (clean(&dir.display().to_string()), clean(&why));
+                let mut ctx = self.ctx();
+                ctx.error(format!(
+                    "session {shown} cannot be opened to work on: its lock cannot be written \
+                     ({why})"
+                ));
+                ctx.ask(
+                    "The session's folder cannot be written. Open it read-only, only to look at \
+                     its images, lines and files? Nothing will be saved.",
+                    Pending::OpenReadOnly(dir),
+                );
                 Vec::new()
             }
             StoreEvent::Locked { dir, holder } => {

@@ -18,6 +18,10 @@ pub struct SessionState {
     /// said in the next-step box until they are accepted, so that no later
     /// message hides it.
     pub refused: Vec<(u32, String)>,
+    /// When the session list was last asked for ([`App::due`]).
+    ///
+    /// [`App::due`]: super::App::due
+    pub listed: Option<std::time::Instant>,
 }
 
 impl SessionState {

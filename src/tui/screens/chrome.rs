@@ -57,7 +57,10 @@ pub fn top_bar(app: &App, area: Rect, buf: &mut Buffer) {
         .session
         .view
         .as_ref()
-        .map(|s| format!(" {bar} {}", s.name))
+        .map(|s| match s.read_only {
+            true => format!(" {bar} {} {bar} {}", s.name, crate::tui::app::READ_ONLY),
+            false => format!(" {bar} {}", s.name),
+        })
         .unwrap_or_default();
     let tabs = |short: bool| -> Vec<Span<'static>> {
         let mut spans = vec![Span::styled("vss", t.title())];

@@ -19,8 +19,9 @@ use crate::profile::Profile;
 use crate::report;
 use crate::session::takeover::LEAVE_POLL;
 use crate::session::{CheckReport, FrameSettings, Session, SessionError};
-use crate::tui::event::{Msg, SessionEntry, StoreCmd, StoreError, StoreEvent};
+use crate::tui::event::{Msg, StoreCmd, StoreError, StoreEvent};
 
+mod list;
 mod load;
 mod logfile;
 mod view;
@@ -76,6 +77,9 @@ pub struct Store {
     /// as files are rewritten.
     check: Option<CheckReport>,
     log: logfile::LogFile,
+    lister: list::Lister,
+    /// The open session was opened only to look: nothing is written.
+    read_only: bool,
 }
 
 impl Store {
@@ -86,6 +90,8 @@ impl Store {
             session: None,
             check: None,
             log: logfile::LogFile::default(),
+            lister: list::Lister::default(),
+            read_only: false,
         }
     }
 
@@ -129,8 +135,7 @@ impl Store {
                     dir,
                     by: asker.to_string(),
                 });
-                let list = self.list();
-                self.reply(StoreEvent::Sessions(list));
+                self.say_list(false);
             }
             Some(Err(why)) => self.reply(StoreEvent::Note(format!(
                 "a request to leave session {} was ignored: {why}",
@@ -193,9 +198,10 @@ impl Store {
     fn try_handle(&mut self, cmd: StoreCmd) -> Result<(), StoreError> {
         match cmd {
             StoreCmd::List => {
-                let list = self.list();
-                self.reply(StoreEvent::Sessions(list));
+                self.lister.forget();
+                self.say_list(false);
             }
+            StoreCmd::Relist => self.say_list(true),
             StoreCmd::Log(lines) => {
                 let path = self.log.path().map(Path::to_path_buf);
                 if let Err(source) = self.log.append(&lines)
@@ -226,8 +232,29 @@ impl Store {
                         self.reply(StoreEvent::Locked { dir, holder });
                         return Ok(());
                     }
+                    // The lock cannot be written: the folder is read-only
+                    // (a mount, permissions). Looking is offered, not done.
+                    Err(SessionError::Io { path, source })
+                        if path.extension().is_some_and(|e| e == "lock")
+                            && matches!(
+                                source.kind(),
+                                std::io::ErrorKind::PermissionDenied
+                                    | std::io::ErrorKind::ReadOnlyFilesystem
+                            ) =>
+                    {
+                        let why = format!("{}: {source}", path.display());
+                        self.reply(StoreEvent::Unwritable { dir, why });
+                        return Ok(());
+                    }
                     Err(e) => return Err(session_err(format!("cannot open {}", dir.display()))(e)),
                 };
+                self.opened(s);
+            }
+            StoreCmd::OpenReadOnly(dir) => {
+                self.close();
+                let s = Session::inspect(&dir)
+                    .map_err(session_err(format!("cannot open {}", dir.display())))?;
+                self.read_only = true;
                 self.opened(s);
             }
             StoreCmd::TakeOver(dir) => {
@@ -356,6 +383,9 @@ impl Store {
                 }
                 crate::calib::write_cdf_keeping(&path, &cdf).map_err(cdf_err)?;
                 let recorded = match self.session.as_mut() {
+                    Some(s) if self.read_only => {
+                        format!("; not recorded in session {} (open only to look)", s.name())
+                    }
                     Some(s) => {
                         s.record_calibration(camera, &path, &calibration)
                             .map_err(session_err(format!(
@@ -378,31 +408,43 @@ impl Store {
         Ok(())
     }
 
+    /// The open session, to write; refused when it is open only to look.
     fn session_mut(&mut self) -> Result<&mut Session, StoreError> {
-        self.session.as_mut().ok_or(StoreError::NoSession)
+        let s = self.session.as_mut().ok_or(StoreError::NoSession)?;
+        if self.read_only {
+            return Err(StoreError::ReadOnly {
+                name: s.name().to_string(),
+            });
+        }
+        Ok(s)
     }
 
     /// Closes the open session (its lock released); the log goes back to
     /// the state folder.
     fn close(&mut self) {
         if self.session.take().is_some()
+            && !self.read_only
             && let Some(p) = logfile::state_path()
         {
             self.use_log(p);
         }
         self.check = None;
+        self.read_only = false;
     }
 
     fn opened(&mut self, s: Session) {
         let check = s.check();
-        let v = view(&s, Some(&check), true);
+        let mut v = view(&s, Some(&check), true);
+        v.read_only = self.read_only;
         let log = s.path(&format!("{}.log", s.name()));
         self.session = Some(s);
         self.check = Some(check);
-        self.use_log(log);
+        // A session open only to look keeps the state folder's log.
+        if !self.read_only {
+            self.use_log(log);
+        }
         self.reply(StoreEvent::Opened(v));
-        let list = self.list();
-        self.reply(StoreEvent::Sessions(list));
+        self.say_list(false);
     }
 
     fn use_log(&mut self, path: PathBuf) {
@@ -414,7 +456,9 @@ impl Store {
 
     fn updated(&self) {
         if let Some(s) = &self.session {
-            self.reply(StoreEvent::Updated(view(s, self.check.as_ref(), false)));
+            let mut v = view(s, self.check.as_ref(), false);
+            v.read_only = self.read_only;
+            self.reply(StoreEvent::Updated(v));
         }
     }
 
@@ -426,66 +470,14 @@ impl Store {
         }
     }
 
-    /// Sessions under the survey folder: name, folder, checklist summary;
-    /// a folder whose manifest does not read is listed with why.
-    fn list(&self) -> Vec<SessionEntry> {
-        let Ok(rd) = std::fs::read_dir(&self.profile.survey.dir) else {
-            return Vec::new();
-        };
+    /// Says the sessions of the survey folder ([`list::Lister::list`]);
+    /// `if_changed`: only when they differ from the list said last.
+    fn say_list(&mut self, if_changed: bool) {
         let here = self.session.as_ref().map(|s| s.dir().to_path_buf());
-        let mut out: Vec<(std::time::SystemTime, SessionEntry)> = rd
-            .flatten()
-            .filter(|e| e.path().is_dir())
-            .filter_map(|e| {
-                let dir = e.path();
-                let folder = e.file_name().to_string_lossy().into_owned();
-                match Session::inspect(&dir) {
-                    Ok(s) => {
-                        let (done, all) = s.progress().done();
-                        let name = s.name().as_str().to_string();
-                        // The session this console has open is ours, not
-                        // "in use by" someone.
-                        let busy = if here.as_deref() == Some(dir.as_path()) {
-                            " (open here)".to_string()
-                        } else {
-                            s.lock_holder()
-                                .map_or(String::new(), |h| format!(" (in use by {})", h.user))
-                        };
-                        let when = std::fs::metadata(dir.join(format!("{name}.toml")))
-                            .and_then(|m| m.modified())
-                            .unwrap_or(std::time::UNIX_EPOCH);
-                        Some((
-                            when,
-                            SessionEntry {
-                                name,
-                                dir,
-                                summary: format!("{done}/{all} done{busy}"),
-                                damaged: None,
-                            },
-                        ))
-                    }
-                    Err(SessionError::NotASession { .. }) => None,
-                    Err(e) => Some((
-                        std::time::UNIX_EPOCH,
-                        SessionEntry {
-                            name: folder,
-                            dir,
-                            summary: "DAMAGED".into(),
-                            damaged: Some(e.to_string()),
-                        },
-                    )),
-                }
-            })
-            .collect();
-        // Damaged sessions first (they need a look), then the most recently
-        // worked on: after a dropped connection the session just worked on
-        // is the one chosen.
-        out.sort_by(|a, b| {
-            (b.1.damaged.is_some(), b.0)
-                .cmp(&(a.1.damaged.is_some(), a.0))
-                .then_with(|| a.1.name.cmp(&b.1.name))
-        });
-        out.into_iter().map(|(_, e)| e).collect()
+        let list = self.lister.list(&self.profile.survey.dir, here.as_deref());
+        if self.lister.say(&list) || !if_changed {
+            self.reply(StoreEvent::Sessions(list));
+        }
     }
 
     /// Opens a session another vss holds, by the rule every take-over
@@ -524,7 +516,7 @@ impl Store {
     /// the session folder, through the one report writer (`vss report`
     /// writes the same pages). A failure says which file on disk is old.
     fn export(&mut self) -> Result<Vec<PathBuf>, StoreError> {
-        let s = self.session.as_ref().ok_or(StoreError::NoSession)?;
+        let s = &*self.session_mut()?;
         let targets = report::survey::Targets::in_session(s);
         let ps = targets.ps.clone().unwrap_or_default();
         report::survey::write(s, None, &targets).map_err(|e| {

@@ -108,5 +108,6 @@ pub fn view(s: &Session, check: Option<&CheckReport>, checked: bool) -> SessionV
         next,
         files,
         checked,
+        read_only: false,
     }
 }

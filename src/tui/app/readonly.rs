@@ -1,0 +1,77 @@
+//! A session open only to look (its folder cannot be written: a
+//! read-only mount, no write permission; opened so after the operator said
+//! yes): the images, lines and files can be seen, and every action that
+//! would write into it is refused here, before anything changes, with
+//! what was refused. The store refuses the same writes again.
+
+use super::App;
+use crate::tui::keymap::{Action, EditAction, FilesAction, PipelineAction, SurveyAction};
+
+/// The status line's words for such a session.
+pub const READ_ONLY: &str = "read-only: nothing will be saved";
+
+impl App {
+    /// Whether the open session is open only to look.
+    pub fn read_only(&self) -> bool {
+        self.session.view.as_ref().is_some_and(|v| v.read_only)
+    }
+
+    /// What `a` would write into the open session, if it would.
+    pub(super) fn would_write(&self, a: Action) -> Option<&'static str> {
+        let survey = &self.screens.survey;
+        let w = &self.session.work;
+        match a {
+            // Enter on the image under work captures it, accepts it or
+            // starts one beyond the plan; on another row it only shows
+            // that image, and in the list it opens a session.
+            Action::Survey(SurveyAction::Enter)
+                if !survey.picking
+                    && survey.row(w) == w.k
+                    && matches!(
+                        w.phase,
+                        super::Phase::Setup | super::Phase::Review | super::Phase::Complete
+                    ) =>
+            {
+                Some(match w.phase {
+                    super::Phase::Setup => "capturing",
+                    super::Phase::Review => "accepting",
+                    _ => "a new image",
+                })
+            }
+            Action::Survey(SurveyAction::Accept) => Some("accepting"),
+            Action::Survey(SurveyAction::Redo) => Some("taking an image again"),
+            Action::Pipeline(PipelineAction::Save) => Some("saving the outputs"),
+            Action::Edit(
+                EditAction::Connect
+                | EditAction::Extend
+                | EditAction::Delete
+                | EditAction::Undo
+                | EditAction::Redo,
+            ) => Some("editing the lines"),
+            Action::Files(FilesAction::Export) => Some("writing the reports"),
+            _ => None,
+        }
+    }
+
+    /// Refuses `a` when the open session is open only to look and `a`
+    /// would write into it (said on the message line); whether it was.
+    pub(super) fn refused_read_only(&mut self, a: Action) -> bool {
+        if !self.read_only() {
+            return false;
+        }
+        let Some(what) = self.would_write(a) else {
+            return false;
+        };
+        let name = self
+            .session
+            .view
+            .as_ref()
+            .map(|v| v.name.clone())
+            .unwrap_or_default();
+        self.ctx().error(format!(
+            "{READ_ONLY} — {what} refused: session {name} is open only to look (its folder \
+             cannot be written); o opens another session"
+        ));
+        true
+    }
+}
