@@ -3,7 +3,8 @@
 //! operator says yes: the top bar says "read-only: nothing will be saved",
 //! the images and lines show, every action that would write is refused
 //! with what was refused, `q` quits at once, and no file of the folder
-//! changes. Needs root (mount); without it the test says so and passes.
+//! changes. Root bind-mounts the folder read-only; anyone else takes the
+//! folder's write permission away (which root would not notice).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -13,13 +14,32 @@ use vss::tui::keymap::{Action, FilesAction, ModalAction, Scope, ScreenId, Survey
 
 use super::tui_harness::{Console, SURVEY};
 
-/// The folder bind-mounted read-only over itself, until dropped.
-struct ReadOnly(PathBuf);
+/// The folder made read-only until dropped: bind-mounted read-only over
+/// itself (root), or its write permission taken away (anyone else).
+enum ReadOnly {
+    Mounted(PathBuf),
+    Unwritable(PathBuf, std::fs::Permissions),
+}
 
 impl ReadOnly {
+    fn make(dir: &Path) -> Option<ReadOnly> {
+        use std::os::unix::fs::PermissionsExt;
+        if let Some(ro) = ReadOnly::mount(dir) {
+            return Some(ro);
+        }
+        let before = std::fs::metadata(dir).ok()?.permissions();
+        std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o555)).ok()?;
+        let ro = ReadOnly::Unwritable(dir.to_path_buf(), before);
+        // Root writes through the permission: no way left to test here.
+        std::fs::write(dir.join("probe"), "x")
+            .is_err()
+            .then_some(ro)
+    }
+
     fn mount(dir: &Path) -> Option<ReadOnly> {
         let run = |args: &[&str]| {
             Command::new("mount")
+                .stderr(std::process::Stdio::null())
                 .args(args)
                 .arg(dir)
                 .arg(dir)
@@ -29,14 +49,21 @@ impl ReadOnly {
         if !run(&["--bind"]) {
             return None;
         }
-        let ro = ReadOnly(dir.to_path_buf());
+        let ro = ReadOnly::Mounted(dir.to_path_buf());
         run(&["-o", "remount,bind,ro"]).then_some(ro)
     }
 }
 
 impl Drop for ReadOnly {
     fn drop(&mut self) {
-        let _ = Command::new("umount").arg(&self.0).status();
+        match self {
+            ReadOnly::Mounted(dir) => {
+                let _ = Command::new("umount").arg(&*dir).status();
+            }
+            ReadOnly::Unwritable(dir, before) => {
+                let _ = std::fs::set_permissions(&*dir, before.clone());
+            }
+        }
     }
 }
 
@@ -60,9 +87,9 @@ fn a_session_that_cannot_be_written_opens_only_to_look() {
     c.survey(1);
     let dir = c.session();
     let mut mounted = None;
-    let mut c = c.restart_after(|_| mounted = ReadOnly::mount(&dir));
+    let mut c = c.restart_after(|_| mounted = ReadOnly::make(&dir));
     let Some(_ro) = mounted else {
-        eprintln!("SKIPPED: a read-only bind mount needs root");
+        eprintln!("SKIPPED: root here cannot mount, and writes through permissions");
         c.send("q");
         c.wait_exit(10);
         return;
