@@ -252,7 +252,12 @@ pub enum StoreEvent {
     OutputsSaved(u32),
     /// A note worth a log line (a stale lock taken over).
     Note(String),
-    Reports(Vec<PathBuf>),
+    /// The survey report is written: its files, and the problems marked in
+    /// it (files it could not show), as `vss report` says them.
+    Reports {
+        paths: Vec<PathBuf>,
+        problems: Vec<String>,
+    },
     /// The session is held by a console that still runs.
     Locked {
         dir: PathBuf,

@@ -259,10 +259,12 @@ impl App {
                 self.ctx().info(clean(&what));
                 Vec::new()
             }
-            StoreEvent::Reports(paths) => {
+            StoreEvent::Reports { paths, problems } => {
                 // One message: the survey's page and how many image pages,
                 // and the problems the report shows (said here, not only
-                // inside the pages).
+                // inside the pages): those the report marks, as `vss
+                // report` says them, else the damage the session's check
+                // found.
                 let ps = paths
                     .iter()
                     .find(|p| p.extension().is_some_and(|e| e == "ps"))
@@ -273,12 +275,15 @@ impl App {
                     .iter()
                     .filter(|p| p.extension().is_some_and(|e| e == "svg"))
                     .count();
-                let problems = self
-                    .session
-                    .view
-                    .as_ref()
-                    .map(|v| v.problem_list())
-                    .unwrap_or_default();
+                let problems = if problems.is_empty() {
+                    self.session
+                        .view
+                        .as_ref()
+                        .map(|v| v.problem_list())
+                        .unwrap_or_default()
+                } else {
+                    problems.iter().map(|p| clean(p)).collect()
+                };
                 let text = format!("report written: {ps} and {svg} SVG page(s)");
                 if problems.is_empty() {
                     self.ctx().info(text);

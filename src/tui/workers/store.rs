@@ -320,8 +320,11 @@ impl Store {
                 )));
             }
             StoreCmd::Export => {
-                let paths = self.export()?;
-                self.reply(StoreEvent::Reports(paths));
+                let written = self.export()?;
+                self.reply(StoreEvent::Reports {
+                    paths: written.files,
+                    problems: written.problems,
+                });
                 self.updated();
             }
             StoreCmd::Refresh => {
@@ -523,7 +526,7 @@ impl Store {
     /// Writes the survey report `NAME.ps` and one `NAMEk.svg` per image in
     /// the session folder, through the one report writer (`vss report`
     /// writes the same pages). A failure says which file on disk is old.
-    fn export(&mut self) -> Result<Vec<PathBuf>, StoreError> {
+    fn export(&mut self) -> Result<report::survey::Written, StoreError> {
         let s = self.session.as_ref().ok_or(StoreError::NoSession)?;
         let targets = report::survey::Targets::in_session(s);
         let ps = targets.ps.clone().unwrap_or_default();
