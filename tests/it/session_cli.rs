@@ -423,3 +423,55 @@ fn choice_arguments_list_their_values() {
         assert!(text(&o).contains(values), "{args:?}: {}", text(&o));
     }
 }
+
+/// `session new` stopped by a full disk (here the file size limit, `ulimit
+/// -f` in 512-byte blocks, with SIGXFSZ ignored so the write returns EFBIG)
+/// leaves nothing: not the empty folder of a failed first manifest (1
+/// block), not the partial session of one whose manifest outgrew the limit
+/// as the cameras were recorded (2 blocks: some `.cdf` files written).
+#[test]
+fn session_new_stopped_by_a_full_disk_leaves_nothing() {
+    let cdfs = ["\"cam1.cdf\""; 8].join(", ");
+    let profile = PROFILE.replace("cameras = 2", "cameras = 8").replace(
+        "cdf = [\"cam1.cdf\", \"cam2.cdf\"]",
+        &format!("cdf = [{cdfs}]"),
+    );
+    for blocks in [1, 2, 8] {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("p.toml"), &profile).unwrap();
+        std::fs::write(d.join("cam1.cdf"), CDF).unwrap();
+        let o = crate::support::limited::vss_under(
+            d,
+            &format!("trap '' XFSZ && ulimit -f {blocks}"),
+            [
+                "session",
+                "new",
+                "cube",
+                "--dir",
+                "sess",
+                "--profile",
+                "p.toml",
+            ],
+        );
+        let t = text(&o);
+        if blocks == 8 {
+            assert!(o.status.success(), "{t}");
+            assert!(d.join("sess/cube/cube8.cdf").is_file(), "{t}");
+            continue;
+        }
+        assert!(!o.status.success(), "{blocks} block(s): {t}");
+        assert!(
+            t.contains("cannot make session sess/cube: sess/cube/cube.toml: File too large")
+                && t.contains("nothing of it is left"),
+            "{blocks} block(s): {t}"
+        );
+        assert!(
+            !d.join("sess").exists(),
+            "{blocks} block(s): left behind: {:?}",
+            std::fs::read_dir(d.join("sess/cube")).map(|r| r
+                .filter_map(|e| Some(e.ok()?.file_name()))
+                .collect::<Vec<_>>())
+        );
+    }
+}
