@@ -284,6 +284,19 @@ pub enum StoreEvent {
         k: u32,
         error: StoreError,
     },
+    /// A hand edit (or its undo) of image `k` is written to its `.ldr`
+    /// (`file`, as said).
+    EditSaved {
+        k: u32,
+        file: String,
+    },
+    /// A hand edit (or its undo) of image `k` could not be written: the
+    /// lines on screen are not its saved outputs, as when they could not
+    /// be saved at all.
+    EditNotSaved {
+        k: u32,
+        error: StoreError,
+    },
     Error(StoreError),
 }
 

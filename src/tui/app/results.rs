@@ -250,8 +250,36 @@ impl App {
             StoreEvent::OutputsSaved(k) => {
                 self.session.saving.retain(|&s| s != k);
                 self.session.refused.retain(|r| r.0 != k);
+                self.session.edit_refused.retain(|&e| e != k);
                 self.ctx().info(format!(
                     "image {k} accepted: outputs saved (.hpo .vpo .lex .ldr)"
+                ));
+                Vec::new()
+            }
+            StoreEvent::EditSaved { k, file } => {
+                // The whole line set is written: an edit that failed before
+                // is in it now.
+                if self.session.edit_refused.contains(&k) {
+                    self.session.edit_refused.retain(|&e| e != k);
+                    self.session.refused.retain(|r| r.0 != k);
+                }
+                self.ctx().info(format!("saved {}", clean(&file)));
+                Vec::new()
+            }
+            StoreEvent::EditNotSaved { k, error } => {
+                // Counted as outputs not saved: q asks, the next-step box
+                // says it, a saves the outputs with the edits.
+                let why = match &error {
+                    StoreError::Session { source, .. } => clean(&source.to_string()),
+                    e => clean(&e.to_string()),
+                };
+                self.session.refused.retain(|r| r.0 != k);
+                self.session.refused.push((k, why));
+                self.session.edit_refused.retain(|&e| e != k);
+                self.session.edit_refused.push(k);
+                self.ctx().error(format!(
+                    "{} — the lines on screen are not saved; the next edit, or a, writes them",
+                    clean(&error.to_string())
                 ));
                 Vec::new()
             }
@@ -347,6 +375,7 @@ impl App {
             }
             StoreEvent::OutputsNotSaved { k, error } => {
                 self.session.saving.retain(|&s| s != k);
+                self.session.edit_refused.retain(|&e| e != k);
                 let why = match &error {
                     StoreError::Session { source, .. } => clean(&source.to_string()),
                     e => clean(&e.to_string()),
@@ -378,6 +407,7 @@ impl App {
         self.session.view = None;
         self.session.saving.clear();
         self.session.refused.clear();
+        self.session.edit_refused.clear();
         self.session.work.phase = Phase::NoSession;
         self.tracker.current = None;
         self.screens.survey.picking = false;

@@ -18,6 +18,9 @@ pub struct SessionState {
     /// said in the next-step box until they are accepted, so that no later
     /// message hides it.
     pub refused: Vec<(u32, String)>,
+    /// The images of `refused` whose refusal is a hand edit not written:
+    /// the next edit written puts it right, as a saves do.
+    pub edit_refused: Vec<u32>,
 }
 
 impl SessionState {

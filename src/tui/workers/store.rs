@@ -267,19 +267,25 @@ impl Store {
             }
             StoreCmd::RecordEdit { k, what, lines } => {
                 let s = self.session_mut()?;
-                s.record_edit(k, &what, &lines)
-                    .map_err(session_err(format!("edit of image {k} NOT saved")))?;
+                if let Err(e) = s.record_edit(k, &what, &lines) {
+                    let error = session_err(format!("edit of image {k} NOT saved"))(e);
+                    self.reply(StoreEvent::EditNotSaved { k, error });
+                    return Ok(());
+                }
                 let file = s.file_name(k, None, "ldr");
                 self.forget_problems(std::slice::from_ref(&file));
-                self.reply(StoreEvent::Saved(file));
+                self.reply(StoreEvent::EditSaved { k, file });
                 self.updated();
             }
             StoreCmd::UndoEdit { k, lines } => {
                 let s = self.session_mut()?;
-                s.undo_edit(k, &lines)
-                    .map_err(session_err(format!("undo of image {k} NOT saved")))?;
-                let file = s.file_name(k, None, "ldr");
-                self.reply(StoreEvent::Saved(format!("{file} (edit taken back)")));
+                if let Err(e) = s.undo_edit(k, &lines) {
+                    let error = session_err(format!("undo of image {k} NOT saved"))(e);
+                    self.reply(StoreEvent::EditNotSaved { k, error });
+                    return Ok(());
+                }
+                let file = format!("{} (edit taken back)", s.file_name(k, None, "ldr"));
+                self.reply(StoreEvent::EditSaved { k, file });
                 self.updated();
             }
             StoreCmd::Load(k) => {
