@@ -475,3 +475,39 @@ fn session_new_stopped_by_a_full_disk_leaves_nothing() {
         );
     }
 }
+
+/// An empty manifest (0 bytes, or white space only) is said to be empty,
+/// naming it, by every command that reads it; it read as "missing field
+/// `format`".
+#[test]
+fn an_empty_manifest_is_said_to_be_empty() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("p.toml"), PROFILE).unwrap();
+    let new = ["session", "new", "w", "--dir", ".", "--profile", "p.toml"];
+    assert!(vss(&new, d).status.success());
+    let m = d.join("w/w.toml");
+    for (content, says) in [
+        ("", "w.toml: the manifest is empty (0 bytes)"),
+        (
+            " \n\n",
+            "w.toml: the manifest is empty (3 bytes, all white space)",
+        ),
+    ] {
+        std::fs::write(&m, content).unwrap();
+        for args in [
+            &["session", "show", "w"][..],
+            &["session", "check", "w"][..],
+            &["report", "w"][..],
+        ] {
+            let o = vss(args, d);
+            let t = text(&o);
+            assert!(!o.status.success(), "{args:?}: {t}");
+            assert!(
+                t.contains(says) && !t.contains("missing field"),
+                "{args:?}: {t}"
+            );
+            assert_eq!(std::fs::read_to_string(&m).unwrap(), content, "kept");
+        }
+    }
+}
