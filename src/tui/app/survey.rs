@@ -624,9 +624,7 @@ impl Ctx<'_> {
         }
         // Outputs the session already holds (hand edits are written as they
         // are made): nothing to save, nothing to ask.
-        let unchanged = cur.is_some_and(|c| {
-            c.in_session && c.outputs_params.as_ref() == Some(&self.tracker.params)
-        });
+        let unchanged = cur.is_some_and(|c| c.saved_with(&self.tracker.params));
         let mut cmds = Vec::new();
         if unchanged {
             self.info(format!("image {k} accepted"));
