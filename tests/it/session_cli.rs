@@ -511,3 +511,49 @@ fn an_empty_manifest_is_said_to_be_empty() {
         }
     }
 }
+
+/// A manifest whose records contradict the frame they describe (a grey
+/// image's width that its header does not have) or each other (one
+/// lighting recorded twice for an image) fails the check, naming the
+/// manifest, the file and the field; it passed.
+#[test]
+fn check_names_records_that_contradict_their_frames() {
+    use vss::formats::img::ImgFile;
+    use vss::llv::GreyImage;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("p.toml"), PROFILE).unwrap();
+    let new = ["session", "new", "w", "--dir", ".", "--profile", "p.toml"];
+    assert!(vss(&new, d).status.success());
+    {
+        let mut s = vss::session::Session::open(&d.join("w")).unwrap();
+        for l in ['a', 'b'] {
+            let img = ImgFile::new(GreyImage::filled(64, 48, 90).unwrap());
+            s.save_image(1, l, &img).unwrap();
+        }
+    }
+    let m = d.join("w/w.toml");
+    let good = std::fs::read_to_string(&m).unwrap();
+    let check = ["session", "check", "w"];
+    assert!(vss(&check, d).status.success(), "{}", text(&vss(&check, d)));
+    for (bad, says) in [
+        (
+            good.replacen("width = 64", "width = 65", 1),
+            "w.toml: image 1, w1a.img: width = 65 recorded, but the file's header says 64 (64 x 48)",
+        ),
+        (
+            good.replacen(
+                "letter = \"b\"\nfile = \"w1b.img\"",
+                "letter = \"a\"\nfile = \"w1b.img\"",
+                1,
+            ),
+            "w.toml: image 1 records lighting 'a' twice (w1a.img and w1b.img)",
+        ),
+    ] {
+        assert_ne!(bad, good, "the record to change is in:\n{good}");
+        std::fs::write(&m, &bad).unwrap();
+        let o = vss(&check, d);
+        assert!(!o.status.success(), "{}", text(&o));
+        assert!(text(&o).contains(says), "{says}\n{}", text(&o));
+    }
+}
