@@ -37,6 +37,9 @@ pub struct ImageReport {
     pub lines: Option<Vec<Segment>>,
     /// Free text lines: parameters used, counts, timings.
     pub notes: Vec<String>,
+    /// The notes that say a file cannot be shown (also in `notes`): what
+    /// the report's caller must pass on, not only print on the page.
+    pub problems: Vec<String>,
 }
 
 /// Most pixels an edge image may have: 2^26, e.g. 8192 × 8192, 256 times a

@@ -12,6 +12,7 @@
 //! ([`Session::redo`]).
 
 pub mod check;
+mod fresh;
 pub mod input;
 pub mod lock;
 pub mod manifest;
@@ -128,6 +129,20 @@ pub enum SessionError {
     PathTooLong { dir: PathBuf, len: usize },
     #[error("image number {0} is out of range: image numbers run from 1 to {MAX_IMAGE_NUMBER}")]
     BadImage(u32),
+    #[error(
+        "cannot make session {}: {source}; {}",
+        dir.display(),
+        match left {
+            None => "nothing of it is left (what it had made is removed)".to_string(),
+            Some(why) => format!("what it had made could not all be removed ({why}): remove {} by hand", dir.display()),
+        }
+    )]
+    NotMade {
+        dir: PathBuf,
+        source: Box<SessionError>,
+        /// What could not be removed, or `None` when nothing made is left.
+        left: Option<String>,
+    },
     #[error("image {image} of session {session}: {what}")]
     Missing {
         session: String,
@@ -183,13 +198,40 @@ impl Session {
     /// Makes a new session `parent/name/` for the survey `profile`
     /// describes: its lightings, its cameras, one location per camera.
     pub fn create(parent: &Path, name: &str, profile: &Profile) -> Result<Session, SessionError> {
-        let name = SessionName::new(name)?;
-        let dir = parent.join(name.as_str());
-        let manifest_path = dir.join(format!("{name}.toml"));
-        if manifest_path.exists() {
+        Self::create_with(parent, name, profile, |_| Ok(()))
+    }
+
+    /// [`Session::create`], then `setup` on the new session (recording its
+    /// cameras): when any of it fails (a full disk), what was made is
+    /// removed, and only that (see [`fresh`]), and the error says so.
+    pub fn create_with(
+        parent: &Path,
+        name: &str,
+        profile: &Profile,
+        setup: impl FnOnce(&mut Session) -> Result<(), SessionError>,
+    ) -> Result<Session, SessionError> {
+        let n = SessionName::new(name)?;
+        let dir = parent.join(n.as_str());
+        if dir.join(format!("{n}.toml")).exists() {
             return Err(SessionError::Exists { dir });
         }
-        check_path_len(&dir, &name)?;
+        check_path_len(&dir, &n)?;
+        let before = fresh::Before::look(&dir);
+        // The session (and its lock) is dropped before its folder goes.
+        let made = Self::make(dir.clone(), n, profile).and_then(|mut s| setup(&mut s).map(|()| s));
+        made.map_err(|e| SessionError::NotMade {
+            left: before
+                .undo()
+                .err()
+                .map(|(p, e)| format!("{}: {e}", p.display())),
+            dir,
+            source: Box::new(e),
+        })
+    }
+
+    /// Makes the folder, the lock, `.ses` and the manifest of a new session.
+    fn make(dir: PathBuf, name: SessionName, profile: &Profile) -> Result<Session, SessionError> {
+        let manifest_path = dir.join(format!("{name}.toml"));
         fs::create_dir_all(&dir).map_err(|source| SessionError::Io {
             path: dir.clone(),
             source,

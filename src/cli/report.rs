@@ -18,7 +18,9 @@ use crate::session::Session;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Session folder to report on.
+    /// Session folder to report on. A file of it the report cannot show (a
+    /// damaged .ldr, a missing image) is marked on the page, said on stderr,
+    /// and the exit status is 3.
     pub dir: Option<PathBuf>,
     /// Only this image number of the session.
     #[arg(long, value_name = "K")]
@@ -201,11 +203,30 @@ fn session_report(dir: &Path, a: &Args) -> anyhow::Result<ExitCode> {
         Some(old) => anyhow::anyhow!("{e} ({old})"),
         None => e.into(),
     })?;
-    for p in written {
+    for p in &written.files {
         outln!("wrote {}", p.display());
     }
-    Ok(ExitCode::SUCCESS)
+    if written.problems.is_empty() {
+        return Ok(ExitCode::SUCCESS);
+    }
+    // Written whole, but not all the session's files are in it: said, and
+    // an exit status of its own, so a script does not take it as complete.
+    for p in &written.problems {
+        errln!("vss: warning: {p}");
+    }
+    errln!(
+        "vss: warning: the report is written, but {} file(s) of session {} are not in it \
+         (marked on its pages); exit status {INCOMPLETE}",
+        written.problems.len(),
+        s.name()
+    );
+    Ok(ExitCode::from(INCOMPLETE))
 }
+
+/// The exit status of a session report written whole but marking files it
+/// could not show (a damaged `.ldr`, a missing image): not 1, an error that
+/// wrote nothing, nor 2, a mistake in the command line.
+pub const INCOMPLETE: u8 = 3;
 
 #[cfg(test)]
 mod tests {

@@ -142,21 +142,24 @@ fn session_dir(g: &Global, dir: PathBuf) -> PathBuf {
 fn new(g: &Global, name: &str, dir: Option<PathBuf>) -> anyhow::Result<ExitCode> {
     let profile = g.load_profile()?;
     let parent = dir.unwrap_or_else(|| profile.survey.dir.clone());
-    let mut s = Session::create(&parent, name, &profile)?;
     // The camera descriptions the profile names go into the session as
-    // NAMEk.cdf for every planned image of that camera.
-    let cams = s.manifest().session.cameras.max(1);
-    for k in 1..=s.manifest().session.planned_images {
-        let cam = (k - 1) % cams + 1;
-        let cdf = match profile.camera_cdf(cam) {
-            Ok(c) => c,
-            Err(e) => {
-                errln!("vss: warning: {e}; image {k} has no camera description");
-                continue;
-            }
-        };
-        s.set_image_camera(k, cam, (k - 1) / cams + 1, cdf.as_ref())?;
-    }
+    // NAMEk.cdf for every planned image of that camera; a failure in any
+    // of it leaves no session behind.
+    let s = Session::create_with(&parent, name, &profile, |s| {
+        let cams = s.manifest().session.cameras.max(1);
+        for k in 1..=s.manifest().session.planned_images {
+            let cam = (k - 1) % cams + 1;
+            let cdf = match profile.camera_cdf(cam) {
+                Ok(c) => c,
+                Err(e) => {
+                    errln!("vss: warning: {e}; image {k} has no camera description");
+                    continue;
+                }
+            };
+            s.set_image_camera(k, cam, (k - 1) / cams + 1, cdf.as_ref())?;
+        }
+        Ok(())
+    })?;
     if let Some(w) = s.name().dos_warning(s.manifest().session.planned_images) {
         errln!("vss: note: {w}");
     }

@@ -6,7 +6,9 @@
 //! the manifest the camera, parameters, counts, timings, whether the
 //! outputs are stale, and the edit log. A file that is missing or
 //! unreadable becomes a note on the page naming it, instead of failing the
-//! whole report or being left out without a word.
+//! whole report or being left out without a word; [`write()`] also returns
+//! these notes as [`Written::problems`], so `vss report` exits non-zero and
+//! the console says them, not only the page.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -62,6 +64,16 @@ pub fn on_disk(path: &Path) -> String {
     }
 }
 
+/// What [`write()`] wrote: the files, in order, and the problems marked in
+/// them (a file the report could not show, named, with where it is
+/// damaged), each once, as the page's note says it. The report is written
+/// whole either way; a problem is what the caller must say, not hide.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Written {
+    pub files: Vec<PathBuf>,
+    pub problems: Vec<String>,
+}
+
 /// Where a survey report goes.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Targets {
@@ -105,8 +117,9 @@ pub fn image_numbers(s: &Session, image: Option<u32>) -> Result<Vec<u32>, Sessio
 }
 
 /// Writes the survey report of `image` (or of every image) to `targets`
-/// and returns the files written, in order. A session without images
-/// gives a report without pages.
+/// and returns the files written, in order, with the problems marked in
+/// them (see [`Written`]). A session without images gives a report without
+/// pages.
 ///
 /// One image's pictures are in memory at a time, and no file's text is
 /// held whole: the PostScript is streamed page by page into the temporary
@@ -116,17 +129,22 @@ pub fn image_numbers(s: &Session, image: Option<u32>) -> Result<Vec<u32>, Sessio
 /// than holding all its pictures). A failure half-way (a full disk, a file
 /// that changed so the pages no longer match the count) leaves the file
 /// that was there untouched, and the error names it.
-pub fn write(
-    s: &Session,
-    image: Option<u32>,
-    targets: &Targets,
-) -> Result<Vec<PathBuf>, ReportError> {
+pub fn write(s: &Session, image: Option<u32>, targets: &Targets) -> Result<Written, ReportError> {
     let numbers = image_numbers(s, image)?;
-    let mut written = Vec::new();
+    let mut written = Written::default();
+    let mut found = |r: &ImageReport| {
+        for p in &r.problems {
+            if !written.problems.contains(p) {
+                written.problems.push(p.clone());
+            }
+        }
+    };
     if let Some(p) = &targets.ps {
         let mut pages = 0;
         for &k in &numbers {
-            pages += ps::image_report_pages(&image_report(s, k)?);
+            let r = image_report(s, k)?;
+            found(&r);
+            pages += ps::image_report_pages(&r);
         }
         let title = title(s, image);
         stream(p, |w, failed| {
@@ -141,7 +159,7 @@ pub fn write(
             }
             doc.finish().map(drop)
         })?;
-        written.push(p.clone());
+        written.files.push(p.clone());
     }
     if let Some(p) = &targets.svg {
         for &k in &numbers {
@@ -151,8 +169,9 @@ pub fn write(
                 numbered(p, k)
             };
             let r = image_report(s, k)?;
+            found(&r);
             stream(&path, |w, _| svg::write_image_svg(w, &r).map(drop))?;
-            written.push(path);
+            written.files.push(path);
         }
     }
     Ok(written)
@@ -202,6 +221,9 @@ pub fn image_report(s: &Session, k: u32) -> Result<ImageReport, SessionError> {
         title: format!("{}{k}", s.name()),
         ..Default::default()
     };
+    // What the report cannot show, said on the page in the order found,
+    // right after this first line, and returned (see [`Written`]).
+    let mut problems = Vec::new();
     let mut notes = vec![format!(
         "image {k}: camera {}, location {}{}",
         rec.camera,
@@ -223,7 +245,7 @@ pub fn image_report(s: &Session, k: u32) -> Result<ImageReport, SessionError> {
                     .map_or(String::new(), |l| format!(" (lights: {})", l.on.join(", ")));
                 r.greys.push((format!("{}{light}", g.file), f.image));
             }
-            Err(e) => notes.push(format!("cannot show {}: {e}", g.file)),
+            Err(e) => problems.push(format!("cannot show {}: {e}", g.file)),
         }
     }
     // Sizes that come from the manifest or an edge header, not from pixels
@@ -234,7 +256,7 @@ pub fn image_report(s: &Session, k: u32) -> Result<ImageReport, SessionError> {
         let (w, h) = (g.width as usize, g.height as usize);
         match check_picture_size(w, h) {
             Ok(()) => (r.width, r.height) = (w, h),
-            Err(e) => notes.push(format!(
+            Err(e) => problems.push(format!(
                 "cannot use the size of {} recorded in the manifest: {e}",
                 g.file
             )),
@@ -247,10 +269,10 @@ pub fn image_report(s: &Session, k: u32) -> Result<ImageReport, SessionError> {
             .as_ref()
             .is_some_and(|o| o.files.iter().any(|f| f.file == file))
     };
-    let present = |file: &str, notes: &mut Vec<String>| {
+    let present = |file: &str, problems: &mut Vec<String>| {
         let there = s.path(file).exists();
         if !there && recorded(file) {
-            notes.push(format!(
+            problems.push(format!(
                 "cannot show {file}: the manifest records it, but it is missing"
             ));
         }
@@ -258,16 +280,16 @@ pub fn image_report(s: &Session, k: u32) -> Result<ImageReport, SessionError> {
     };
     for (ext, slot) in [("hpo", &mut r.edges_h), ("vpo", &mut r.edges_v)] {
         let file = s.file_name(k, None, ext);
-        if !present(&file, &mut notes) {
+        if !present(&file, &mut problems) {
             continue;
         }
         match formats::edgefile::read_edges(&s.path(&file)) {
             Ok(e) if e.width > 0 && e.height > 0 => match check_picture_size(e.width, e.height) {
                 Ok(()) => *slot = Some(e),
-                Err(err) => notes.push(format!("cannot show {file}: {err}")),
+                Err(err) => problems.push(format!("cannot show {file}: {err}")),
             },
             Ok(e) => *slot = Some(e),
-            Err(e) => notes.push(format!("cannot show {file}: {e}")),
+            Err(e) => problems.push(format!("cannot show {file}: {e}")),
         }
     }
     if r.width == 0
@@ -276,7 +298,7 @@ pub fn image_report(s: &Session, k: u32) -> Result<ImageReport, SessionError> {
         (r.width, r.height) = (e.width, e.height);
     }
     let lex = s.file_name(k, None, "lex");
-    if present(&lex, &mut notes) {
+    if present(&lex, &mut problems) {
         match formats::lines::read_lines(&s.path(&lex)) {
             Ok(mut l) => {
                 if let Some(a) = rec.outputs.as_ref().and_then(|o| o.lex_attributes.as_ref()) {
@@ -284,16 +306,17 @@ pub fn image_report(s: &Session, k: u32) -> Result<ImageReport, SessionError> {
                 }
                 r.lines_raw = Some(l);
             }
-            Err(e) => notes.push(format!("cannot show {lex}: {e}")),
+            Err(e) => problems.push(format!("cannot show {lex}: {e}")),
         }
     }
     let ldr = s.file_name(k, None, "ldr");
-    if present(&ldr, &mut notes) {
+    if present(&ldr, &mut problems) {
         match s.load_lines(k) {
             Ok(l) => r.lines = Some(l),
-            Err(e) => notes.push(format!("cannot show {ldr}: {e}")),
+            Err(e) => problems.push(format!("cannot show {ldr}: {e}")),
         }
     }
+    notes.extend(problems.iter().cloned());
     if let Some(o) = &rec.outputs {
         notes.push(format!(
             "outputs made {} by vss {}{}",
@@ -331,6 +354,7 @@ pub fn image_report(s: &Session, k: u32) -> Result<ImageReport, SessionError> {
         );
     }
     r.notes = notes;
+    r.problems = problems;
     Ok(r)
 }
 

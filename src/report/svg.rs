@@ -239,6 +239,7 @@ mod tests {
                 Point::new(3.0, 4.0),
             )]),
             notes: vec!["edges.floor = 2 & more".into()],
+            problems: Vec::new(),
         };
         let s = image_svg(&r);
         assert!(s.contains("<desc>edges.floor = 2 &amp; more</desc>"));

@@ -2,7 +2,10 @@
 //! the format readers; files changed since they were recorded, stale
 //! outputs, a `.ses` that disagrees, leftovers of interrupted saves and
 //! VSS-named data files the manifest does not record (a second writer's, or
-//! a save that failed before its record) are listed. Problems (missing or unreadable files) make the check fail;
+//! a save that failed before its record) are listed; so are the manifest's
+//! records that contradict themselves or the frame they describe (a size
+//! its header does not have, a lighting recorded twice for one image).
+//! Problems (missing or unreadable files, contradictions) make the check fail;
 //! the rest are warnings a person should read.
 
 use std::collections::HashSet;
@@ -63,6 +66,7 @@ pub fn check(s: &Session) -> CheckReport {
         if let OutputState::Stale(why) = output_state(rec) {
             r.stale.push((rec.number, why));
         }
+        contradictions(s, rec, &mut r);
     }
     let ses_file = format!("{}.ses", s.name());
     match formats::ses::read_ses(&s.path(&ses_file)) {
@@ -162,6 +166,39 @@ fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) {
                 r.warnings.push(format!(
                     "{}: changed since the manifest recorded it (outputs made from it may be stale)",
                     path.display()
+                ));
+            }
+        }
+    }
+}
+
+/// The records of image `rec` that contradict the frames they describe or
+/// each other, as problems naming the manifest, the file and the field: a
+/// grey image's `width`/`height` that its `.img` header does not have (the
+/// file may be the one recorded, hash and all, and the record edited), a
+/// lighting recorded twice.
+fn contradictions(s: &Session, rec: &super::manifest::ImageRecord, r: &mut CheckReport) {
+    let manifest = s.path(&format!("{}.toml", s.name()));
+    let m = manifest.display();
+    let k = rec.number;
+    for (i, g) in rec.grey.iter().enumerate() {
+        if let Some(first) = rec.grey[..i].iter().find(|o| o.letter == g.letter) {
+            r.problems.push(format!(
+                "{m}: image {k} records lighting {:?} twice ({} and {}): which frame is it?",
+                g.letter, first.file, g.file
+            ));
+        }
+        // A header that does not read is the file's own problem, said above.
+        let Ok(h) = formats::img::read_header(&s.path(&g.file)) else {
+            continue;
+        };
+        let (hw, hh) = (u32::from(h.width), u32::from(h.height));
+        for (field, recorded, header) in [("width", g.width, hw), ("height", g.height, hh)] {
+            if recorded != header {
+                r.problems.push(format!(
+                    "{m}: image {k}, {}: {field} = {recorded} recorded, but the file's header \
+                     says {header} ({hw} x {hh})",
+                    g.file
                 ));
             }
         }

@@ -343,6 +343,18 @@ impl Manifest {
                 ),
             });
         }
+        // Said as what it is, not as the first field missing ("missing
+        // field `format`"): a save cut short, a copy that failed.
+        if text.trim().is_empty() {
+            return Err(SessionError::Manifest {
+                path: path.to_path_buf(),
+                line: 0,
+                message: match text.len() {
+                    0 => "the manifest is empty (0 bytes)".to_string(),
+                    n => format!("the manifest is empty ({n} bytes, all white space)"),
+                },
+            });
+        }
         let m = records::parse(text, path)?;
         m.validate()
             .map_err(|(needle, message)| SessionError::Manifest {

@@ -255,7 +255,12 @@ pub enum StoreEvent {
     OutputsSaved(u32),
     /// A note worth a log line (a stale lock taken over).
     Note(String),
-    Reports(Vec<PathBuf>),
+    /// The survey report is written: its files, and the problems marked in
+    /// it (files it could not show), as `vss report` says them.
+    Reports {
+        paths: Vec<PathBuf>,
+        problems: Vec<String>,
+    },
     /// The session's folder cannot be written (a read-only mount, no
     /// write permission): it can be opened only to look
     /// ([`StoreCmd::OpenReadOnly`]), if the operator says so.
@@ -286,6 +291,19 @@ pub enum StoreEvent {
     },
     /// Image `k`'s outputs could not be saved: it is not accepted.
     OutputsNotSaved {
+        k: u32,
+        error: StoreError,
+    },
+    /// A hand edit (or its undo) of image `k` is written to its `.ldr`
+    /// (`file`, as said).
+    EditSaved {
+        k: u32,
+        file: String,
+    },
+    /// A hand edit (or its undo) of image `k` could not be written: the
+    /// lines on screen are not its saved outputs, as when they could not
+    /// be saved at all.
+    EditNotSaved {
         k: u32,
         error: StoreError,
     },

@@ -226,14 +226,27 @@ fn the_console_s_export_and_vss_report_write_the_same_pages() {
     std::fs::write(sdir.join("cube2.lex"), "1 2 3\nnot a line file\n").unwrap();
 
     let d = sdir.to_str().unwrap();
-    vss(
-        &["report", d, "--ps", "cli.ps", "--svg", "cli.svg"],
-        dir.path(),
-    );
+    let out = Command::new(env!("CARGO_BIN_EXE_vss"))
+        .args(["report", d, "--ps", "cli.ps", "--svg", "cli.svg"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    // Written, but the two files it cannot show are said and the status
+    // says the report is not whole.
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
     // What the console's `e` calls.
     let s = Session::inspect(&sdir).unwrap();
     let written = survey::write(&s, None, &Targets::in_session(&s)).unwrap();
+    assert_eq!(written.problems.len(), 2, "{:?}", written.problems);
+    for p in &written.problems {
+        assert!(
+            stderr.contains(&format!("vss: warning: {p}\n")),
+            "{p}\n{stderr}"
+        );
+    }
     let names: Vec<String> = written
+        .files
         .iter()
         .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
         .collect();

@@ -151,6 +151,7 @@ fn survey_report_renders_every_page() {
         notes: (0..70)
             .map(|i| format!("note {i}: (parenthesised) \\ text"))
             .collect(),
+        problems: Vec::new(),
     };
     let text = ps::survey_report("cube", &[r.clone(), r]);
     let path = dir.path().join("cube.ps");

@@ -64,6 +64,7 @@ fn image_svg_has_layers_png_and_lines_in_place() {
         lines_raw: Some(vec![seg(12.0, 50.0, 30.0, 50.0)]),
         lines: Some(lines.clone()),
         notes: vec![],
+        problems: Vec::new(),
     };
     let text = svg::image_svg(&r);
     let (tree, pix) = render(&text);

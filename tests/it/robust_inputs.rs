@@ -89,9 +89,15 @@ fn a_fifo_in_a_session_blocks_no_reader() {
     assert!(out.contains("cube1a.img") && out.contains("FIFO"), "{out}");
     let (ok, out) = vss(root, &["info", "s/cube/cube1a.img"]);
     assert!(!ok && out.contains("FIFO"), "{out}");
-    // The report ends (it notes on the page what it could not read).
+    // The report ends (it notes on the page what it could not read, and
+    // says it: exit status 3, a report that is not whole).
     let (ok, out) = vss(root, &["report", "s/cube", "--ps", "r.ps"]);
-    assert!(ok && root.join("r.ps").is_file(), "{out}");
+    assert!(
+        !ok && root.join("r.ps").is_file()
+            && out.contains("vss: warning: cannot show cube1a.img")
+            && out.contains("exit status 3"),
+        "{out}"
+    );
 }
 
 #[test]

@@ -423,3 +423,137 @@ fn choice_arguments_list_their_values() {
         assert!(text(&o).contains(values), "{args:?}: {}", text(&o));
     }
 }
+
+/// `session new` stopped by a full disk (here the file size limit, `ulimit
+/// -f` in 512-byte blocks, with SIGXFSZ ignored so the write returns EFBIG)
+/// leaves nothing: not the empty folder of a failed first manifest (1
+/// block), not the partial session of one whose manifest outgrew the limit
+/// as the cameras were recorded (2 blocks: some `.cdf` files written).
+#[test]
+fn session_new_stopped_by_a_full_disk_leaves_nothing() {
+    let cdfs = ["\"cam1.cdf\""; 8].join(", ");
+    let profile = PROFILE.replace("cameras = 2", "cameras = 8").replace(
+        "cdf = [\"cam1.cdf\", \"cam2.cdf\"]",
+        &format!("cdf = [{cdfs}]"),
+    );
+    for blocks in [1, 2, 8] {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("p.toml"), &profile).unwrap();
+        std::fs::write(d.join("cam1.cdf"), CDF).unwrap();
+        let o = crate::support::limited::vss_under(
+            d,
+            &format!("trap '' XFSZ && ulimit -f {blocks}"),
+            [
+                "session",
+                "new",
+                "cube",
+                "--dir",
+                "sess",
+                "--profile",
+                "p.toml",
+            ],
+        );
+        let t = text(&o);
+        if blocks == 8 {
+            assert!(o.status.success(), "{t}");
+            assert!(d.join("sess/cube/cube8.cdf").is_file(), "{t}");
+            continue;
+        }
+        assert!(!o.status.success(), "{blocks} block(s): {t}");
+        assert!(
+            t.contains("cannot make session sess/cube: sess/cube/cube.toml: File too large")
+                && t.contains("nothing of it is left"),
+            "{blocks} block(s): {t}"
+        );
+        assert!(
+            !d.join("sess").exists(),
+            "{blocks} block(s): left behind: {:?}",
+            std::fs::read_dir(d.join("sess/cube")).map(|r| r
+                .filter_map(|e| Some(e.ok()?.file_name()))
+                .collect::<Vec<_>>())
+        );
+    }
+}
+
+/// An empty manifest (0 bytes, or white space only) is said to be empty,
+/// naming it, by every command that reads it; it read as "missing field
+/// `format`".
+#[test]
+fn an_empty_manifest_is_said_to_be_empty() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("p.toml"), PROFILE).unwrap();
+    let new = ["session", "new", "w", "--dir", ".", "--profile", "p.toml"];
+    assert!(vss(&new, d).status.success());
+    let m = d.join("w/w.toml");
+    for (content, says) in [
+        ("", "w.toml: the manifest is empty (0 bytes)"),
+        (
+            " \n\n",
+            "w.toml: the manifest is empty (3 bytes, all white space)",
+        ),
+    ] {
+        std::fs::write(&m, content).unwrap();
+        for args in [
+            &["session", "show", "w"][..],
+            &["session", "check", "w"][..],
+            &["report", "w"][..],
+        ] {
+            let o = vss(args, d);
+            let t = text(&o);
+            assert!(!o.status.success(), "{args:?}: {t}");
+            assert!(
+                t.contains(says) && !t.contains("missing field"),
+                "{args:?}: {t}"
+            );
+            assert_eq!(std::fs::read_to_string(&m).unwrap(), content, "kept");
+        }
+    }
+}
+
+/// A manifest whose records contradict the frame they describe (a grey
+/// image's width that its header does not have) or each other (one
+/// lighting recorded twice for an image) fails the check, naming the
+/// manifest, the file and the field; it passed.
+#[test]
+fn check_names_records_that_contradict_their_frames() {
+    use vss::formats::img::ImgFile;
+    use vss::llv::GreyImage;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("p.toml"), PROFILE).unwrap();
+    let new = ["session", "new", "w", "--dir", ".", "--profile", "p.toml"];
+    assert!(vss(&new, d).status.success());
+    {
+        let mut s = vss::session::Session::open(&d.join("w")).unwrap();
+        for l in ['a', 'b'] {
+            let img = ImgFile::new(GreyImage::filled(64, 48, 90).unwrap());
+            s.save_image(1, l, &img).unwrap();
+        }
+    }
+    let m = d.join("w/w.toml");
+    let good = std::fs::read_to_string(&m).unwrap();
+    let check = ["session", "check", "w"];
+    assert!(vss(&check, d).status.success(), "{}", text(&vss(&check, d)));
+    for (bad, says) in [
+        (
+            good.replacen("width = 64", "width = 65", 1),
+            "w.toml: image 1, w1a.img: width = 65 recorded, but the file's header says 64 (64 x 48)",
+        ),
+        (
+            good.replacen(
+                "letter = \"b\"\nfile = \"w1b.img\"",
+                "letter = \"a\"\nfile = \"w1b.img\"",
+                1,
+            ),
+            "w.toml: image 1 records lighting 'a' twice (w1a.img and w1b.img)",
+        ),
+    ] {
+        assert_ne!(bad, good, "the record to change is in:\n{good}");
+        std::fs::write(&m, &bad).unwrap();
+        let o = vss(&check, d);
+        assert!(!o.status.success(), "{}", text(&o));
+        assert!(text(&o).contains(says), "{says}\n{}", text(&o));
+    }
+}

@@ -189,3 +189,33 @@ fn an_extension_far_outside_the_image_asks_first() {
     c.send("q");
     c.wait_exit(15);
 }
+
+/// An edit whose `.ldr` cannot be written (here a folder stands in its
+/// place) counts as outputs not saved: q asks before it quits, as it does
+/// for outputs not saved.
+#[test]
+fn an_edit_not_written_makes_q_ask() {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("cube");
+    c.capture_current(1);
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Edit)),
+    );
+    c.wait_text("highlighted (n p", 10);
+    let ldr = c.session().join("cube1.ldr");
+    let _ = std::fs::remove_file(&ldr);
+    std::fs::create_dir_all(ldr.join("in the way")).unwrap();
+    select(&mut c, 0);
+    edit(&mut c, EditAction::Delete);
+    if flat(&c.screen()).contains("anyway?") || flat(&c.screen()).contains("accepted.") {
+        c.yes();
+    }
+    wait_words(&c, "edit of image 1 NOT saved", 10);
+    c.send("q");
+    let s = wait_words(&c, "Quit anyway?", 10);
+    assert!(flat(&s).contains("not saved"), "{s}");
+    assert_eq!(c.exit_code(), None, "q quit without asking:\n{s}");
+    c.yes();
+    c.wait_exit(15);
+}

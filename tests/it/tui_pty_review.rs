@@ -200,3 +200,36 @@ fn a_click_chooses_a_checklist_row() {
     c.send("q");
     c.wait_exit(10);
 }
+
+/// After Ctrl-S on the Pipeline screen the image is saved (accepted): the
+/// next-step box says so and that a goes on, not "a accepts"; a then goes
+/// on without saving again.
+#[test]
+fn the_next_step_after_ctrl_s_says_the_image_is_saved() {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("cube");
+    c.capture_current(1);
+    let s = c.wait_text("a accepts", 10);
+    assert!(!flat(&s).contains("saved a goes on"), "{s}");
+    c.press(
+        Scope::Global,
+        Action::Global(vss::tui::keymap::GlobalAction::GoTo(
+            vss::tui::keymap::ScreenId::Pipeline,
+        )),
+    );
+    c.press(PIPELINE, Action::Pipeline(PipelineAction::Save));
+    c.wait_text("image 1 accepted: outputs saved", 20);
+    c.press(
+        Scope::Global,
+        Action::Global(vss::tui::keymap::GlobalAction::GoTo(
+            vss::tui::keymap::ScreenId::Survey,
+        )),
+    );
+    let s = c.wait_words("a goes on: it is accepted", 10);
+    assert!(!flat(&s).contains("a accepts"), "{s}");
+    assert!(flat(&s).contains("before CONNECT), saved"), "{s}");
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    c.wait_text("Image 2: camera", 10);
+    c.send("q");
+    c.wait_exit(15);
+}

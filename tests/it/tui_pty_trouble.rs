@@ -264,6 +264,9 @@ fn outputs_that_cannot_be_saved_keep_the_image_under_review() {
     saved_within_20_s("image 1's outputs", || {
         vss::formats::lines::read_lines(&d.join("cube1.ldr")).is_ok()
     });
+    // Until the save is said done, q rightly asks (the outputs are not
+    // saved yet): the .ldr is on disk before the manifest records it.
+    c.wait_text("image 1 accepted", 20);
     c.send("q");
     c.wait_exit(10);
 }

@@ -101,6 +101,15 @@ fn survey_key(app: &mut App, a: SurveyAction) -> Vec<Cmd> {
 /// A session `cube` with image 1 captured, run and accepted by the
 /// console's own App, engine and store; returns the session folder.
 fn console_survey(dir: &Path) -> std::path::PathBuf {
+    console_survey_then(dir, |_| ()).0
+}
+
+/// [`console_survey`], with `before_export` done to the session folder
+/// just before the console's export; also returns the report's message.
+fn console_survey_then(
+    dir: &Path,
+    before_export: impl FnOnce(&Path),
+) -> (std::path::PathBuf, String) {
     let text = five_lightings(true).replace(
         "dir = \"sessions\"",
         &format!("dir = {:?}", dir.join("sessions")),
@@ -145,6 +154,7 @@ fn console_survey(dir: &Path) -> std::path::PathBuf {
     assert!(!outputs.corrected.is_empty(), "lens correction ran");
     assert!(!outputs.lines.is_empty());
     let d = dir.join("sessions/cube");
+    before_export(&d);
     // The console's export, before the store lets the session go.
     drive(
         &mut app,
@@ -153,16 +163,15 @@ fn console_survey(dir: &Path) -> std::path::PathBuf {
         &mut engine,
         vec![Cmd::Store(StoreCmd::Export)],
     );
-    assert!(
-        app.chrome
-            .log
-            .entries()
-            .any(|e| e.text.contains("report written")),
-        "{:?}",
-        app.chrome.log.last()
-    );
+    let said = app
+        .chrome
+        .log
+        .entries()
+        .find(|e| e.text.contains("report written"))
+        .map(|e| e.text.clone());
+    let said = said.unwrap_or_else(|| panic!("{:?}", app.chrome.log.last()));
     drop(store);
-    d
+    (d, said)
 }
 
 #[test]
@@ -216,4 +225,38 @@ fn the_console_export_and_vss_report_write_the_same_pages() {
         assert!(a == b, "{console} differs from vss report's {cli}");
         assert!(a.len() > 1000, "{console} has pages");
     }
+}
+
+/// A `.ldr` damaged under the console: its export and `vss report` both
+/// write the report and say the file and where it is damaged, from the
+/// same writer; the command's exit status says the report is not whole.
+#[test]
+fn a_damaged_ldr_is_said_by_the_console_s_export_and_by_vss_report() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (d, said) = console_survey_then(tmp.path(), |d| {
+        std::fs::write(d.join("cube1.ldr"), "1 2 3\nnot a line file\n").unwrap();
+    });
+    assert!(d.join("cube.ps").is_file(), "the console wrote the report");
+    let out = Command::cargo_bin("vss")
+        .unwrap()
+        .current_dir(tmp.path())
+        .args(["--profile", "cell.toml", "report"])
+        .arg(&d)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(tmp.path().join("cube.ps").is_file(), "vss report wrote it");
+    let problem = stderr
+        .lines()
+        .find_map(|l| l.strip_prefix("vss: warning: cannot show cube1.ldr: "))
+        .unwrap_or_else(|| panic!("no warning naming cube1.ldr:\n{stderr}"));
+    assert!(
+        problem.contains("cube1.ldr:2: "),
+        "where it is damaged: {problem}"
+    );
+    assert!(
+        said.contains("1 problem(s) marked in it") && said.contains(problem),
+        "the console's message: {said}\nvss report: {problem}"
+    );
 }

@@ -268,8 +268,36 @@ impl App {
             StoreEvent::OutputsSaved(k) => {
                 self.session.saving.retain(|&s| s != k);
                 self.session.refused.retain(|r| r.0 != k);
+                self.session.edit_refused.retain(|&e| e != k);
                 self.ctx().info(format!(
                     "image {k} accepted: outputs saved (.hpo .vpo .lex .ldr)"
+                ));
+                Vec::new()
+            }
+            StoreEvent::EditSaved { k, file } => {
+                // The whole line set is written: an edit that failed before
+                // is in it now.
+                if self.session.edit_refused.contains(&k) {
+                    self.session.edit_refused.retain(|&e| e != k);
+                    self.session.refused.retain(|r| r.0 != k);
+                }
+                self.ctx().info(format!("saved {}", clean(&file)));
+                Vec::new()
+            }
+            StoreEvent::EditNotSaved { k, error } => {
+                // Counted as outputs not saved: q asks, the next-step box
+                // says it, a saves the outputs with the edits.
+                let why = match &error {
+                    StoreError::Session { source, .. } => clean(&source.to_string()),
+                    e => clean(&e.to_string()),
+                };
+                self.session.refused.retain(|r| r.0 != k);
+                self.session.refused.push((k, why));
+                self.session.edit_refused.retain(|&e| e != k);
+                self.session.edit_refused.push(k);
+                self.ctx().error(format!(
+                    "{} — the lines on screen are not saved; the next edit, or a, writes them",
+                    clean(&error.to_string())
                 ));
                 Vec::new()
             }
@@ -277,10 +305,12 @@ impl App {
                 self.ctx().info(clean(&what));
                 Vec::new()
             }
-            StoreEvent::Reports(paths) => {
+            StoreEvent::Reports { paths, problems } => {
                 // One message: the survey's page and how many image pages,
                 // and the problems the report shows (said here, not only
-                // inside the pages).
+                // inside the pages): those the report marks, as `vss
+                // report` says them, else the damage the session's check
+                // found.
                 let ps = paths
                     .iter()
                     .find(|p| p.extension().is_some_and(|e| e == "ps"))
@@ -291,12 +321,15 @@ impl App {
                     .iter()
                     .filter(|p| p.extension().is_some_and(|e| e == "svg"))
                     .count();
-                let problems = self
-                    .session
-                    .view
-                    .as_ref()
-                    .map(|v| v.problem_list())
-                    .unwrap_or_default();
+                let problems = if problems.is_empty() {
+                    self.session
+                        .view
+                        .as_ref()
+                        .map(|v| v.problem_list())
+                        .unwrap_or_default()
+                } else {
+                    problems.iter().map(|p| clean(p)).collect()
+                };
                 let text = format!("report written: {ps} and {svg} SVG page(s)");
                 if problems.is_empty() {
                     self.ctx().info(text);
@@ -374,6 +407,7 @@ impl App {
             }
             StoreEvent::OutputsNotSaved { k, error } => {
                 self.session.saving.retain(|&s| s != k);
+                self.session.edit_refused.retain(|&e| e != k);
                 let why = match &error {
                     StoreError::Session { source, .. } => clean(&source.to_string()),
                     e => clean(&e.to_string()),
@@ -405,6 +439,7 @@ impl App {
         self.session.view = None;
         self.session.saving.clear();
         self.session.refused.clear();
+        self.session.edit_refused.clear();
         self.session.work.phase = Phase::NoSession;
         self.tracker.current = None;
         self.screens.survey.picking = false;

@@ -22,6 +22,9 @@ pub struct SessionState {
     ///
     /// [`App::due`]: super::App::due
     pub listed: Option<std::time::Instant>,
+    /// The images of `refused` whose refusal is a hand edit not written:
+    /// the next edit written puts it right, as a saves do.
+    pub edit_refused: Vec<u32>,
 }
 
 impl SessionState {

@@ -442,6 +442,7 @@ impl Ctx<'_> {
     pub fn session_opened(&mut self, v: SessionView) -> Vec<Cmd> {
         self.session.saving.clear();
         self.session.refused.clear();
+        self.session.edit_refused.clear();
         self.info(format!("session {} open in {}", v.name, v.dir.display()));
         let last = v
             .images
@@ -623,9 +624,7 @@ impl Ctx<'_> {
         }
         // Outputs the session already holds (hand edits are written as they
         // are made): nothing to save, nothing to ask.
-        let unchanged = cur.is_some_and(|c| {
-            c.in_session && c.outputs_params.as_ref() == Some(&self.tracker.params)
-        });
+        let unchanged = cur.is_some_and(|c| c.saved_with(&self.tracker.params));
         let mut cmds = Vec::new();
         if unchanged {
             self.info(format!("image {k} accepted"));

@@ -81,6 +81,14 @@ impl Loaded {
         self.frames.iter().find(|f| f.0 == letter).map(|f| &f.1)
     }
 
+    /// The outputs on screen are the session's and were made with `params`
+    /// (the panel's): saved (a save asked, such as Ctrl-S on the Pipeline
+    /// screen, counts until it fails), so accepting saves nothing. What `a`
+    /// does and what the next-step box says both follow it.
+    pub fn saved_with(&self, params: &crate::llv::Params) -> bool {
+        self.in_session && self.outputs_params.as_ref() == Some(params)
+    }
+
     /// The lines as they stand (edited, or the run's).
     pub fn lines(&self) -> Option<&[Segment]> {
         match (&self.editor, &self.outputs) {

@@ -294,19 +294,25 @@ impl Store {
             }
             StoreCmd::RecordEdit { k, what, lines } => {
                 let s = self.session_mut()?;
-                s.record_edit(k, &what, &lines)
-                    .map_err(session_err(format!("edit of image {k} NOT saved")))?;
+                if let Err(e) = s.record_edit(k, &what, &lines) {
+                    let error = session_err(format!("edit of image {k} NOT saved"))(e);
+                    self.reply(StoreEvent::EditNotSaved { k, error });
+                    return Ok(());
+                }
                 let file = s.file_name(k, None, "ldr");
                 self.forget_problems(std::slice::from_ref(&file));
-                self.reply(StoreEvent::Saved(file));
+                self.reply(StoreEvent::EditSaved { k, file });
                 self.updated();
             }
             StoreCmd::UndoEdit { k, lines } => {
                 let s = self.session_mut()?;
-                s.undo_edit(k, &lines)
-                    .map_err(session_err(format!("undo of image {k} NOT saved")))?;
-                let file = s.file_name(k, None, "ldr");
-                self.reply(StoreEvent::Saved(format!("{file} (edit taken back)")));
+                if let Err(e) = s.undo_edit(k, &lines) {
+                    let error = session_err(format!("undo of image {k} NOT saved"))(e);
+                    self.reply(StoreEvent::EditNotSaved { k, error });
+                    return Ok(());
+                }
+                let file = format!("{} (edit taken back)", s.file_name(k, None, "ldr"));
+                self.reply(StoreEvent::EditSaved { k, file });
                 self.updated();
             }
             StoreCmd::Load(k) => {
@@ -347,8 +353,11 @@ impl Store {
                 )));
             }
             StoreCmd::Export => {
-                let paths = self.export()?;
-                self.reply(StoreEvent::Reports(paths));
+                let written = self.export()?;
+                self.reply(StoreEvent::Reports {
+                    paths: written.files,
+                    problems: written.problems,
+                });
                 self.updated();
             }
             StoreCmd::Refresh => {
@@ -515,7 +524,7 @@ impl Store {
     /// Writes the survey report `NAME.ps` and one `NAMEk.svg` per image in
     /// the session folder, through the one report writer (`vss report`
     /// writes the same pages). A failure says which file on disk is old.
-    fn export(&mut self) -> Result<Vec<PathBuf>, StoreError> {
+    fn export(&mut self) -> Result<report::survey::Written, StoreError> {
         let s = &*self.session_mut()?;
         let targets = report::survey::Targets::in_session(s);
         let ps = targets.ps.clone().unwrap_or_default();
