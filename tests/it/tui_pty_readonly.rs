@@ -12,7 +12,7 @@ use std::time::SystemTime;
 
 use vss::tui::keymap::{Action, FilesAction, ModalAction, Scope, ScreenId, SurveyAction};
 
-use super::tui_harness::{Console, SURVEY};
+use super::tui_harness::{Console, SURVEY, flat};
 
 /// The folder made read-only until dropped: bind-mounted read-only over
 /// itself (root), or its write permission taken away (anyone else).
@@ -115,6 +115,9 @@ fn a_session_that_cannot_be_written_opens_only_to_look() {
     let s = c.wait_text("read-only: nothing will be saved", 10);
     assert!(s.lines().next().unwrap().contains("read-only"), "{s}");
     assert!(s.contains("done"), "image 1 is listed done:\n{s}");
+    // The next step offers nothing that would write.
+    let s = c.wait_words("Open only to look", 10);
+    assert!(!flat(&s).contains("captures lightings"), "{s}");
     // Enter on the image under work would capture: refused.
     c.press(SURVEY, Action::Survey(SurveyAction::Enter));
     c.wait_words("capturing refused", 10);
