@@ -369,38 +369,29 @@ fn step_lines(app: &App) -> Vec<Line<'static>> {
                     .map_or((0, 0), |o| (o.lines.len(), o.lines_raw.len()));
                 let n = cur.and_then(|c| c.lines()).map_or(n, <[_]>::len);
                 let unsaved = cur.map_or(String::new(), |c| c.unsaved_letters());
-                if unsaved.is_empty() && cur.is_some_and(|c| c.saved_with(&app.tracker.params)) {
+                if unsaved.is_empty() {
                     // Saved already (Ctrl-S on the Pipeline screen): a only
                     // goes on, as it says when pressed.
+                    let saved = cur.is_some_and(|c| c.saved_with(&app.tracker.params));
+                    let (head, mut a) = if saved {
+                        (
+                            ", saved",
+                            vec![key("a"), Span::raw(" goes on: it is accepted · ")],
+                        )
+                    } else {
+                        let asks = Span::raw(" asks) · ");
+                        (
+                            "",
+                            vec![key("a"), Span::raw(" accepts ("), key("Enter"), asks],
+                        )
+                    };
+                    a.extend([key("R"), Span::raw(" again")]);
                     vec![
                         Line::raw(format!(
-                            "Image {}: {n} lines ({raw} before CONNECT), saved",
+                            "Image {}: {n} lines ({raw} before CONNECT){head}",
                             w.k
                         )),
-                        Line::from(vec![
-                            key("a"),
-                            Span::raw(" goes on: it is accepted · "),
-                            key("R"),
-                            Span::raw(" again"),
-                        ]),
-                        Line::from(vec![
-                            key("3"),
-                            Span::raw(" tune · "),
-                            key("4"),
-                            Span::raw(" edit"),
-                        ]),
-                    ]
-                } else if unsaved.is_empty() {
-                    vec![
-                        Line::raw(format!("Image {}: {n} lines ({raw} before CONNECT)", w.k)),
-                        Line::from(vec![
-                            key("a"),
-                            Span::raw(" accepts ("),
-                            key("Enter"),
-                            Span::raw(" asks) · "),
-                            key("R"),
-                            Span::raw(" again"),
-                        ]),
+                        Line::from(a),
                         Line::from(vec![
                             key("3"),
                             Span::raw(" tune · "),
