@@ -203,7 +203,7 @@ impl Session {
 
     /// [`Session::create`], then `setup` on the new session (recording its
     /// cameras): when any of it fails (a full disk), what was made is
-    /// removed, and only that (see [`fresh`]), and the error says so.
+    /// removed, and only that (see `session::fresh`), and the error says so.
     pub fn create_with(
         parent: &Path,
         name: &str,
