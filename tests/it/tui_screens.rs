@@ -588,3 +588,30 @@ fn an_error_after_the_answer_to_a_key_takes_the_message_line() {
     let words = message.split_whitespace().collect::<Vec<_>>().join(" ");
     assert!(words.contains("(+1 newer in the log)"), "{s}");
 }
+
+/// A session open only to look says so on the top bar, in a word where
+/// the words do not fit, and the profile's name stays whole at 80 columns
+/// (a simulated and a real cell cannot be confused).
+#[test]
+fn the_top_bar_keeps_the_profile_name_beside_a_read_only_session() {
+    let mut app = App::new(&profile(), colour());
+    app.start();
+    app.update(Msg::Store(StoreEvent::Opened(SessionView {
+        name: "hull_port_aft".into(),
+        read_only: true,
+        ..view()
+    })));
+    let (s, _) = draw(&app, 80, 24);
+    let top = s.lines().next().unwrap();
+    assert!(top.contains("hull_port_aft"), "{top}");
+    assert!(top.contains("read-only"), "{top}");
+    assert!(top.trim_end().ends_with("screen test cell"), "{top}");
+    let (s, _) = draw(&app, 120, 24);
+    assert!(
+        s.lines()
+            .next()
+            .unwrap()
+            .contains("read-only: nothing will be saved"),
+        "{s}"
+    );
+}

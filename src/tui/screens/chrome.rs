@@ -53,15 +53,19 @@ pub fn top_bar(app: &App, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
     let bar = if app.ascii() { '|' } else { '│' };
     let right = format!(" {bar} {} ", app.cell.profile_name);
-    let session = app
-        .session
-        .view
-        .as_ref()
-        .map(|s| match s.read_only {
-            true => format!(" {bar} {} {bar} {}", s.name, crate::tui::app::READ_ONLY),
-            false => format!(" {bar} {}", s.name),
-        })
-        .unwrap_or_default();
+    // A session open only to look says so in full where there is room,
+    // else in a word: the profile's name on the right is never cut for it.
+    let session_text = |short: bool| {
+        app.session
+            .view
+            .as_ref()
+            .map(|s| match (s.read_only, short) {
+                (true, false) => format!(" {bar} {} {bar} {}", s.name, crate::tui::app::READ_ONLY),
+                (true, true) => format!(" {bar} {} {bar} read-only", s.name),
+                (false, _) => format!(" {bar} {}", s.name),
+            })
+            .unwrap_or_default()
+    };
     let tabs = |short: bool| -> Vec<Span<'static>> {
         let mut spans = vec![Span::styled("vss", t.title())];
         for (i, s) in ScreenId::ALL.iter().enumerate() {
@@ -78,9 +82,15 @@ pub fn top_bar(app: &App, area: Rect, buf: &mut Buffer) {
     };
     let width = |spans: &[Span]| spans.iter().map(|s| s.width()).sum::<usize>();
     let mut spans = tabs(false);
-    let need = width(&spans) + session.chars().count() + right.chars().count();
-    if need > area.width as usize {
+    let mut session = session_text(false);
+    let fits = |spans: &[Span], session: &str| {
+        width(spans) + session.chars().count() + right.chars().count() <= area.width as usize
+    };
+    if !fits(&spans, &session) {
         spans = tabs(true);
+    }
+    if !fits(&spans, &session) {
+        session = session_text(true);
     }
     spans.push(Span::styled(session, t.title()));
     let used = width(&spans);
