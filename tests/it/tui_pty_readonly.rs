@@ -99,7 +99,10 @@ fn a_session_that_cannot_be_written_opens_only_to_look() {
         "the folder is read-only"
     );
     let before = files(&dir);
-    c.wait_text("choose a session", 10);
+    // The list read (its row says how far the survey is), then Enter.
+    c.wait("the session listed", 10, |s| {
+        s.contains("choose a session") && s.contains("done")
+    });
     // Asked, not downgraded silently: no keeps the list.
     c.send("\r");
     c.wait_words("Open it read-only", 10);

@@ -84,7 +84,9 @@ pub fn top_bar(app: &App, area: Rect, buf: &mut Buffer) {
     let mut spans = tabs(false);
     let mut session = session_text(false);
     let fits = |spans: &[Span], session: &str| {
-        width(spans) + session.chars().count() + right.chars().count() <= area.width as usize
+        // (The right part's last space may go.)
+        width(spans) + session.chars().count() + right.trim_end().chars().count()
+            <= area.width as usize
     };
     if !fits(&spans, &session) {
         spans = tabs(true);
