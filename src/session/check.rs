@@ -59,14 +59,18 @@ pub fn check(s: &Session) -> CheckReport {
             let ldr = s.file_name(rec.number, None, "ldr");
             expected.push((ldr, e.hash.as_str()));
         }
+        // The pixel size of each grey image read whole, for `contradictions`.
+        let mut sizes: Vec<(String, (usize, usize))> = Vec::new();
         for (file, hash) in expected {
             recorded.insert(file.clone());
-            check_file(&s.path(&file), &file, hash, &mut r);
+            if let Some(size) = check_file(&s.path(&file), &file, hash, &mut r) {
+                sizes.push((file, size));
+            }
         }
         if let OutputState::Stale(why) = output_state(rec) {
             r.stale.push((rec.number, why));
         }
-        contradictions(s, rec, &mut r);
+        contradictions(s, rec, &sizes, &mut r);
     }
     let ses_file = format!("{}.ses", s.name());
     match formats::ses::read_ses(&s.path(&ses_file)) {
@@ -127,39 +131,44 @@ fn unrecorded(s: &Session, recorded: &HashSet<String>) -> Vec<String> {
     v
 }
 
-fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) {
+/// Reads and parses one recorded file, with its problems and warnings in
+/// `r`; gives the pixel size of an image (`.img`, `.imc`) that parsed.
+fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) -> Option<(usize, usize)> {
     let bytes = match crate::fsutil::read_input(path, formats::max_len(path)) {
         Ok(b) => b,
         Err(e) => {
             r.problems.push(format!("{}: {e}", path.display()));
-            return;
+            return None;
         }
     };
     let ext = file.rsplit_once('.').map_or("", |(_, e)| e);
     let parsed = match ext {
-        "img" | "imc" => formats::img::parse_img(&bytes, path).map(|_| ()),
-        "hpo" | "vpo" => formats::edgefile::parse_edges(&bytes, path).map(|_| ()),
+        "img" | "imc" => formats::img::parse_img(&bytes, path).map(|f| Some(f.image.size())),
+        "hpo" | "vpo" => formats::edgefile::parse_edges(&bytes, path).map(|_| None),
         "lex" | "ldr" => match std::str::from_utf8(&bytes) {
-            Ok(t) => formats::lines::parse_lines(t, path).map(|_| ()),
+            Ok(t) => formats::lines::parse_lines(t, path).map(|_| None),
             Err(e) => {
                 r.problems
                     .push(format!("{}: not text: {e}", path.display()));
-                return;
+                return None;
             }
         },
         "cdf" => match std::str::from_utf8(&bytes) {
-            Ok(t) => formats::cdf::parse_cdf(t, path).map(|_| ()),
+            Ok(t) => formats::cdf::parse_cdf(t, path).map(|_| None),
             Err(e) => {
                 r.problems
                     .push(format!("{}: not text: {e}", path.display()));
-                return;
+                return None;
             }
         },
-        _ => Ok(()),
+        _ => Ok(None),
     };
     match parsed {
-        Err(e) => r.problems.push(e.to_string()),
-        Ok(()) => {
+        Err(e) => {
+            r.problems.push(e.to_string());
+            None
+        }
+        Ok(size) => {
             r.checked += 1;
             if stamp::hash(&bytes) != hash {
                 r.changed.push(file.to_string());
@@ -168,6 +177,7 @@ fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) {
                     path.display()
                 ));
             }
+            size
         }
     }
 }
@@ -176,8 +186,14 @@ fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) {
 /// each other, as problems naming the manifest, the file and the field: a
 /// grey image's `width`/`height` that its `.img` header does not have (the
 /// file may be the one recorded, hash and all, and the record edited), a
-/// lighting recorded twice.
-fn contradictions(s: &Session, rec: &super::manifest::ImageRecord, r: &mut CheckReport) {
+/// lighting recorded twice. `sizes` are the grey images' pixel sizes as
+/// [`check_file`] read them (one that did not read is its own problem).
+fn contradictions(
+    s: &Session,
+    rec: &super::manifest::ImageRecord,
+    sizes: &[(String, (usize, usize))],
+    r: &mut CheckReport,
+) {
     let manifest = s.path(&format!("{}.toml", s.name()));
     let m = manifest.display();
     let k = rec.number;
@@ -188,11 +204,10 @@ fn contradictions(s: &Session, rec: &super::manifest::ImageRecord, r: &mut Check
                 g.letter, first.file, g.file
             ));
         }
-        // A header that does not read is the file's own problem, said above.
-        let Ok(h) = formats::img::read_header(&s.path(&g.file)) else {
+        let Some(&(_, (w, h))) = sizes.iter().find(|(f, _)| *f == g.file) else {
             continue;
         };
-        let (hw, hh) = (u32::from(h.width), u32::from(h.height));
+        let (hw, hh) = (w as u32, h as u32);
         for (field, recorded, header) in [("width", g.width, hw), ("height", g.height, hh)] {
             if recorded != header {
                 r.problems.push(format!(
