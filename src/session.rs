@@ -72,6 +72,13 @@ pub enum SessionError {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// The session's lock cannot be written because its folder cannot be
+    /// (a read-only mount, no write permission): it can be looked at only.
+    #[error("{}: {source}", path.display())]
+    Unwritable {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     // Transparent, not "{0}": with "{0}" the wrapped error was also the
     // source, and `vss` printed its message twice.
     #[error(transparent)]

@@ -242,7 +242,16 @@ impl Lock {
         // folder is never written through. (No sweep of stale temporary
         // files here: the session's first write does it, and a lock is
         // taken again quickly when a console closes and reopens.)
-        let (mut file, tmp) = crate::fsutil::create_temp(dir, name).map_err(io_err)?;
+        let (mut file, tmp) =
+            crate::fsutil::create_temp(dir, name).map_err(|source| match source.kind() {
+                io::ErrorKind::PermissionDenied | io::ErrorKind::ReadOnlyFilesystem => {
+                    SessionError::Unwritable {
+                        path: path.to_path_buf(),
+                        source,
+                    }
+                }
+                _ => io_err(source),
+            })?;
         // No fsync: a lock torn by a crash reads as an unknown holder, which
         // can be taken over.
         if let Err(e) = file.write_all(text.as_bytes()) {

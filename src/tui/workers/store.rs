@@ -234,14 +234,7 @@ impl Store {
                     }
                     // The lock cannot be written: the folder is read-only
                     // (a mount, permissions). Looking is offered, not done.
-                    Err(SessionError::Io { path, source })
-                        if path.extension().is_some_and(|e| e == "lock")
-                            && matches!(
-                                source.kind(),
-                                std::io::ErrorKind::PermissionDenied
-                                    | std::io::ErrorKind::ReadOnlyFilesystem
-                            ) =>
-                    {
+                    Err(SessionError::Unwritable { path, source }) => {
                         let why = format!("{}: {source}", path.display());
                         self.reply(StoreEvent::Unwritable { dir, why });
                         return Ok(());
@@ -443,8 +436,7 @@ impl Store {
 
     fn opened(&mut self, s: Session) {
         let check = s.check();
-        let mut v = view(&s, Some(&check), true);
-        v.read_only = self.read_only;
+        let v = view(&s, Some(&check), true, self.read_only);
         let log = s.path(&format!("{}.log", s.name()));
         self.session = Some(s);
         self.check = Some(check);
@@ -465,8 +457,7 @@ impl Store {
 
     fn updated(&self) {
         if let Some(s) = &self.session {
-            let mut v = view(s, self.check.as_ref(), false);
-            v.read_only = self.read_only;
+            let v = view(s, self.check.as_ref(), false, self.read_only);
             self.reply(StoreEvent::Updated(v));
         }
     }

@@ -13,8 +13,14 @@ pub fn names_file(problem: &str, file: &str) -> bool {
 }
 
 /// The console's picture of `s`. `check` is the last full check of its
-/// files (`checked` says whether it was made just now).
-pub fn view(s: &Session, check: Option<&CheckReport>, checked: bool) -> SessionView {
+/// files (`checked` says whether it was made just now); `read_only`: it is
+/// open only to look.
+pub fn view(
+    s: &Session,
+    check: Option<&CheckReport>,
+    checked: bool,
+    read_only: bool,
+) -> SessionView {
     let p = s.progress();
     let m = s.manifest();
     let problem = |file: &str| -> Option<String> {
@@ -108,6 +114,6 @@ pub fn view(s: &Session, check: Option<&CheckReport>, checked: bool) -> SessionV
         next,
         files,
         checked,
-        read_only: false,
+        read_only,
     }
 }
