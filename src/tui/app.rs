@@ -47,7 +47,7 @@ pub use modal::{Modal, Pending, Prompt, PromptPurpose};
 pub use nav::PreviewNav;
 pub use pipeline::{GreySource, PipelineScreen, StageView};
 pub use readonly::READ_ONLY;
-pub use session::{SessionEntry, SessionState};
+pub use session::{Refused, SessionEntry, SessionState};
 pub use survey::{Phase, SurveyScreen, Work};
 pub use tracker::{Loaded, Tracker};
 
@@ -387,7 +387,7 @@ impl App {
                         ),
                         Pending::Quit,
                     );
-                } else if let Some((k, why)) = self.session.refused.first() {
+                } else if let Some(Refused { k, why, .. }) = self.session.refused.first() {
                     let q = format!(
                         "The outputs of image {k} are not saved ({why}): quitting loses them \
                          (its frames are kept). Quit anyway?"

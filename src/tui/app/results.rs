@@ -267,8 +267,7 @@ impl App {
             }
             StoreEvent::OutputsSaved(k) => {
                 self.session.saving.retain(|&s| s != k);
-                self.session.refused.retain(|r| r.0 != k);
-                self.session.edit_refused.retain(|&e| e != k);
+                self.session.saved(k);
                 self.ctx().info(format!(
                     "image {k} accepted: outputs saved (.hpo .vpo .lex .ldr)"
                 ));
@@ -277,9 +276,8 @@ impl App {
             StoreEvent::EditSaved { k, file } => {
                 // The whole line set is written: an edit that failed before
                 // is in it now.
-                if self.session.edit_refused.contains(&k) {
-                    self.session.edit_refused.retain(|&e| e != k);
-                    self.session.refused.retain(|r| r.0 != k);
+                if self.session.refused.iter().any(|r| r.k == k && r.edit) {
+                    self.session.saved(k);
                 }
                 self.ctx().info(format!("saved {}", clean(&file)));
                 Vec::new()
@@ -287,14 +285,7 @@ impl App {
             StoreEvent::EditNotSaved { k, error } => {
                 // Counted as outputs not saved: q asks, the next-step box
                 // says it, a saves the outputs with the edits.
-                let why = match &error {
-                    StoreError::Session { source, .. } => clean(&source.to_string()),
-                    e => clean(&e.to_string()),
-                };
-                self.session.refused.retain(|r| r.0 != k);
-                self.session.refused.push((k, why));
-                self.session.edit_refused.retain(|&e| e != k);
-                self.session.edit_refused.push(k);
+                self.session.refuse(k, cause(&error), true);
                 self.ctx().error(format!(
                     "{} — the lines on screen are not saved; the next edit, or a, writes them",
                     clean(&error.to_string())
@@ -393,10 +384,7 @@ impl App {
             StoreEvent::FrameNotSaved { k, letter, error } => {
                 // The whole error for the log; the session's reason (which
                 // file, why) for the checklist and the questions.
-                let why = match &error {
-                    StoreError::Session { source, .. } => clean(&source.to_string()),
-                    e => clean(&e.to_string()),
-                };
+                let why = cause(&error);
                 let mut ctx = self.ctx();
                 ctx.error(format!(
                     "{} — image {k} is not accepted until R captures it again",
@@ -407,13 +395,7 @@ impl App {
             }
             StoreEvent::OutputsNotSaved { k, error } => {
                 self.session.saving.retain(|&s| s != k);
-                self.session.edit_refused.retain(|&e| e != k);
-                let why = match &error {
-                    StoreError::Session { source, .. } => clean(&source.to_string()),
-                    e => clean(&e.to_string()),
-                };
-                self.session.refused.retain(|r| r.0 != k);
-                self.session.refused.push((k, why));
+                self.session.refuse(k, cause(&error), false);
                 let mut ctx = self.ctx();
                 ctx.error(format!(
                     "{} — image {k} is not accepted; a tries again once that is put right",
@@ -439,7 +421,6 @@ impl App {
         self.session.view = None;
         self.session.saving.clear();
         self.session.refused.clear();
-        self.session.edit_refused.clear();
         self.session.work.phase = Phase::NoSession;
         self.tracker.current = None;
         self.screens.survey.picking = false;
@@ -451,5 +432,15 @@ impl App {
     pub fn take_log_lines(&mut self) -> Option<Cmd> {
         let lines = self.chrome.log.take_unwritten();
         (!lines.is_empty()).then_some(Cmd::Store(StoreCmd::Log(lines)))
+    }
+}
+
+/// The session's reason in a store error (which file, why), without what
+/// was being done: for the checklist, the next-step box and the questions;
+/// the whole error goes to the log.
+fn cause(error: &StoreError) -> String {
+    match error {
+        StoreError::Session { source, .. } => clean(&source.to_string()),
+        e => clean(&e.to_string()),
     }
 }

@@ -17,17 +17,35 @@ pub struct SessionState {
     /// Images whose acceptance failed (their outputs not saved), with why:
     /// said in the next-step box until they are accepted, so that no later
     /// message hides it.
-    pub refused: Vec<(u32, String)>,
+    pub refused: Vec<Refused>,
     /// When the session list was last asked for ([`App::due`]).
     ///
     /// [`App::due`]: super::App::due
     pub listed: Option<std::time::Instant>,
-    /// The images of `refused` whose refusal is a hand edit not written:
-    /// the next edit written puts it right, as a saves do.
-    pub edit_refused: Vec<u32>,
+}
+
+/// An image whose outputs are not saved, and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Refused {
+    pub k: u32,
+    pub why: String,
+    /// A hand edit (or its undo) that was not written: the next edit
+    /// written puts it right, as a save does.
+    pub edit: bool,
 }
 
 impl SessionState {
+    /// Image `k`'s outputs are not saved, for `why` (`edit`: a hand edit
+    /// not written); said once, the newest reason.
+    pub fn refuse(&mut self, k: u32, why: String, edit: bool) {
+        self.refused.retain(|r| r.k != k);
+        self.refused.push(Refused { k, why, edit });
+    }
+
+    /// Image `k`'s outputs are saved: no refusal of it stands.
+    pub fn saved(&mut self, k: u32) {
+        self.refused.retain(|r| r.k != k);
+    }
     /// The checklist row of image `k`.
     pub fn image(&self, k: u32) -> Option<&ImageState> {
         self.view.as_ref()?.images.iter().find(|i| i.k == k)

@@ -442,7 +442,6 @@ impl Ctx<'_> {
     pub fn session_opened(&mut self, v: SessionView) -> Vec<Cmd> {
         self.session.saving.clear();
         self.session.refused.clear();
-        self.session.edit_refused.clear();
         self.info(format!("session {} open in {}", v.name, v.dir.display()));
         let last = v
             .images

@@ -453,8 +453,8 @@ fn step_lines(app: &App) -> Vec<Line<'static>> {
         .refused
         .iter()
         // The image under review says it itself.
-        .filter(|r| app.session.view.is_some() && !(r.0 == w.k && w.phase == Phase::Review))
-        .map(|(k, why)| {
+        .filter(|r| app.session.view.is_some() && !(r.k == w.k && w.phase == Phase::Review))
+        .map(|crate::tui::app::Refused { k, why, .. }| {
             Line::styled(
                 format!("Image {k} NOT accepted: its outputs were not saved ({why}) — ↑↓ Enter goes to it, then a"),
                 t.error(),
