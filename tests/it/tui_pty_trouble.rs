@@ -258,17 +258,7 @@ fn outputs_that_cannot_be_saved_keep_the_image_under_review() {
         OUTSIDE,
         "nothing written through the link"
     );
-    std::fs::remove_file(d.join("cube1.ldr")).unwrap();
-    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
-    c.wait_text("Image 2: camera", 20);
-    saved_within_20_s("image 1's outputs", || {
-        vss::formats::lines::read_lines(&d.join("cube1.ldr")).is_ok()
-    });
-    // Until the save is said done, q rightly asks (the outputs are not
-    // saved yet): the .ldr is on disk before the manifest records it.
-    c.wait_text("image 1 accepted", 20);
-    c.send("q");
-    c.wait_exit(10);
+    accepted_once_the_link_is_gone(c, &d);
 }
 
 /// Outputs that could not be saved make `q` ask first, as the README
@@ -292,12 +282,20 @@ fn q_asks_first_while_outputs_are_not_saved() {
     c.send("n");
     c.wait("the question closed", 5, |s| !s.contains("Quit anyway"));
     assert_eq!(c.exit_code(), None, "still running");
+    accepted_once_the_link_is_gone(c, &d);
+}
+
+/// With the link planted at `cube1.ldr` removed, `a` accepts image 1: its
+/// outputs are written and said saved, and then `q` quits at once.
+fn accepted_once_the_link_is_gone(mut c: Console, d: &std::path::Path) {
     std::fs::remove_file(d.join("cube1.ldr")).unwrap();
     c.press(SURVEY, Action::Survey(SurveyAction::Accept));
     c.wait_text("Image 2: camera", 20);
     saved_within_20_s("image 1's outputs", || {
         vss::formats::lines::read_lines(&d.join("cube1.ldr")).is_ok()
     });
+    // Until the save is said done, q rightly asks (the outputs are not
+    // saved yet): the .ldr is on disk before the manifest records it.
     c.wait_text("image 1 accepted", 20);
     c.send("q");
     c.wait_exit(10);
