@@ -95,8 +95,9 @@ fn select(c: &mut Console, i: usize) {
     edit(c, EditAction::Toggle);
 }
 
-#[test]
-fn an_extension_far_outside_the_image_asks_first() {
+/// A console with session `cube`, image 1 captured, on the Edit screen;
+/// and that screen.
+fn image_1_on_the_edit_screen() -> (Console, String) {
     let mut c = Console::start(80, 24, &[]);
     c.create_session("cube");
     c.capture_current(1);
@@ -105,6 +106,12 @@ fn an_extension_far_outside_the_image_asks_first() {
         Action::Global(GlobalAction::GoTo(ScreenId::Edit)),
     );
     let s = c.wait_text("highlighted (n p", 10);
+    (c, s)
+}
+
+#[test]
+fn an_extension_far_outside_the_image_asks_first() {
+    let (mut c, s) = image_1_on_the_edit_screen();
     let n: usize = flat(&s)
         .split("image 1: ")
         .nth(1)
@@ -195,14 +202,7 @@ fn an_extension_far_outside_the_image_asks_first() {
 /// for outputs not saved.
 #[test]
 fn an_edit_not_written_makes_q_ask() {
-    let mut c = Console::start(80, 24, &[]);
-    c.create_session("cube");
-    c.capture_current(1);
-    c.press(
-        Scope::Global,
-        Action::Global(GlobalAction::GoTo(ScreenId::Edit)),
-    );
-    c.wait_text("highlighted (n p", 10);
+    let (mut c, _) = image_1_on_the_edit_screen();
     let ldr = c.session().join("cube1.ldr");
     let _ = std::fs::remove_file(&ldr);
     std::fs::create_dir_all(ldr.join("in the way")).unwrap();
