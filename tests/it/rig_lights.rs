@@ -456,8 +456,17 @@ fn lcus_frames_over_a_pty() {
     );
     assert_eq!(b.read_mask().expect("mask"), 0b100);
     // The peer hung up: the next switch reports a vanished board, by name.
+    // (The hang-up reaches the board's side of the pty a moment later on
+    // a loaded machine: a switch in that moment may still be written.)
     drop(peer);
-    let e = b.set(1, true).expect_err("peer gone");
+    let deadline = Instant::now() + Duration::from_secs(3);
+    let e = loop {
+        match b.set(1, true) {
+            Err(e) => break e,
+            Ok(()) if Instant::now() < deadline => std::thread::sleep(Duration::from_millis(20)),
+            Ok(()) => panic!("peer gone, but switches still succeed after 3 s"),
+        }
+    };
     assert!(e.is_vanished() && e.to_string().contains(&name), "{e}");
 }
 
