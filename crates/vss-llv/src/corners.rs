@@ -12,9 +12,13 @@
 //!    would erase it).
 //! 2. For a cluster of lines that are not all parallel (some pair differs by
 //!    at least [`MIN_CORNER_ANGLE_DEG`]), the corner is the point closest, in
-//!    least squares, to all of their infinite lines — for two lines exactly
-//!    their intersection, for a cube vertex of three edges the best
-//!    compromise. It is accepted when it lies within [`MAX_VERTEX_OFFSET`]
+//!    weighted least squares, to all of their infinite lines — for two lines
+//!    exactly their intersection, for a cube vertex of three edges the best
+//!    compromise. Each line weighs what its position near its end is worth:
+//!    the inverse variance of a least-squares line's end, `L / (4 r²)` for a
+//!    line of length `L` whose points scatter `r` (its `residual`), so that a
+//!    short stub inside the corner does not pull a long edge's end off it.
+//!    The corner is accepted when it lies within [`MAX_VERTEX_OFFSET`]
 //!    of every line of the cluster (their lines really meet there), within
 //!    `radius` of every endpoint and is a *corner move* for each: outward
 //!    along the line, or inward by at most [`MAX_INWARD_RADII`] × `radius` (a
@@ -22,7 +26,12 @@
 //!    Without the first test, two close parallel edges meeting a third (a
 //!    plate seen edge-on against an upright) had their ends moved to a point
 //!    between them, tilting both (docs/llv.md, "Measurements behind the
-//!    design").
+//!    design"). An endpoint goes to the corner itself when the corner lies
+//!    within [`VERTEX_SIGMAS`] of its own line's end uncertainty (the lines
+//!    agree: a cube's vertex fixes each edge's end better than the edge
+//!    alone); a line that the corner would move further is sure of its own
+//!    position there, and its endpoint goes to the foot of the corner on its
+//!    line, so that closing the corner never tilts it.
 //! 3. Otherwise the cluster falls back to pairs: every pair of endpoints of
 //!    non-parallel lines within `radius`, whose intersection lies within
 //!    `radius` of both and is a corner move for both, ordered by the total
@@ -59,6 +68,34 @@ pub const MAX_INWARD_RADII: f64 = 0.25;
 /// this (px) of every line of the cluster.
 pub const MAX_VERTEX_OFFSET: f64 = 1.0;
 
+/// An endpoint moves to its cluster's corner only when the corner lies
+/// within this many standard deviations of its line's end position
+/// ([`end_sigma`]); otherwise to the corner's foot on its line.
+pub const VERTEX_SIGMAS: f64 = 5.0;
+
+/// Least point scatter (px) assumed of a line: a line with a residual of
+/// zero (made from exact points) would otherwise weigh infinitely.
+const MIN_RESIDUAL: f64 = 0.05;
+
+/// The standard deviation (px) of a line's distance at its ends, as a
+/// least-squares line through about one point a pixel of scatter `r` has
+/// it: `2 r / √L` (twice its offset's at the centre).
+fn end_sigma(s: &Segment) -> f64 {
+    2.0 * s.residual.max(MIN_RESIDUAL) / s.length().sqrt()
+}
+
+/// The foot of the perpendicular from `p` on the infinite line of `s`
+/// (`p` itself for a zero-length segment).
+fn on_line(s: &Segment, p: Point) -> Point {
+    match normal_form(s) {
+        Some((a, b, c)) => {
+            let d = a * p.x + b * p.y + c;
+            Point::new(p.x - d * a, p.y - d * b)
+        }
+        None => p,
+    }
+}
+
 /// One endpoint: line index and which end (false = `a`, true = `b`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 struct End {
@@ -92,18 +129,24 @@ fn angle_between_deg(s: &Segment, t: &Segment) -> f64 {
     cross.atan2(dot).to_degrees()
 }
 
-/// The point with the least sum of squared distances to the given lines;
-/// `None` when the lines are (numerically) all parallel. Each line
+/// The point with the least sum of squared distances to the given lines,
+/// each weighed by the inverse variance of its end ([`end_sigma`]); `None`
+/// when the lines are (numerically) all parallel. Each line
 /// `a x + b y + c = 0` (unit normal) is one row of `N p = -c`; the point
-/// solves the normal equations `NᵀN p = -Nᵀc`.
+/// solves the normal equations `NᵀWN p = -NᵀWc`. For two lines the weights
+/// do not matter: the point is their intersection.
 fn least_squares_point(lines: &[Segment], idx: &[usize]) -> Option<Point> {
     let mut ntn = Matrix2::zeros();
     let mut ntc = Vector2::zeros();
     for &i in idx {
         let (a, b, c) = normal_form(&lines[i])?;
+        let w = end_sigma(&lines[i]).powi(-2);
+        if !w.is_finite() {
+            return None;
+        }
         let n = Vector2::new(a, b);
-        ntn += n * n.transpose();
-        ntc -= n * c;
+        ntn += w * n * n.transpose();
+        ntc -= w * n * c;
     }
     let det = ntn.determinant();
     if det.is_nan() || det.abs() <= 1e-12 {
@@ -258,7 +301,11 @@ pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerS
         }
         if let Some(p) = cluster_corner(&s.original, ends, pts, &s.kept, radius, &mut s.idx) {
             for &k in &s.kept {
-                set_end(lines, ends[k], p);
+                let own = &s.original[ends[k].line];
+                let agrees = normal_form(own).is_some_and(|(a, b, c)| {
+                    (a * p.x + b * p.y + c).abs() <= VERTEX_SIGMAS * end_sigma(own)
+                });
+                set_end(lines, ends[k], if agrees { p } else { on_line(own, p) });
             }
             continue;
         }
@@ -538,6 +585,38 @@ mod tests {
             );
         }
         assert!(close(v[0].b, 50.0, 40.0), "{:?}", v[0]);
+    }
+
+    #[test]
+    fn a_short_line_in_a_corner_does_not_pull_a_long_edge_off_its_line() {
+        // From a yard scene at noise σ 10: a long edge and a shorter one
+        // meet at a corner, and a 20 px line 7° off the long edge (the start
+        // of a bevel's inner edge) ends there too. The unweighted
+        // least-squares point of the three lay 0.54 px off the long edge,
+        // and moving its end there tilted all 290 px of it.
+        let with_residual = |mut s: Segment, r: f64| {
+            s.residual = r;
+            s
+        };
+        let long = with_residual(seg(60.9, 183.6, 204.0, 436.1), 0.5);
+        let other = with_residual(seg(61.3, 182.2, 141.7, 136.6), 0.5);
+        let stub = with_residual(seg(62.0, 186.8, 73.6, 202.5), 0.7);
+        let mut v = vec![long, other, stub];
+        close_corners(&mut v, 5.0);
+        let (a, b, c) = normal_form(&long).unwrap();
+        let off = |p: Point| (a * p.x + b * p.y + c).abs();
+        assert!(
+            off(v[0].a) < 1e-9 && off(v[0].b) < 1e-9,
+            "the long edge tilted: its end is {:.3} px off its line",
+            off(v[0].a)
+        );
+        let corner = least_squares_point(&[long, other], &[0, 1]).unwrap();
+        assert!(
+            v[0].a.dist(corner) < 0.2 && v[0].a != long.a,
+            "the corner was not closed: {:?}",
+            v[0].a
+        );
+        assert!(v[0].b == long.b, "the far end moved: {:?}", v[0].b);
     }
 
     #[test]
