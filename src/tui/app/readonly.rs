@@ -1,8 +1,9 @@
 //! A session open only to look (its folder cannot be written: a
-//! read-only mount, no write permission; opened so after the operator said
-//! yes): the images, lines and files can be seen, and every action that
-//! would write into it is refused here, before anything changes, with
-//! what was refused. The store refuses the same writes again.
+//! read-only mount, no write permission; or another console that still
+//! runs holds it; opened so after the operator chose it): the images,
+//! lines and files can be seen, and every action that would write into it
+//! is refused here, before anything changes, with what was refused. The
+//! store refuses the same writes again.
 
 use super::App;
 use crate::tui::keymap::{Action, EditAction, FilesAction, PipelineAction, SurveyAction};
@@ -69,8 +70,8 @@ impl App {
             .map(|v| v.name.clone())
             .unwrap_or_default();
         self.ctx().error(format!(
-            "{READ_ONLY} — {what} refused: session {name} is open only to look (its folder \
-             cannot be written); o opens another session"
+            "{READ_ONLY} — {what} refused: session {name} is open only to look; o opens \
+             another session"
         ));
         true
     }
