@@ -2,14 +2,15 @@
 //! case: a colleague's console is running the survey): the second console
 //! is offered take over / read-only / neither; read-only opens it by the
 //! same path as an unwritable folder — no lock written, no take-over
-//! request, nothing saved — and the first console goes on saving. Two
+//! request, nothing saved — and the first console goes on saving. The
+//! read-only view's hint rows offer only the keys that work there. Two
 //! real consoles on real ptys at 80 × 24.
 
 use std::path::PathBuf;
 use std::time::SystemTime;
 
 use vss::session::lock::leave_path;
-use vss::tui::keymap::{Action, GlobalAction, ModalAction, Scope, SurveyAction};
+use vss::tui::keymap::{Action, GlobalAction, ModalAction, Scope, ScreenId, SurveyAction};
 
 use super::tui_harness::{Console, SURVEY, flat};
 use super::tui_pty_readonly::files;
@@ -88,6 +89,66 @@ fn a_second_console_looks_at_a_held_session_without_disturbing_it() {
     assert_eq!(b.wait_exit(10), 0);
     assert_eq!(std::fs::read(&lock).unwrap(), held, "the lock is untouched");
     assert_eq!(a.exit_code(), None, "the first console runs on");
+    a.send("q");
+    assert_eq!(a.wait_exit(10), 0);
+}
+
+#[test]
+fn the_read_only_view_offers_only_the_keys_that_work_there() {
+    let (mut a, mut b, _) = looking();
+    // The writing console offers accept and redo on its hint rows ...
+    let s = a.screen();
+    assert!(hint_rows(&s).contains("a accept"), "{s}");
+    // ... the one only looking does not, on the image shown or the next.
+    for up in [false, true] {
+        if up {
+            b.press(SURVEY, Action::Survey(SurveyAction::Up));
+            b.press(SURVEY, Action::Survey(SurveyAction::Enter));
+            b.wait_text("image 1a + lines", 20);
+        }
+        let s = b.wait("the hints drawn", 10, |s| hint_rows(s).contains("o open"));
+        let h = hint_rows(&s);
+        for refused in ["a accept", "R redo", "c camera", "p place"] {
+            assert!(!h.contains(refused), "{refused:?} offered:\n{s}");
+        }
+    }
+    // The key still refuses, with what it was.
+    b.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    b.wait_words("accepting refused", 10);
+    // The other screens offer looking, not changing: the lines (Edit),
+    // the outputs (Pipeline), the reports (Session).
+    let screens: [(ScreenId, &str, &[&str]); 3] = [
+        (
+            ScreenId::Edit,
+            "nearest",
+            &["connect", "extend", "delete", "undo", "redo"],
+        ),
+        (ScreenId::Pipeline, "view", &["save"]),
+        (ScreenId::Session, "check", &["export"]),
+    ];
+    for (screen, offered, refused) in screens {
+        // The writing console offers them there ...
+        a.press(Scope::Global, Action::Global(GlobalAction::GoTo(screen)));
+        let s = a.wait(&format!("the {screen:?} hints"), 10, |s| {
+            hint_rows(s).contains(offered)
+        });
+        for r in refused {
+            assert!(hint_rows(&s).contains(r), "{screen:?}: {r:?} offered:\n{s}");
+        }
+        // ... the one only looking does not.
+        b.press(Scope::Global, Action::Global(GlobalAction::GoTo(screen)));
+        let s = b.wait(&format!("the {screen:?} hints"), 10, |s| {
+            hint_rows(s).contains(offered)
+        });
+        for r in refused {
+            assert!(
+                !hint_rows(&s).contains(r),
+                "{screen:?}: {r:?} offered:\n{s}"
+            );
+        }
+    }
+    b.send("q");
+    assert_eq!(b.wait_exit(10), 0);
     a.send("q");
     assert_eq!(a.wait_exit(10), 0);
 }

@@ -287,8 +287,9 @@ fn key_hints_of(app: &App, scope: Scope) -> Vec<Span<'static>> {
     } else {
         Vec::new()
     };
-    // Not offered: keys a search on takes, and the image keys before a
-    // session is open (there is no image to accept or capture again).
+    // Not offered: keys a search on takes, the image keys before a
+    // session is open (there is no image to accept or capture again), and
+    // what a session open only to look refuses (`App::refused_here`).
     let keep = |b: &keymap::Binding| {
         let taken = searching
             && keymap::KEYMAP
@@ -310,7 +311,7 @@ fn key_hints_of(app: &App, scope: Scope) -> Vec<Span<'static>> {
             (Action::Modal(m), Some(modal)) => !modal.offers(m),
             _ => false,
         };
-        !taken && !no_image && !unoffered
+        !taken && !no_image && !unoffered && app.refused_here(b.action).is_none()
     };
     hints.extend(keymap::hints_where(scope, keep));
     if let Scope::Screen(s) = scope {
