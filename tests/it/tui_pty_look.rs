@@ -38,6 +38,13 @@ fn looking() -> (Console, Console, Before) {
     b.wait_text("in use by", 10);
     // Its devices found first, so that what opening says is the newest.
     b.wait_text("grabber", 10);
+    // Esc leaves the question and the session alone.
+    b.send("\r");
+    b.wait_text("over anyway?", 10);
+    b.send("\x1b");
+    b.wait("the question closed", 10, |s| {
+        !s.contains("over anyway?") && s.contains("choose a session")
+    });
     b.send("\r");
     // Three choices, all in sight at 80 × 24, in the question's box and
     // on the hint row.
