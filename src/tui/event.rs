@@ -128,8 +128,9 @@ pub struct SessionView {
     /// Whether the files were read and checked for this view (not only
     /// the manifest).
     pub checked: bool,
-    /// Opened only to look (its folder cannot be written): every action
-    /// that would write is refused, and nothing is written into it.
+    /// Opened only to look (its folder cannot be written, or another
+    /// console holds it): every action that would write is refused, and
+    /// nothing is written into it.
     pub read_only: bool,
 }
 
@@ -268,7 +269,9 @@ pub enum StoreEvent {
         dir: PathBuf,
         why: String,
     },
-    /// The session is held by a console that still runs.
+    /// The session is held by a console that still runs: it can be taken
+    /// over ([`StoreCmd::TakeOver`]) or opened only to look
+    /// ([`StoreCmd::OpenReadOnly`]), as the operator chooses.
     Locked {
         dir: PathBuf,
         holder: String,
@@ -432,8 +435,8 @@ pub enum StoreError {
     #[error("no session open: create or open one on the Survey screen (1)")]
     NoSession,
     #[error(
-        "read-only: nothing will be saved — session {name} is open only to look (its folder \
-         cannot be written); o opens another session"
+        "read-only: nothing will be saved — session {name} is open only to look; o opens \
+         another session"
     )]
     ReadOnly { name: String },
     #[error("{what}: {source}")]

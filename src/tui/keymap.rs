@@ -234,6 +234,9 @@ pub enum ModalAction {
     No,
     /// "All", where a question offers it (retake every lighting).
     All,
+    /// Only look, read-only, where a question offers it (a session another
+    /// console holds).
+    Look,
     Submit,
     Cancel,
     Left,

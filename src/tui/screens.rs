@@ -259,15 +259,14 @@ impl Widget for &App {
                 ));
             }
             match &self.chrome.modal {
-                Some(crate::tui::app::Modal::Confirm {
-                    question, on_all, ..
-                }) => {
+                Some(m @ crate::tui::app::Modal::Confirm { question, .. }) => {
                     text.push(Line::styled(question.clone(), t.title()));
-                    text.push(Line::raw(if on_all.is_some() {
-                        "y yes  a all  n no"
-                    } else {
-                        "y yes  n no"
-                    }));
+                    let keys: Vec<String> = m
+                        .choices()
+                        .iter()
+                        .map(|(k, w)| format!("{k} {w}"))
+                        .collect();
+                    text.push(Line::raw(keys.join("  ")));
                 }
                 Some(crate::tui::app::Modal::Prompt(p)) => {
                     text.push(Line::styled(format!("{} {}", p.title, p.text), t.title()));

@@ -62,6 +62,7 @@ mod tui_pty_edit;
 mod tui_pty_feedback;
 mod tui_pty_hidden;
 mod tui_pty_layout;
+mod tui_pty_look;
 mod tui_pty_narrow;
 mod tui_pty_operator;
 mod tui_pty_polish;

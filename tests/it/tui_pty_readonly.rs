@@ -68,7 +68,7 @@ impl Drop for ReadOnly {
 }
 
 /// Every file of `dir` with its length and modification time.
-fn files(dir: &Path) -> Vec<(PathBuf, u64, SystemTime)> {
+pub fn files(dir: &Path) -> Vec<(PathBuf, u64, SystemTime)> {
     let mut out: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .flatten()

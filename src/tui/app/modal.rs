@@ -8,7 +8,7 @@ use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
 use super::{App, Level};
 use crate::tui::event::{Cmd, StoreCmd};
-use crate::tui::keymap::ModalAction;
+use crate::tui::keymap::{Action, ModalAction, Scope};
 
 /// What a confirmed question does.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -30,7 +30,8 @@ pub enum Pending {
     Switch(std::path::PathBuf),
     /// Take the lock of a session held by a console that still runs.
     TakeOver(std::path::PathBuf),
-    /// Open, only to look, a session whose folder cannot be written.
+    /// Open, only to look, a session whose folder cannot be written or
+    /// that another console holds: without its lock, nothing saved.
     OpenReadOnly(std::path::PathBuf),
     /// Start an image beyond the survey's plan.
     ExtraImage(u32),
@@ -83,6 +84,9 @@ pub enum Modal {
         on_yes: Pending,
         /// What `a` ("all") does, where the question offers it.
         on_all: Option<Pending>,
+        /// What `r` ("read-only", only look) does, where the question
+        /// offers it.
+        on_look: Option<Pending>,
     },
 }
 
@@ -92,7 +96,37 @@ impl Modal {
             question: question.into(),
             on_yes,
             on_all: None,
+            on_look: None,
         }
+    }
+
+    /// Whether the open question takes `a`: "all" and "read-only" only
+    /// where it offers them.
+    pub fn offers(&self, a: ModalAction) -> bool {
+        match self {
+            Modal::Confirm {
+                on_all, on_look, ..
+            } => match a {
+                ModalAction::All => on_all.is_some(),
+                ModalAction::Look => on_look.is_some(),
+                _ => true,
+            },
+            Modal::Prompt(_) => true,
+        }
+    }
+
+    /// The keys a question offers with their words, as the key table has
+    /// them (`y yes`, `n no`, and `a all`, `r read-only` where offered; none
+    /// for a text field): the question's box, the too-small window's line
+    /// and the hint row say the same.
+    pub fn choices(&self) -> Vec<(String, &'static str)> {
+        if let Modal::Prompt(_) = self {
+            return Vec::new();
+        }
+        crate::tui::keymap::hints_where(
+            Scope::Confirm,
+            |b| matches!(b.action, Action::Modal(m) if self.offers(m)),
+        )
     }
 
     pub fn prompt(
@@ -208,6 +242,7 @@ impl Prompt {
             ModalAction::DeleteBack
             | ModalAction::DeleteForward
             | ModalAction::All
+            | ModalAction::Look
             | ModalAction::Yes
             | ModalAction::No
             | ModalAction::Submit
@@ -234,8 +269,9 @@ impl App {
 
     pub(super) fn modal_action(&mut self, a: ModalAction) -> Vec<Cmd> {
         match a {
-            ModalAction::Yes | ModalAction::No => self.answer(Some(a == ModalAction::Yes)),
-            ModalAction::All => self.answer(None),
+            ModalAction::Yes | ModalAction::No | ModalAction::All | ModalAction::Look => {
+                self.answer(a)
+            }
             ModalAction::Submit => self.submit(),
             ModalAction::Cancel => {
                 self.chrome.modal = None;
@@ -257,14 +293,23 @@ impl App {
         }
     }
 
-    /// The answer to the open question: yes, no, or (`None`) "all".
-    pub(super) fn answer(&mut self, yes: Option<bool>) -> Vec<Cmd> {
-        let Some(Modal::Confirm { on_yes, on_all, .. }) = self.chrome.modal.take() else {
+    /// The answer to the open question: yes, no, "all" or "read-only"; a
+    /// choice the question does not offer leaves it open.
+    pub(super) fn answer(&mut self, a: ModalAction) -> Vec<Cmd> {
+        if !self.chrome.modal.as_ref().is_some_and(|m| m.offers(a)) {
+            return Vec::new();
+        }
+        let Some(Modal::Confirm {
+            on_yes,
+            on_all,
+            on_look,
+            ..
+        }) = self.chrome.modal.take()
+        else {
             return Vec::new();
         };
-        let pending = match yes {
-            Some(true) => on_yes,
-            Some(false) => {
+        let pending = match a {
+            ModalAction::No => {
                 if let Pending::CreateSession(name) = on_yes {
                     // Back to the field, the name there to change.
                     self.chrome.modal = Some(Modal::prompt(
@@ -279,12 +324,11 @@ impl App {
                 self.chrome.log.push(Level::Info, "nothing changed");
                 return Vec::new();
             }
-            None => match on_all {
-                Some(p) => p,
-                None => return Vec::new(),
-            },
+            ModalAction::All => on_all,
+            ModalAction::Look => on_look,
+            _ => Some(on_yes),
         };
-        self.run_pending(pending)
+        pending.map_or_else(Vec::new, |p| self.run_pending(p))
     }
 
     fn run_pending(&mut self, p: Pending) -> Vec<Cmd> {

@@ -1,8 +1,10 @@
 //! A session open only to look (its folder cannot be written: a
-//! read-only mount, no write permission; opened so after the operator said
-//! yes): the images, lines and files can be seen, and every action that
-//! would write into it is refused here, before anything changes, with
-//! what was refused. The store refuses the same writes again.
+//! read-only mount, no write permission; or another console that still
+//! runs holds it; opened so after the operator chose it): the images,
+//! lines and files can be seen, and every action that would write into it
+//! is refused here, before anything changes, with what was refused. The
+//! hint line offers only the keys [`App::refused_here`] lets through. The
+//! store refuses the same writes again.
 
 use super::App;
 use crate::tui::keymap::{Action, EditAction, FilesAction, PipelineAction, SurveyAction};
@@ -16,8 +18,24 @@ impl App {
         self.session.view.as_ref().is_some_and(|v| v.read_only)
     }
 
+    /// What `a` would do that a session open only to look refuses, when
+    /// the open session is one (`None`: `a` goes on). The one rule of
+    /// what works read-only: the refusal ([`App::act`]) and the hint line
+    /// both follow it.
+    pub fn refused_here(&self, a: Action) -> Option<&'static str> {
+        if !self.read_only() {
+            return None;
+        }
+        match a {
+            // Nothing is captured here: no capture to set up.
+            Action::Survey(SurveyAction::Camera) => Some("choosing a capture's camera"),
+            Action::Survey(SurveyAction::Location) => Some("choosing a capture's location"),
+            a => self.would_write(a),
+        }
+    }
+
     /// What `a` would write into the open session, if it would.
-    pub(super) fn would_write(&self, a: Action) -> Option<&'static str> {
+    fn would_write(&self, a: Action) -> Option<&'static str> {
         let survey = &self.screens.survey;
         let w = &self.session.work;
         match a {
@@ -53,13 +71,10 @@ impl App {
         }
     }
 
-    /// Refuses `a` when the open session is open only to look and `a`
-    /// would write into it (said on the message line); whether it was.
+    /// Refuses `a` when [`App::refused_here`] says so (said on the message
+    /// line, with what was refused); whether it was.
     pub(super) fn refused_read_only(&mut self, a: Action) -> bool {
-        if !self.read_only() {
-            return false;
-        }
-        let Some(what) = self.would_write(a) else {
+        let Some(what) = self.refused_here(a) else {
             return false;
         };
         let name = self
@@ -69,8 +84,8 @@ impl App {
             .map(|v| v.name.clone())
             .unwrap_or_default();
         self.ctx().error(format!(
-            "{READ_ONLY} — {what} refused: session {name} is open only to look (its folder \
-             cannot be written); o opens another session"
+            "{READ_ONLY} — {what} refused: session {name} is open only to look; o opens \
+             another session"
         ));
         true
     }

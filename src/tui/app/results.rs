@@ -353,16 +353,23 @@ impl App {
                 ctx.error(format!(
                     "session {} is open in another console that still runs ({holder}). If \
                      that is your own console in a detached tmux or screen (an SSH drop), go \
-                     back to it: `tmux attach`. Taking it over makes that console's saves fail.",
+                     back to it: `tmux attach`. Taking it over makes that console's saves fail; \
+                     looking at it read-only leaves that console alone.",
                     dir.display()
                 ));
-                ctx.chrome.modal = Some(Modal::confirm(
-                    format!(
+                // Looking is the read-only open of an unwritable folder:
+                // no lock written, no request made, nothing saved.
+                ctx.chrome.modal = Some(Modal::Confirm {
+                    question: format!(
                         "Session held by {holder}, which still runs (try `tmux attach` first). \
+                         r only looks at it, read-only: nothing is saved, that console keeps \
+                         it undisturbed. y takes it over: that console's saves then fail. \
                          Take it over anyway?"
                     ),
-                    Pending::TakeOver(dir),
-                ));
+                    on_yes: Pending::TakeOver(dir.clone()),
+                    on_all: None,
+                    on_look: Some(Pending::OpenReadOnly(dir)),
+                });
                 Vec::new()
             }
             StoreEvent::Left { dir, by } => {

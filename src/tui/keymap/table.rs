@@ -90,7 +90,8 @@ pub const KEYMAP: &[Binding] = rows! {
     CO, ch('y'), Modal(Yes), "yes, go ahead", "yes";
     CO, ch('n'), Modal(No), "no, keep what is there", "no";
     CO, k(K::Esc), Modal(No), "no", "";
-    CO, ch('a'), Modal(All), "all (where the question offers it)", "";
+    CO, ch('a'), Modal(All), "all (where the question offers it)", "all";
+    CO, ch('r'), Modal(Look), "read-only: only look, nothing saved (where the question offers it)", "read-only";
     // Typing.
     PR, k(K::Enter), Modal(Submit), "accept the typed text", "accept";
     PR, k(K::Esc), Modal(Cancel), "cancel typing", "cancel";

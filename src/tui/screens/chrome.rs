@@ -287,8 +287,9 @@ fn key_hints_of(app: &App, scope: Scope) -> Vec<Span<'static>> {
     } else {
         Vec::new()
     };
-    // Not offered: keys a search on takes, and the image keys before a
-    // session is open (there is no image to accept or capture again).
+    // Not offered: keys a search on takes, the image keys before a
+    // session is open (there is no image to accept or capture again), and
+    // what a session open only to look refuses (`App::refused_here`).
     let keep = |b: &keymap::Binding| {
         let taken = searching
             && keymap::KEYMAP
@@ -305,7 +306,12 @@ fn key_hints_of(app: &App, scope: Scope) -> Vec<Span<'static>> {
                         | SurveyAction::ResetParams
                 )
             );
-        !taken && !no_image
+        // A question's "all" and "read-only" where it offers them.
+        let unoffered = match (b.action, &app.chrome.modal) {
+            (Action::Modal(m), Some(modal)) => !modal.offers(m),
+            _ => false,
+        };
+        !taken && !no_image && !unoffered && app.refused_here(b.action).is_none()
     };
     hints.extend(keymap::hints_where(scope, keep));
     if let Scope::Screen(s) = scope {
@@ -438,23 +444,18 @@ pub fn modal_box(app: &App, m: &Modal, area: Rect, buf: &mut Buffer) {
             }
             ("Enter accepts · Esc cancels · ←→ Home End C-u C-w", lines)
         }
-        Modal::Confirm {
-            question, on_all, ..
-        } => {
+        Modal::Confirm { question, .. } => {
             let mut lines: Vec<Line> = wrap(question, inner_w)
                 .into_iter()
                 .map(|r| Line::styled(r, t.warn()))
                 .collect();
-            let mut keys = vec![
-                Span::styled("y", t.key()),
-                Span::raw(" yes   "),
-                Span::styled("n", t.key()),
-                Span::raw(" no"),
-            ];
-            if on_all.is_some() {
-                keys.push(Span::raw("   "));
-                keys.push(Span::styled("a", t.key()));
-                keys.push(Span::raw(" all"));
+            let mut keys = Vec::new();
+            for (key, word) in m.choices() {
+                if !keys.is_empty() {
+                    keys.push(Span::raw("   "));
+                }
+                keys.push(Span::styled(key, t.key()));
+                keys.push(Span::raw(format!(" {word}")));
             }
             lines.push(Line::from(keys));
             ("question", lines)

@@ -247,8 +247,17 @@ impl Store {
                 self.close();
                 let s = Session::inspect(&dir)
                     .map_err(session_err(format!("cannot open {}", dir.display())))?;
+                // Its lock is only read: a holder keeps it, unasked.
+                let holder = s.lock_holder();
                 self.read_only = true;
                 self.opened(s);
+                if let Some(h) = holder {
+                    self.reply(StoreEvent::Note(format!(
+                        "session {} stays with {h}, undisturbed; its checklist is as on disk \
+                         when opened (not read again while open)",
+                        dir.display()
+                    )));
+                }
             }
             StoreCmd::TakeOver(dir) => {
                 self.close();

@@ -54,6 +54,7 @@ impl Ctx<'_> {
                 ),
                 on_yes: Pending::Remake(k),
                 on_all: Some(all),
+                on_look: None,
             });
             return;
         }
@@ -79,6 +80,7 @@ impl Ctx<'_> {
             ),
             on_yes: Pending::Retake { k, letters },
             on_all: Some(all),
+            on_look: None,
         });
     }
 

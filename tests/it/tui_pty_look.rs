@@ -1,0 +1,161 @@
+//! Looking at a session another console holds and still runs (the 3 a.m.
+//! case: a colleague's console is running the survey): the second console
+//! is offered take over / read-only / neither; read-only opens it by the
+//! same path as an unwritable folder — no lock written, no take-over
+//! request, nothing saved — and the first console goes on saving. The
+//! read-only view's hint rows offer only the keys that work there. Two
+//! real consoles on real ptys at 80 × 24.
+
+use std::path::PathBuf;
+use std::time::SystemTime;
+
+use vss::session::lock::leave_path;
+use vss::tui::keymap::{Action, GlobalAction, ModalAction, Scope, ScreenId, SurveyAction};
+
+use super::tui_harness::{Console, SURVEY, flat};
+use super::tui_pty_readonly::files;
+
+/// The bottom rows of the screen, where the hints are (at most three).
+fn hint_rows(s: &str) -> String {
+    let rows: Vec<&str> = s.lines().collect();
+    flat(&rows[rows.len().saturating_sub(3)..].join("\n"))
+}
+
+/// The lock file's bytes and the folder's files with their lengths and
+/// times, as the first console left them.
+type Before = (Vec<u8>, Vec<(PathBuf, u64, SystemTime)>);
+
+/// A first console that surveyed image 1 of `cube` and holds it, and a
+/// second one in the same folder that chose to look at it read-only; the
+/// folder as it was before the second started.
+fn looking() -> (Console, Console, Before) {
+    let mut a = Console::start(80, 24, &[]);
+    a.survey(1);
+    let dir = a.session();
+    let held = std::fs::read(dir.join("cube.lock")).expect("the first console holds the lock");
+    let before = files(&dir);
+    let mut b = a.another(80, 24);
+    b.wait_text("in use by", 10);
+    // Its devices found first, so that what opening says is the newest.
+    b.wait_text("grabber", 10);
+    // Esc leaves the question and the session alone.
+    b.send("\r");
+    b.wait_text("over anyway?", 10);
+    b.send("\x1b");
+    b.wait("the question closed", 10, |s| {
+        !s.contains("over anyway?") && s.contains("choose a session")
+    });
+    b.send("\r");
+    // Three choices, all in sight at 80 × 24, in the question's box and
+    // on the hint row.
+    let s = b.wait_text("over anyway?", 10);
+    assert!(s.contains("y yes   n no   r read-only"), "{s}");
+    assert!(hint_rows(&s).contains("y yes n no r read-only"), "{s}");
+    b.press(Scope::Confirm, Action::Modal(ModalAction::Look));
+    let s = b.wait_text("read-only: nothing will be saved", 10);
+    assert!(s.lines().next().unwrap().contains("read-only"), "{s}");
+    (a, b, (held, before))
+}
+
+#[test]
+fn a_second_console_looks_at_a_held_session_without_disturbing_it() {
+    let (mut a, mut b, (held, before)) = looking();
+    let dir = a.session();
+    let lock = dir.join("cube.lock");
+    let s = b.screen();
+    assert!(s.contains("done"), "image 1 is listed done:\n{s}");
+    // Said whose it stays, and that the view is not read again (in the
+    // log: the image's loading is said after it).
+    b.press(Scope::Global, Action::Global(GlobalAction::ToggleLog));
+    b.wait("the log says whose it stays", 10, |s| {
+        flat(&s.replace('│', " ")).contains("stays with process")
+    });
+    b.press(Scope::Global, Action::Global(GlobalAction::ToggleLog));
+    b.press(Scope::Global, Action::Global(GlobalAction::ToggleLog));
+    // Its image with its lines shows.
+    b.press(SURVEY, Action::Survey(SurveyAction::Up));
+    b.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    b.wait_text("image 1a + lines", 20);
+    // The first console was not disturbed: its lock is the same bytes, no
+    // request to leave was made, no file of the folder changed.
+    assert_eq!(std::fs::read(&lock).unwrap(), held, "the lock is untouched");
+    assert!(!leave_path(&lock).exists(), "no take-over request");
+    assert_eq!(files(&dir), before, "nothing written into the folder");
+    assert!(
+        !a.screen().contains("taken over"),
+        "the first console keeps the session:\n{}",
+        a.screen()
+    );
+    // It still saves: image 2 captured and accepted.
+    a.capture_current(2);
+    a.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    let s = a.wait_text("image 2 accepted", 20);
+    assert!(!s.contains("NOT saved"), "{s}");
+    // The second console leaves at once, the lock still the first's.
+    b.send("q");
+    assert_eq!(b.wait_exit(10), 0);
+    assert_eq!(std::fs::read(&lock).unwrap(), held, "the lock is untouched");
+    assert_eq!(a.exit_code(), None, "the first console runs on");
+    a.send("q");
+    assert_eq!(a.wait_exit(10), 0);
+}
+
+#[test]
+fn the_read_only_view_offers_only_the_keys_that_work_there() {
+    let (mut a, mut b, _) = looking();
+    // The writing console offers accept and redo on its hint rows ...
+    let s = a.screen();
+    assert!(hint_rows(&s).contains("a accept"), "{s}");
+    // ... the one only looking does not, on the image shown or the next.
+    for up in [false, true] {
+        if up {
+            b.press(SURVEY, Action::Survey(SurveyAction::Up));
+            b.press(SURVEY, Action::Survey(SurveyAction::Enter));
+            b.wait_text("image 1a + lines", 20);
+        }
+        let s = b.wait("the hints drawn", 10, |s| hint_rows(s).contains("o open"));
+        let h = hint_rows(&s);
+        for refused in ["a accept", "R redo", "c camera", "p place"] {
+            assert!(!h.contains(refused), "{refused:?} offered:\n{s}");
+        }
+    }
+    // The key still refuses, with what it was.
+    b.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    b.wait_words("accepting refused", 10);
+    // The other screens offer looking, not changing: the lines (Edit),
+    // the outputs (Pipeline), the reports (Session).
+    let screens: [(ScreenId, &str, &[&str]); 3] = [
+        (
+            ScreenId::Edit,
+            "nearest",
+            &["connect", "extend", "delete", "undo", "redo"],
+        ),
+        (ScreenId::Pipeline, "view", &["save"]),
+        (ScreenId::Session, "check", &["export"]),
+    ];
+    for (screen, offered, refused) in screens {
+        // The writing console offers them there ...
+        a.press(Scope::Global, Action::Global(GlobalAction::GoTo(screen)));
+        let s = a.wait(&format!("the {screen:?} hints"), 10, |s| {
+            hint_rows(s).contains(offered)
+        });
+        for r in refused {
+            assert!(hint_rows(&s).contains(r), "{screen:?}: {r:?} offered:\n{s}");
+        }
+        // ... the one only looking does not.
+        b.press(Scope::Global, Action::Global(GlobalAction::GoTo(screen)));
+        let s = b.wait(&format!("the {screen:?} hints"), 10, |s| {
+            hint_rows(s).contains(offered)
+        });
+        for r in refused {
+            assert!(
+                !hint_rows(&s).contains(r),
+                "{screen:?}: {r:?} offered:\n{s}"
+            );
+        }
+    }
+    b.send("q");
+    assert_eq!(b.wait_exit(10), 0);
+    a.send("q");
+    assert_eq!(a.wait_exit(10), 0);
+}
