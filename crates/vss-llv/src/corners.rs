@@ -70,7 +70,8 @@ pub const MAX_VERTEX_OFFSET: f64 = 1.0;
 
 /// An endpoint moves to its cluster's corner only when the corner lies
 /// within this many standard deviations of its line's end position
-/// ([`end_sigma`]); otherwise to the corner's foot on its line.
+/// (`2 r / √L` for a line of length `L` whose points scatter `r`);
+/// otherwise to the corner's foot on its line.
 pub const VERTEX_SIGMAS: f64 = 5.0;
 
 /// Least point scatter (px) assumed of a line: a line with a residual of
