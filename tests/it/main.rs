@@ -70,6 +70,7 @@ mod tui_pty_readonly;
 mod tui_pty_review;
 mod tui_pty_search;
 mod tui_pty_shared;
+mod tui_pty_switch;
 mod tui_pty_takeover;
 mod tui_pty_trouble;
 mod tui_pty_tuning;

@@ -4,6 +4,8 @@
 //! record edits, read an image back, export the reports, append the log —
 //! reporting each result or error as a message. On quit the UI waits for it
 //! to finish what is queued, so nothing the operator saw saved is lost.
+//! A session replaces the open one only once it is open (`open`): one that
+//! cannot be opened leaves the open one open and held.
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver, Sender};
@@ -24,7 +26,10 @@ use crate::tui::event::{Msg, StoreCmd, StoreError, StoreEvent};
 mod list;
 mod load;
 mod logfile;
+mod open;
 mod view;
+
+use open::Opening;
 
 pub use view::view;
 
@@ -210,60 +215,10 @@ impl Store {
                     return Err(StoreError::Log { path, source });
                 }
             }
-            StoreCmd::Create(name) => {
-                self.close();
-                let s = Session::create(&self.profile.survey.dir, &name, &self.profile)
-                    .map_err(session_err(format!("cannot create session {name}")))?;
-                self.opened(s);
-            }
-            StoreCmd::Open(dir) => {
-                self.close();
-                let s = match Session::open(&dir) {
-                    Ok(s) => s,
-                    Err(SessionError::Locked { stale: true, .. }) => {
-                        self.reply(StoreEvent::Note(format!(
-                            "took over the lock of {}: its holder is gone",
-                            dir.display()
-                        )));
-                        Session::open_take_over(&dir)
-                            .map_err(session_err(format!("cannot open {}", dir.display())))?
-                    }
-                    Err(SessionError::Locked { holder, .. }) => {
-                        self.reply(StoreEvent::Locked { dir, holder });
-                        return Ok(());
-                    }
-                    // The lock cannot be written: the folder is read-only
-                    // (a mount, permissions). Looking is offered, not done.
-                    Err(SessionError::Unwritable { path, source }) => {
-                        let why = format!("{}: {source}", path.display());
-                        self.reply(StoreEvent::Unwritable { dir, why });
-                        return Ok(());
-                    }
-                    Err(e) => return Err(session_err(format!("cannot open {}", dir.display()))(e)),
-                };
-                self.opened(s);
-            }
-            StoreCmd::OpenReadOnly(dir) => {
-                self.close();
-                let s = Session::inspect(&dir)
-                    .map_err(session_err(format!("cannot open {}", dir.display())))?;
-                // Its lock is only read: a holder keeps it, unasked.
-                let holder = s.lock_holder();
-                self.read_only = true;
-                self.opened(s);
-                if let Some(h) = holder {
-                    self.reply(StoreEvent::Note(format!(
-                        "session {} stays with {h}, undisturbed; its checklist is as on disk \
-                         when opened (not read again while open)",
-                        dir.display()
-                    )));
-                }
-            }
-            StoreCmd::TakeOver(dir) => {
-                self.close();
-                let s = self.take_over(&dir)?;
-                self.opened(s);
-            }
+            StoreCmd::Create(name) => self.replace(Opening::Create(name)),
+            StoreCmd::Open(dir) => self.replace(Opening::Open(dir)),
+            StoreCmd::OpenReadOnly(dir) => self.replace(Opening::Look(dir)),
+            StoreCmd::TakeOver(dir) => self.replace(Opening::TakeOver(dir)),
             StoreCmd::SaveImage {
                 k,
                 letter,
@@ -487,21 +442,6 @@ impl Store {
         if self.lister.say(&list) || !if_changed {
             self.reply(StoreEvent::Sessions(list));
         }
-    }
-
-    /// Opens a session another vss holds, by the rule every take-over
-    /// follows ([`takeover::open_taking_over`]: a live holder on this host
-    /// is asked through the session folder, and signalled only when it
-    /// does not answer); each step is said.
-    fn take_over(&self, dir: &Path) -> Result<Session, StoreError> {
-        use crate::session::takeover::{self, TakeOverError};
-        let mut say = |text: String| self.reply(StoreEvent::Note(text));
-        takeover::open_taking_over(dir, &mut say).map_err(|e| match e {
-            TakeOverError::Session(e) => {
-                session_err(format!("cannot take over {}", dir.display()))(e)
-            }
-            e => StoreError::TakeOver(e),
-        })
     }
 
     /// Each camera's model (index 0 = camera 1) from
