@@ -173,10 +173,26 @@ impl App {
             .listed
             .is_some_and(|t| now.saturating_duration_since(t) < RELIST);
         if !shown || recent {
-            return Vec::new();
+            return self.relook_due(now);
         }
         self.session.listed = Some(now);
         vec![Cmd::Store(StoreCmd::Relist)]
+    }
+
+    /// A session open only to look is read again every [`RELIST`] on any
+    /// screen (another console may be surveying it); the store says it
+    /// only when it changed.
+    fn relook_due(&mut self, now: std::time::Instant) -> Vec<Cmd> {
+        let looking = self.session.view.as_ref().is_some_and(|v| v.read_only);
+        let recent = self
+            .session
+            .looked
+            .is_some_and(|t| now.saturating_duration_since(t) < RELIST);
+        if !looking || recent {
+            return Vec::new();
+        }
+        self.session.looked = Some(now);
+        vec![Cmd::Store(StoreCmd::Relook)]
     }
 
     pub fn quit(&self) -> bool {

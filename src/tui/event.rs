@@ -376,6 +376,10 @@ pub enum StoreCmd {
     /// only when it differs from the one last said, so an unchanged list
     /// costs the screen nothing.
     Relist,
+    /// Read the session open only to look again if its folder, manifest
+    /// or lock changed (another console goes on surveying it): said as
+    /// [`StoreEvent::Updated`], only when it changed.
+    Relook,
     Create(String),
     Open(PathBuf),
     /// Open only to look, without the lock: nothing is written into the

@@ -63,9 +63,9 @@ fn a_second_console_looks_at_a_held_session_without_disturbing_it() {
     let dir = a.session();
     let lock = dir.join("cube.lock");
     let s = b.screen();
-    assert!(s.contains("done"), "image 1 is listed done:\n{s}");
-    // Said whose it stays, and that the view is not read again (in the
-    // log: the image's loading is said after it).
+    assert!(s.contains("1 of 4 done"), "image 1 is listed done:\n{s}");
+    // Said whose it stays, and that what it saves will show (in the log:
+    // the image's loading is said after it).
     b.press(Scope::Global, Action::Global(GlobalAction::ToggleLog));
     b.wait("the log says whose it stays", 10, |s| {
         flat(&s.replace('│', " ")).contains("stays with process")
@@ -91,6 +91,11 @@ fn a_second_console_looks_at_a_held_session_without_disturbing_it() {
     a.press(SURVEY, Action::Survey(SurveyAction::Accept));
     let s = a.wait_text("image 2 accepted", 20);
     assert!(!s.contains("NOT saved"), "{s}");
+    // What it saved shows in the second console without a key: the view
+    // is read again when the folder changes.
+    b.wait("image 2 shows done in the second console", 10, |s| {
+        s.contains("2 of 4 done")
+    });
     // The second console leaves at once, the lock still the first's.
     b.send("q");
     assert_eq!(b.wait_exit(10), 0);

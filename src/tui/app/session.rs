@@ -22,6 +22,11 @@ pub struct SessionState {
     ///
     /// [`App::due`]: super::App::due
     pub listed: Option<std::time::Instant>,
+    /// When the session open only to look was last asked to be read again
+    /// ([`App::due`]).
+    ///
+    /// [`App::due`]: super::App::due
+    pub looked: Option<std::time::Instant>,
 }
 
 /// An image whose outputs are not saved, and why.

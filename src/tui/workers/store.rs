@@ -85,6 +85,15 @@ pub struct Store {
     lister: list::Lister,
     /// The open session was opened only to look: nothing is written.
     read_only: bool,
+    /// What the session open only to look was last read from
+    /// ([`StoreCmd::Relook`]).
+    looked: Option<list::Stamp>,
+}
+
+/// What a session open only to look rests on: its folder, manifest and
+/// lock ([`list::stamp`], the session list's own test of a change).
+fn look_stamp(s: &Session) -> list::Stamp {
+    list::stamp(s.dir(), s.name().as_str())
 }
 
 impl Store {
@@ -97,6 +106,7 @@ impl Store {
             log: logfile::LogFile::default(),
             lister: list::Lister::default(),
             read_only: false,
+            looked: None,
         }
     }
 
@@ -207,6 +217,7 @@ impl Store {
                 self.say_list(false);
             }
             StoreCmd::Relist => self.say_list(true),
+            StoreCmd::Relook => self.relook()?,
             StoreCmd::Log(lines) => {
                 let path = self.log.path().map(Path::to_path_buf);
                 if let Err(source) = self.log.append(&lines)
@@ -396,9 +407,11 @@ impl Store {
         }
         self.check = None;
         self.read_only = false;
+        self.looked = None;
     }
 
     fn opened(&mut self, s: Session) {
+        self.looked = self.read_only.then(|| look_stamp(&s));
         let check = s.check();
         let v = view(&s, Some(&check), true, self.read_only);
         let log = s.path(&format!("{}.log", s.name()));
@@ -417,6 +430,31 @@ impl Store {
             Ok(()) => self.reply(StoreEvent::LogFile(path)),
             Err(source) => self.reply(StoreEvent::Error(StoreError::Log { path, source })),
         }
+    }
+
+    /// The session open only to look, read again when what it rests on
+    /// changed since it was last read: its checklist and files as another
+    /// console left them, the console's place in it kept.
+    fn relook(&mut self) -> Result<(), StoreError> {
+        let (Some(s), true) = (&self.session, self.read_only) else {
+            return Ok(());
+        };
+        let now = look_stamp(s);
+        if self.looked.as_ref() == Some(&now) {
+            return Ok(());
+        }
+        // Said once a change, whether it reads or not.
+        self.looked = Some(now);
+        let dir = s.dir().to_path_buf();
+        let s = Session::inspect(&dir).map_err(session_err(format!(
+            "cannot read {} again (the view shows it as it was)",
+            dir.display()
+        )))?;
+        let check = s.check();
+        self.reply(StoreEvent::Updated(view(&s, Some(&check), true, true)));
+        self.session = Some(s);
+        self.check = Some(check);
+        Ok(())
     }
 
     fn updated(&self) {

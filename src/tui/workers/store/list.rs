@@ -15,9 +15,9 @@ use crate::tui::event::SessionEntry;
 /// What a folder's entry rests on: the folder, `FOLDER.toml` and
 /// `FOLDER.lock`, each by inode, change time (any write, rename or
 /// permission change moves it) and length (`None`: absent).
-type Stamp = [Option<(u64, i64, i64, u64)>; 3];
+pub(super) type Stamp = [Option<(u64, i64, i64, u64)>; 3];
 
-fn stamp(dir: &Path, folder: &str) -> Stamp {
+pub(super) fn stamp(dir: &Path, folder: &str) -> Stamp {
     let of = |p: &Path| {
         std::fs::metadata(p)
             .ok()

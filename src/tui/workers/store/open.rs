@@ -67,8 +67,8 @@ impl Store {
                 self.opened(s);
                 if let Some(h) = holder {
                     self.reply(StoreEvent::Note(format!(
-                        "session {} stays with {h}, undisturbed; its checklist is as on disk \
-                         when opened (not read again while open)",
+                        "session {} stays with {h}, undisturbed; what it saves shows here \
+                         within 2 s",
                         how.shown()
                     )));
                 }
