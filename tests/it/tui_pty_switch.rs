@@ -14,6 +14,17 @@ use super::tui_harness::{Console, SURVEY, flat};
 
 const DOWN: &str = "\x1b[B";
 
+/// From the session list, open `two` (listed below `cube`, the open one)
+/// and say yes to leaving `cube` for it.
+fn switch_to_two(b: &mut Console) {
+    b.press(SURVEY, Action::Survey(SurveyAction::OpenPicker));
+    b.wait_words("choose a session", 10);
+    b.send(DOWN);
+    b.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    b.wait_words("Leave session cube and open session two?", 10);
+    b.yes();
+}
+
 #[test]
 fn declining_a_held_session_keeps_the_open_one_held_and_saving() {
     // The first console holds session two and runs on.
@@ -34,12 +45,7 @@ fn declining_a_held_session_keeps_the_open_one_held_and_saving() {
     b.wait_text("image 1 accepted", 20);
     // It switches to two (the list: cube, the newer, first and chosen)
     // and declines the question about the console that holds it.
-    b.press(SURVEY, Action::Survey(SurveyAction::OpenPicker));
-    b.wait_words("choose a session", 10);
-    b.send(DOWN);
-    b.press(SURVEY, Action::Survey(SurveyAction::Enter));
-    b.wait_words("Leave session cube and open session two?", 10);
-    b.yes();
+    switch_to_two(&mut b);
     b.wait_text("over anyway?", 10);
     b.press(Scope::Confirm, Action::Modal(ModalAction::No));
     let s = b.wait("the question closed", 10, |s| !s.contains("over anyway?"));
@@ -68,12 +74,7 @@ fn declining_a_held_session_keeps_the_open_one_held_and_saving() {
     // and only then is cube released.
     a.send("q");
     assert_eq!(a.wait_exit(10), 0);
-    b.press(SURVEY, Action::Survey(SurveyAction::OpenPicker));
-    b.wait_words("choose a session", 10);
-    b.send(DOWN);
-    b.press(SURVEY, Action::Survey(SurveyAction::Enter));
-    b.wait_words("Leave session cube and open session two?", 10);
-    b.yes();
+    switch_to_two(&mut b);
     b.wait_text("session two open", 10);
     assert_eq!(read_holder(&two_lock).map(|h| h.pid), Some(b_pid));
     assert!(!lock.exists(), "cube's lock released once two is open");

@@ -21,7 +21,7 @@ use crate::profile::Profile;
 use crate::report;
 use crate::session::takeover::LEAVE_POLL;
 use crate::session::{CheckReport, FrameSettings, Session, SessionError};
-use crate::tui::event::{Msg, StoreCmd, StoreError, StoreEvent};
+use crate::tui::event::{Msg, SessionView, StoreCmd, StoreError, StoreEvent};
 
 mod list;
 mod load;
@@ -412,11 +412,8 @@ impl Store {
 
     fn opened(&mut self, s: Session) {
         self.looked = self.read_only.then(|| look_stamp(&s));
-        let check = s.check();
-        let v = view(&s, Some(&check), true, self.read_only);
         let log = s.path(&format!("{}.log", s.name()));
-        self.session = Some(s);
-        self.check = Some(check);
+        let v = self.adopt(s);
         // A session open only to look keeps the state folder's log.
         if !self.read_only {
             self.use_log(log);
@@ -450,11 +447,20 @@ impl Store {
             "cannot read {} again (the view shows it as it was)",
             dir.display()
         )))?;
+        let v = self.adopt(s);
+        self.reply(StoreEvent::Updated(v));
+        Ok(())
+    }
+
+    /// Makes `s` the open session with a full check of its files, and
+    /// gives the console's picture of it (opening, and reading a session
+    /// open only to look again, both).
+    fn adopt(&mut self, s: Session) -> SessionView {
         let check = s.check();
-        self.reply(StoreEvent::Updated(view(&s, Some(&check), true, true)));
+        let v = view(&s, Some(&check), true, self.read_only);
         self.session = Some(s);
         self.check = Some(check);
-        Ok(())
+        v
     }
 
     fn updated(&self) {
