@@ -303,10 +303,9 @@ pub fn close_corners_with(lines: &mut Vec<Segment>, radius: f64, s: &mut CornerS
         if let Some(p) = cluster_corner(&s.original, ends, pts, &s.kept, radius, &mut s.idx) {
             for &k in &s.kept {
                 let own = &s.original[ends[k].line];
-                let agrees = normal_form(own).is_some_and(|(a, b, c)| {
-                    (a * p.x + b * p.y + c).abs() <= VERTEX_SIGMAS * end_sigma(own)
-                });
-                set_end(lines, ends[k], if agrees { p } else { on_line(own, p) });
+                let foot = on_line(own, p);
+                let agrees = p.dist(foot) <= VERTEX_SIGMAS * end_sigma(own);
+                set_end(lines, ends[k], if agrees { p } else { foot });
             }
             continue;
         }
