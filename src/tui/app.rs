@@ -54,6 +54,16 @@ pub use tracker::{Loaded, Tracker};
 /// How often the session list is read again while it is shown.
 pub const RELIST: std::time::Duration = std::time::Duration::from_secs(2);
 
+/// Whether [`RELIST`] has passed since `last` (or nothing was asked yet);
+/// if so, `last` becomes `now`.
+fn due_again(last: &mut Option<std::time::Instant>, now: std::time::Instant) -> bool {
+    if last.is_some_and(|t| now.saturating_duration_since(t) < RELIST) {
+        return false;
+    }
+    *last = Some(now);
+    true
+}
+
 /// Each screen's own state.
 #[derive(Debug, Default)]
 pub struct Screens {
@@ -168,31 +178,17 @@ impl App {
         let shown = self.chrome.screen == ScreenId::Survey
             && !self.chrome.too_small()
             && (self.session.view.is_none() || self.screens.survey.picking);
-        let recent = self
-            .session
-            .listed
-            .is_some_and(|t| now.saturating_duration_since(t) < RELIST);
-        if !shown || recent {
-            return self.relook_due(now);
+        if shown && due_again(&mut self.session.listed, now) {
+            return vec![Cmd::Store(StoreCmd::Relist)];
         }
-        self.session.listed = Some(now);
-        vec![Cmd::Store(StoreCmd::Relist)]
-    }
-
-    /// A session open only to look is read again every [`RELIST`] on any
-    /// screen (another console may be surveying it); the store says it
-    /// only when it changed.
-    fn relook_due(&mut self, now: std::time::Instant) -> Vec<Cmd> {
+        // A session open only to look is read again as often, on any
+        // screen (another console may be surveying it); the store says it
+        // only when it changed.
         let looking = self.session.view.as_ref().is_some_and(|v| v.read_only);
-        let recent = self
-            .session
-            .looked
-            .is_some_and(|t| now.saturating_duration_since(t) < RELIST);
-        if !looking || recent {
-            return Vec::new();
+        if looking && due_again(&mut self.session.looked, now) {
+            return vec![Cmd::Store(StoreCmd::Relook)];
         }
-        self.session.looked = Some(now);
-        vec![Cmd::Store(StoreCmd::Relook)]
+        Vec::new()
     }
 
     pub fn quit(&self) -> bool {
