@@ -14,6 +14,7 @@ pub mod cell;
 #[cfg(feature = "genicam")]
 pub mod genicam;
 pub mod grabber;
+pub mod holder;
 pub mod lights;
 pub mod protocol;
 pub mod replay;
@@ -37,6 +38,13 @@ pub enum RigError {
         port: String,
         source: serialport::Error,
     },
+    /// The port exists and another open file holds it (its lock): another
+    /// console on this cell, a terminal program. `holder` is what
+    /// [`holder::describe`] found.
+    #[error(
+        "{port}: in use by {holder} — quit it there, or wait: the port is taken once it is free"
+    )]
+    Busy { port: String, holder: String },
     #[error(
         "{port}: the device vanished ({source}); everything saved so far is kept — \
          plug it back in and reconnect"
@@ -144,6 +152,10 @@ fn tries(n: u32) -> String {
 
 impl RigError {
     /// Whether the device has gone away (unplugged, powered off).
+    pub fn is_busy(&self) -> bool {
+        matches!(self, RigError::Busy { .. })
+    }
+
     pub fn is_vanished(&self) -> bool {
         matches!(
             self,
@@ -258,6 +270,12 @@ pub fn open_serial(path: &str, baud: u32, timeout: Duration) -> Result<SerialLin
             Err(e) if is_locked(&e) && start.elapsed() < BUSY_WAIT => {
                 std::thread::sleep(Duration::from_millis(10));
             }
+            Err(e) if is_locked(&e) => {
+                return Err(RigError::Busy {
+                    port: path.to_string(),
+                    holder: holder::describe(std::path::Path::new(path)),
+                });
+            }
             r => {
                 return r.map_err(|source| RigError::Open {
                     port: path.to_string(),
@@ -268,8 +286,11 @@ pub fn open_serial(path: &str, baud: u32, timeout: Duration) -> Result<SerialLin
     }
 }
 
-/// Whether serialport refused a port because another open file holds its
-/// lock (its only way of saying so is this kind and text).
+/// Whether serialport refused a port because another open file holds it:
+/// its `flock` ("… exclusive lock …") or, for a caller without root, its
+/// `TIOCEXCL` (`EBUSY`). serialport's only way of saying so is this kind
+/// and text.
 fn is_locked(e: &serialport::Error) -> bool {
-    e.kind() == serialport::ErrorKind::NoDevice && e.description.contains("lock")
+    let d = e.description.to_ascii_lowercase();
+    e.kind() == serialport::ErrorKind::NoDevice && (d.contains("lock") || d.contains("busy"))
 }

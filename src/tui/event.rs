@@ -67,8 +67,9 @@ pub enum FramePurpose {
 pub enum DeviceEvent {
     /// The cell answered: a one-line description of grabber and relay board.
     Connected { grabber: String, relay: String },
-    /// A device stopped answering; the worker retries on its own.
-    Lost { error: String },
+    /// A device stopped answering, or (`busy`) another program holds its
+    /// port; the worker retries on its own.
+    Lost { error: String, busy: bool },
     /// The lights are switched and settling before the freeze.
     Settling { ms: u64 },
     /// Transfer progress of the frame under way.

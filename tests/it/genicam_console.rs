@@ -241,7 +241,7 @@ fn live_view_rate_and_reconnecting_after_the_camera_is_killed() {
     let lost = next(&rx, 20, "the camera lost", |e| {
         matches!(e, DeviceEvent::Lost { .. })
     });
-    let DeviceEvent::Lost { error } = lost else {
+    let DeviceEvent::Lost { error, .. } = lost else {
         unreachable!()
     };
     assert!(error.contains("camera 1 (127.0.0.1)"), "{error}");

@@ -93,6 +93,14 @@ fn a_port_locked_for_a_moment_is_waited_for_and_one_held_is_refused() {
         start.elapsed()
     );
     assert!(e.to_string().contains(&path), "{e}");
+    // Said as what it is: held, and by whom (here: this test itself).
+    assert!(
+        e.to_string().contains(&format!(
+            "in use by this program itself (process {})",
+            std::process::id()
+        )),
+        "{e}"
+    );
     drop(again);
 }
 

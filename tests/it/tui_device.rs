@@ -72,7 +72,7 @@ fn an_unplugged_grabber_is_reported_and_reconnected() {
     let lost = next(&rx, 10, "lost device", |e| {
         matches!(e, DeviceEvent::Lost { .. })
     });
-    let DeviceEvent::Lost { error } = lost else {
+    let DeviceEvent::Lost { error, .. } = lost else {
         unreachable!()
     };
     assert!(

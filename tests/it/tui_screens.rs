@@ -454,6 +454,7 @@ fn device_trouble_and_hostile_text_are_shown_cleanly() {
     let mut app = App::new(&profile(), colour());
     app.update(Msg::Device(DeviceEvent::Lost {
         error: "/dev/pts/9: gone\x1b[2J".into(),
+        busy: false,
     }));
     let (s, _) = draw(&app, 80, 24);
     assert!(s.contains("DEVICE LOST"), "{s}");

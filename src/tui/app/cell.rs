@@ -16,6 +16,8 @@ pub struct DeviceState {
     pub grabber: String,
     pub relay: String,
     pub lost: Option<String>,
+    /// What `lost` says is another program holding a port, not a fault.
+    pub busy: bool,
     pub lights_on: Vec<String>,
     pub mask: u32,
     /// A frame coming in: what for, bytes done and total.

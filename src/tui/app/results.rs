@@ -66,20 +66,23 @@ impl App {
                     format!("grabber {g}; relay board {r}")
                 };
                 dev.connected = true;
+                dev.busy = false;
                 dev.grabber = g;
                 dev.relay = r;
                 self.ctx().info(text);
                 Vec::new()
             }
-            DeviceEvent::Lost { error } => {
+            DeviceEvent::Lost { error, busy } => {
                 let e = clean(&error);
                 let new = dev.lost.as_deref() != Some(e.as_str());
                 dev.connected = false;
                 dev.lost = Some(e.clone());
+                dev.busy = busy;
                 dev.transfer = None;
                 if new {
+                    let what = if busy { "device busy" } else { "device lost" };
                     self.ctx()
-                        .error(format!("device lost: {e} — retrying; saved work is safe"));
+                        .error(format!("{what}: {e} — retrying; saved work is safe"));
                 }
                 Vec::new()
             }

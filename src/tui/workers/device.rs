@@ -168,6 +168,7 @@ impl Worker {
                     &self.ui,
                     DeviceEvent::Lost {
                         error: e.to_string(),
+                        busy: e.is_busy(),
                     },
                 );
             }
@@ -194,6 +195,7 @@ impl Worker {
                 &self.ui,
                 DeviceEvent::Lost {
                     error: e.to_string(),
+                    busy: false,
                 },
             );
         }
