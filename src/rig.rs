@@ -41,9 +41,7 @@ pub enum RigError {
     /// The port exists and another open file holds it (its lock): another
     /// console on this cell, a terminal program. `holder` is what
     /// [`holder::describe`] found.
-    #[error(
-        "{port}: in use by {holder} — quit it there, or wait: the port is taken once it is free"
-    )]
+    #[error("{port}: in use by {holder} — quit it there to use the port here")]
     Busy { port: String, holder: String },
     #[error(
         "{port}: the device vanished ({source}); everything saved so far is kept — \
