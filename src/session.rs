@@ -150,6 +150,9 @@ pub enum SessionError {
         /// What could not be removed, or `None` when nothing made is left.
         left: Option<String>,
     },
+    /// A camera the session does not have ([`Manifest::check_camera`]).
+    #[error("session {session}: {what}; nothing was recorded")]
+    NoCamera { session: String, what: String },
     #[error("image {image} of session {session}: {what}")]
     Missing {
         session: String,
@@ -413,6 +416,7 @@ impl Session {
         c: &crate::calib::Calibration,
     ) -> Result<(), SessionError> {
         self.writable()?;
+        self.known_camera(camera)?;
         self.manifest.calibration.push(manifest::CalibrationRecord {
             camera,
             made: stamp::now_rfc3339(),
@@ -423,6 +427,13 @@ impl Session {
             centre_stated: c.centre_stated,
         });
         self.commit()
+    }
+    /// Refuses a camera the manifest could not be read back with.
+    fn known_camera(&self, camera: u32) -> Result<(), SessionError> {
+        let session = self.name.to_string();
+        self.manifest
+            .check_camera(camera)
+            .map_err(|what| SessionError::NoCamera { session, what })
     }
     /// Who holds the lock of this session right now, if anyone.
     pub fn lock_holder(&self) -> Option<LockInfo> {
@@ -484,6 +495,7 @@ impl Session {
     ) -> Result<(), SessionError> {
         self.writable()?;
         check_image_number(k)?;
+        self.known_camera(camera)?;
         let cdf_record = match cdf {
             Some(parsed) => {
                 let file = self.file_name(k, None, "cdf");
@@ -497,7 +509,7 @@ impl Session {
             None => None,
         };
         let rec = self.record_mut(k)?;
-        rec.camera = camera.max(1);
+        rec.camera = camera;
         rec.location = location.max(1);
         if cdf_record.is_some() {
             rec.cdf = cdf_record;

@@ -8,7 +8,8 @@
 //! It is plain serde + TOML, readable and editable by a person. Loading is
 //! strict (unknown keys are errors) and then checked for sense (unique image
 //! numbers and letters, image numbers and `planned_images` within
-//! [`MAX_IMAGE_NUMBER`], file names that stay inside the session folder), so
+//! [`MAX_IMAGE_NUMBER`], every record's camera one of the session's, file
+//! names that stay inside the session folder), so
 //! a manifest edited into nonsense is reported with its file and line and
 //! never silently rewritten. It is read record by record (`records`): each
 //! `[[image]]` is parsed on its own, never the whole file into one TOML
@@ -433,6 +434,8 @@ impl Manifest {
             if !numbers.insert(r.number) {
                 return Err((at, format!("image number {} appears twice", r.number)));
             }
+            self.check_camera(r.camera)
+                .map_err(|e| camera_at(r.camera, format!("[[image]] number {}: {e}", r.number)))?;
             for g in &r.grey {
                 if !letters.contains(&g.letter) {
                     return Err((
@@ -466,8 +469,32 @@ impl Manifest {
                 }
             }
         }
+        for c in &self.calibration {
+            self.check_camera(c.camera).map_err(|e| {
+                camera_at(c.camera, format!("[[calibration]] made {}: {e}", c.made))
+            })?;
+        }
         Ok(())
     }
+
+    /// Whether `camera` is one of the session's cameras (1 to
+    /// `session.cameras`): what every image and calibration record must
+    /// name, and what a session records; if not, why not.
+    pub fn check_camera(&self, camera: u32) -> Result<(), String> {
+        let n = self.session.cameras;
+        if (1..=n).contains(&camera) {
+            return Ok(());
+        }
+        Err(format!(
+            "camera {camera} is not one of the session's cameras, which run from 1 to {n} \
+             ([session] cameras = {n})"
+        ))
+    }
+}
+
+/// A camera check's failure at the record's `camera` key.
+fn camera_at(camera: u32, message: String) -> (Option<String>, String) {
+    (Some(format!("camera = {camera}")), message)
 }
 
 /// A name with no path in it: what a session may name.
@@ -647,5 +674,60 @@ mod tests {
         m.format = 9;
         let err = Manifest::parse(&m.to_toml().unwrap(), Path::new("c.toml")).unwrap_err();
         assert!(err.to_string().contains("format 9"), "{err}");
+    }
+
+    #[test]
+    fn records_naming_a_camera_the_session_lacks_are_refused_at_their_line() {
+        // The session has cameras 1 to 4; `full` names 3 (image 7) and 2
+        // (its calibration).
+        for camera in [0, 5, 9, u32::MAX] {
+            let mut m = full();
+            m.image[0].camera = camera;
+            let text = m.to_toml().unwrap();
+            let err = Manifest::parse(&text, Path::new("cube.toml"))
+                .unwrap_err()
+                .to_string();
+            let line = text
+                .lines()
+                .position(|l| l == format!("camera = {camera}"))
+                .unwrap()
+                + 1;
+            assert!(err.starts_with(&format!("cube.toml:{line}:")), "{err}");
+            assert!(
+                err.contains(&format!(
+                    "[[image]] number 7: camera {camera} is not one of the session's cameras, \
+                     which run from 1 to 4"
+                )),
+                "{err}"
+            );
+
+            let mut m = full();
+            m.calibration[0].camera = camera;
+            let text = m.to_toml().unwrap();
+            let err = Manifest::parse(&text, Path::new("cube.toml"))
+                .unwrap_err()
+                .to_string();
+            let line = text
+                .lines()
+                .position(|l| l == format!("camera = {camera}"))
+                .unwrap()
+                + 1;
+            assert!(err.starts_with(&format!("cube.toml:{line}:")), "{err}");
+            assert!(
+                err.contains(&format!(
+                    "[[calibration]] made 2026-01-01T00:00:00Z: camera {camera} is not one of \
+                     the session's cameras"
+                )),
+                "{err}"
+            );
+        }
+        // The last camera is one of them.
+        let mut m = full();
+        m.image[0].camera = 4;
+        m.calibration[0].camera = 4;
+        assert_eq!(
+            Manifest::parse(&m.to_toml().unwrap(), Path::new("c.toml")).unwrap(),
+            m
+        );
     }
 }

@@ -229,6 +229,14 @@ pub struct ImageState {
     pub params: Option<Params>,
 }
 
+impl ImageState {
+    /// Its outputs are there and current, and every file of it reads:
+    /// what the checklist counts done.
+    pub fn done(&self) -> bool {
+        self.outputs && !self.stale && self.damaged.is_empty() && self.outputs_damaged.is_none()
+    }
+}
+
 /// A file of the session and how it stands.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FileState {

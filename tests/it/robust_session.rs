@@ -346,3 +346,108 @@ fn an_io_error_is_told_once() {
     assert!(!ok, "{out}");
     assert_eq!(out.matches("more than").count(), 1, "{out}");
 }
+
+/// Every file of session folder `dir` with its bytes, in name order.
+fn files_of(dir: &Path) -> Vec<(std::ffi::OsString, Vec<u8>)> {
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .expect("session folder")
+        .map(|e| {
+            let e = e.expect("entry");
+            (e.file_name(), std::fs::read(e.path()).unwrap_or_default())
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+/// A hand-edited manifest naming a camera its session does not have
+/// (camera 9 of 4) is refused where it is read, naming the record, the
+/// camera and the line, and nothing is written; it was accepted, and the
+/// image's camera went to the report and to the console's next capture.
+#[test]
+fn a_manifest_naming_a_camera_the_session_lacks_is_refused() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let d = tmp.path();
+    write_profile(d);
+    let (ok, out) = vss(
+        d,
+        &["--profile", "p.toml", "session", "new", "w", "--dir", "."],
+    );
+    assert!(ok, "{out}");
+    let m = d.join("w/w.toml");
+    let good = std::fs::read_to_string(&m).expect("manifest");
+    let bad = format!("{good}\n[[image]]\nnumber = 2\ncamera = 9\nlocation = 1\n");
+    std::fs::write(&m, &bad).expect("edit manifest");
+    let before = files_of(&d.join("w"));
+    let line = bad.lines().position(|l| l == "camera = 9").expect("line") + 1;
+    for args in [
+        &["session", "show", "w"][..],
+        &["session", "check", "w"][..],
+        &[
+            "--profile",
+            "p.toml",
+            "session",
+            "redo",
+            "w",
+            "--image",
+            "2",
+        ][..],
+        &["report", "w"][..],
+    ] {
+        let o = Command::cargo_bin("vss")
+            .expect("the vss binary")
+            .args(args)
+            .current_dir(d)
+            .timeout(Duration::from_secs(60))
+            .output()
+            .expect("run vss");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains(&format!(
+                "w.toml:{line}: [[image]] number 2: camera 9 is not one of the session's \
+                 cameras, which run from 1 to 4"
+            )),
+            "{args:?}: {err}"
+        );
+        assert_eq!(
+            files_of(&d.join("w")),
+            before,
+            "{args:?} changed the session"
+        );
+    }
+}
+
+/// `vss grab` into a session made with fewer cameras than the profile's
+/// grabber has is refused before it records the camera: it wrote camera 3
+/// into a one-camera session, whose manifest then no longer read.
+#[test]
+fn grab_does_not_record_a_camera_the_session_lacks() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let d = tmp.path();
+    new_session(d);
+    write_profile(d);
+    let (ok, out) = vss(
+        d,
+        &[
+            "--profile",
+            "p.toml",
+            "grab",
+            "--session",
+            "w",
+            "--image",
+            "2",
+            "--camera",
+            "3",
+            "--lighting",
+            "a",
+        ],
+    );
+    assert!(!ok, "{out}");
+    assert!(
+        out.contains("camera 3 is not one of the session's cameras, which run from 1 to 1"),
+        "{out}"
+    );
+    let (ok, out) = vss(d, &["session", "show", "w"]);
+    assert!(ok, "the session still reads: {out}");
+}

@@ -9,10 +9,11 @@
 use std::path::PathBuf;
 use std::time::SystemTime;
 
+use vss::session::Session;
 use vss::session::lock::leave_path;
 use vss::tui::keymap::{Action, GlobalAction, ModalAction, Scope, ScreenId, SurveyAction};
 
-use super::tui_harness::{Console, SURVEY, flat};
+use super::tui_harness::{Console, SURVEY, flat, line_count};
 use super::tui_pty_readonly::files;
 
 /// The bottom rows of the screen, where the hints are (at most three).
@@ -25,12 +26,12 @@ fn hint_rows(s: &str) -> String {
 /// times, as the first console left them.
 type Before = (Vec<u8>, Vec<(PathBuf, u64, SystemTime)>);
 
-/// A first console that surveyed image 1 of `cube` and holds it, and a
-/// second one in the same folder that chose to look at it read-only; the
-/// folder as it was before the second started.
-fn looking() -> (Console, Console, Before) {
+/// A first console that surveyed images 1 to `n` of `cube` and holds it,
+/// and a second one in the same folder that chose to look at it
+/// read-only; the folder as it was before the second started.
+fn looking(n: u32) -> (Console, Console, Before) {
     let mut a = Console::start(80, 24, &[]);
-    a.survey(1);
+    a.survey(n);
     let dir = a.session();
     let held = std::fs::read(dir.join("cube.lock")).expect("the first console holds the lock");
     let before = files(&dir);
@@ -59,7 +60,7 @@ fn looking() -> (Console, Console, Before) {
 
 #[test]
 fn a_second_console_looks_at_a_held_session_without_disturbing_it() {
-    let (mut a, mut b, (held, before)) = looking();
+    let (mut a, mut b, (held, before)) = looking(1);
     let dir = a.session();
     let lock = dir.join("cube.lock");
     let s = b.screen();
@@ -72,9 +73,7 @@ fn a_second_console_looks_at_a_held_session_without_disturbing_it() {
     });
     b.press(Scope::Global, Action::Global(GlobalAction::ToggleLog));
     b.press(Scope::Global, Action::Global(GlobalAction::ToggleLog));
-    // Its image with its lines shows.
-    b.press(SURVEY, Action::Survey(SurveyAction::Up));
-    b.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    // Its image with its lines shows (the newest done image, opened on).
     b.wait_text("image 1a + lines", 20);
     // The first console was not disturbed: its lock is the same bytes, no
     // request to leave was made, no file of the folder changed.
@@ -107,16 +106,18 @@ fn a_second_console_looks_at_a_held_session_without_disturbing_it() {
 
 #[test]
 fn the_read_only_view_offers_only_the_keys_that_work_there() {
-    let (mut a, mut b, _) = looking();
+    let (mut a, mut b, _) = looking(1);
     // The writing console offers accept and redo on its hint rows ...
     let s = a.screen();
     assert!(hint_rows(&s).contains("a accept"), "{s}");
-    // ... the one only looking does not, on the image shown or the next.
-    for up in [false, true] {
-        if up {
-            b.press(SURVEY, Action::Survey(SurveyAction::Up));
+    // ... the one only looking does not, on the image shown (image 1, done,
+    // opened on) or the next.
+    b.wait_text("image 1a + lines", 20);
+    for next in [false, true] {
+        if next {
+            b.press(SURVEY, Action::Survey(SurveyAction::Down));
             b.press(SURVEY, Action::Survey(SurveyAction::Enter));
-            b.wait_text("image 1a + lines", 20);
+            b.wait("image 2 under work", 10, |s| s.contains(">  2 "));
         }
         let s = b.wait("the hints drawn", 10, |s| hint_rows(s).contains("o open"));
         let h = hint_rows(&s);
@@ -159,6 +160,37 @@ fn the_read_only_view_offers_only_the_keys_that_work_there() {
             );
         }
     }
+    b.send("q");
+    assert_eq!(b.wait_exit(10), 0);
+    a.send("q");
+    assert_eq!(a.wait_exit(10), 0);
+}
+
+/// Nothing can be captured in a read-only view: it opens on the newest
+/// done image, its row chosen, its frame with its lines shown and its line
+/// count on the Pipeline screen, without a key. It opened on the next image
+/// to capture (3), beside image 2's frame without its lines.
+#[test]
+fn opens_on_the_newest_done_image() {
+    let (mut a, mut b, _) = looking(2);
+    let s = b.wait_text("image 2a + lines", 20);
+    assert!(s.contains("2 of 4 done"), "{s}");
+    // Image 2's checklist row is the one under work, not image 3's.
+    assert!(s.contains(">  2 ") && !s.contains(">  3 "), "{s}");
+    let recorded = Session::inspect(&a.session())
+        .expect("the session reads")
+        .manifest()
+        .image(2)
+        .and_then(|r| r.outputs.as_ref())
+        .map(|o| o.counts.lines as usize)
+        .expect("image 2's outputs are recorded");
+    b.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
+    );
+    b.wait(&format!("image 2's {recorded} lines"), 10, |s| {
+        s.contains("image 2") && line_count(s) == Some(recorded)
+    });
     b.send("q");
     assert_eq!(b.wait_exit(10), 0);
     a.send("q");

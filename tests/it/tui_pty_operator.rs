@@ -4,7 +4,7 @@
 //! do nothing unseen; a frame changed since recorded is said on the
 //! Session screen.
 
-use super::tui_harness::Console;
+use super::tui_harness::{Console, flat};
 
 /// A session whose manifest does not read is listed as damaged; the
 /// error says to mend it "then open it again", and once mended (while
@@ -38,6 +38,40 @@ fn a_session_mended_while_the_console_runs_opens() {
     );
     c.send("q");
     c.wait_exit(10);
+}
+
+/// A manifest naming a camera its session does not have (camera 9) is
+/// listed as damaged and, asked for, said with its record and camera,
+/// the file left as it is; it opened, and the image's camera went to the
+/// next capture.
+#[test]
+fn a_session_naming_a_camera_it_lacks_is_said_damaged() {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("cube");
+    let m = c.session().join("cube.toml");
+    let good = std::fs::read_to_string(&m).unwrap();
+    let bad = format!("{good}\n[[image]]\nnumber = 99\ncamera = 9\nlocation = 1\n");
+    let mut c = c.restart_after(|dir| {
+        std::fs::write(dir.join("sessions/cube/cube.toml"), &bad).unwrap();
+    });
+    c.wait_text("DAMAGED", 10);
+    c.send("\r");
+    let s = c.wait_text("last message", 5);
+    let said = flat(&s.replace('│', " "));
+    assert!(
+        said.contains("cannot be opened")
+            && said.contains("[[image]] number 99: camera 9 is not one of the session's cameras"),
+        "{s}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(&m).unwrap(),
+        bad,
+        "the manifest is kept"
+    );
+    c.send("\x1b");
+    c.wait("the window closed", 5, |s| !s.contains("last message"));
+    c.send("q");
+    assert_eq!(c.wait_exit(10), 0);
 }
 
 /// While the terminal is too small the screen says only that, q quits

@@ -121,7 +121,15 @@ fn a_session_that_cannot_be_written_opens_only_to_look() {
     // The next step offers nothing that would write.
     let s = c.wait_words("Open only to look", 10);
     assert!(!flat(&s).contains("captures lightings"), "{s}");
-    // Enter on the image under work would capture: refused.
+    // It opens on its newest done image, with its lines, without a key;
+    // Enter there would accept it: refused.
+    c.wait_text("image 1a + lines", 20);
+    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    c.wait_words("accepting refused", 10);
+    // Enter on the next image would capture: refused.
+    c.press(SURVEY, Action::Survey(SurveyAction::Down));
+    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    c.wait("image 2 under work", 10, |s| s.contains(">  2 "));
     c.press(SURVEY, Action::Survey(SurveyAction::Enter));
     c.wait_words("capturing refused", 10);
     // Image 1 can be gone back to and seen with its lines ...

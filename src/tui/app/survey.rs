@@ -461,6 +461,12 @@ impl Ctx<'_> {
             ),
         };
         let resume = v.images.iter().any(|i| i.k == k && !i.captured.is_empty());
+        // Open only to look, nothing can be captured: the view opens on the
+        // newest image with results instead, as choosing it shows it.
+        let look_at = v
+            .read_only
+            .then(|| v.images.iter().filter(|i| i.done()).map(|i| i.k).max())
+            .flatten();
         self.session.work = Work {
             k,
             camera: self.session.work.camera.max(1),
@@ -481,6 +487,9 @@ impl Ctx<'_> {
         self.session.view = Some(v);
         self.follow_plan();
         self.tracker.current = None;
+        if let Some(d) = look_at {
+            return self.go_to(d);
+        }
         // The image the survey goes on with, or the last one worked on, so
         // the Pipeline and Edit screens show it at once.
         match (resume, last) {

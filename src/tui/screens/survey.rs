@@ -210,11 +210,7 @@ fn row_text(app: &App, k: u32) -> (String, bool) {
 fn checklist(app: &App, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
     let Some(v) = &app.session.view else { return };
-    let done = v
-        .images
-        .iter()
-        .filter(|i| i.outputs && !i.stale && i.damaged.is_empty() && i.outputs_damaged.is_none())
-        .count();
+    let done = v.images.iter().filter(|i| i.done()).count();
     let problems = v.problems();
     let mut lines = vec![
         Line::styled(
