@@ -9,10 +9,10 @@
 
 use vss::formats::cdf::{Status, read_cdf};
 use vss::tui::keymap::{
-    Action, CalibrateAction as CA, GlobalAction, PipelineAction, Scope, ScreenId,
+    Action, CalibrateAction as CA, GlobalAction, PipelineAction, Scope, ScreenId, SurveyAction,
 };
 
-use super::tui_harness::{Console, PIPELINE, flat};
+use super::tui_harness::{Console, PIPELINE, SURVEY, flat};
 
 /// The console with the built-in profile in an empty folder, `HOME` and
 /// the XDG folders in another empty one (kept alive by the caller).
@@ -153,6 +153,49 @@ fn a_camera_without_its_cdf_is_said_on_the_pipeline_screen() {
     );
     let s = c.wait_words("lens OFF — camera 1:", 30);
     assert!(super::tui_harness::flat(&s).contains("cam1.cdf"), "{s}");
+    c.send("q");
+    c.wait_exit(15);
+}
+
+/// A session surveyed with a profile of three cameras, opened with one of
+/// two: image 3's camera has no description here, and the Pipeline screen
+/// says lens correction is off for it and why (before, nothing was said:
+/// the camera was past the profile's list of descriptions).
+#[test]
+fn a_camera_past_the_profile_s_is_said_on_the_pipeline_screen() {
+    let three = super::tui_harness::five_lightings(true)
+        .replace("cameras = 2", "cameras = 3")
+        .replace(
+            r#"cdf = ["cam1.cdf", "cam2.cdf"]"#,
+            r#"cdf = ["cam1.cdf", "cam2.cdf", "cam3.cdf"]"#,
+        );
+    let mut c = Console::start_with(&three, 80, 24, &[], |d| {
+        super::tui_harness::write_cdfs(d, 3);
+    });
+    // Three images, one a camera (the last has no next image to wait for).
+    c.survey(2);
+    c.capture_current(3);
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    c.wait_text("image 3 accepted", 20);
+    let mut c = c.restart_after(|d| {
+        std::fs::write(
+            d.join("cell.toml"),
+            super::tui_harness::five_lightings(true),
+        )
+        .unwrap();
+    });
+    c.wait_text("choose a session", 10);
+    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    c.wait_text("session cube", 10);
+    c.press(SURVEY, Action::Survey(SurveyAction::Up));
+    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    c.wait_text("image 3a", 20);
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
+    );
+    let s = c.wait_words("lens OFF — camera 3: not one", 30);
+    assert!(s.contains("of this profile's 2 cameras,"), "{s}");
     c.send("q");
     c.wait_exit(15);
 }

@@ -476,8 +476,7 @@ impl CalibrateScreen {
             let why = ctx
                 .cell
                 .camera_problem(cam)
-                .unwrap_or("its camera description is not read yet")
-                .to_string();
+                .unwrap_or_else(|| "its camera description is not read yet".to_string());
             ctx.error(format!(
                 "camera {cam}: no scale S to calibrate with — {why}; `vss calibrate --camera {cam} --scale SX,SY IMAGES…` makes the first one"
             ));

@@ -98,11 +98,18 @@ impl CellState {
 
     /// Why camera `cam` (1-based) has no model for lens correction, once
     /// the store has said (`None` while it has not, or when it has one).
-    pub fn camera_problem(&self, cam: u32) -> Option<&str> {
-        self.camera_models
-            .get(cam.checked_sub(1)? as usize)?
-            .as_ref()
-            .err()
-            .map(String::as_str)
+    /// A camera past the profile's (a session made with a profile of more
+    /// cameras) has no `.cdf` here at all.
+    pub fn camera_problem(&self, cam: u32) -> Option<String> {
+        if self.camera_models.is_empty() {
+            return None;
+        }
+        match self.camera_models.get(cam.checked_sub(1)? as usize) {
+            Some(m) => m.as_ref().err().cloned(),
+            None => Some(format!(
+                "not one of this profile's {} cameras, so it has no camera description",
+                self.cameras
+            )),
+        }
     }
 }
