@@ -11,6 +11,10 @@
 //! - only when the lock is still held after [`LEAVE_WAIT`] is the holder
 //!   signalled (SIGTERM), and only the lock's own vss
 //!   ([`lock::ask_holder_to_leave`]).
+//!
+//! While it waits, the taker answers requests for what it holds itself
+//! ([`Taker::meanwhile`]): two consoles that each take over the other's
+//! session at once both get it, neither signalled.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -46,10 +50,33 @@ pub enum TakeOverError {
     },
 }
 
+/// Who takes a session over: it hears each step, and while it waits for
+/// the lock it may answer requests for a session it holds itself.
+pub trait Taker {
+    /// One step said ("asking process N to release…").
+    fn say(&mut self, text: String);
+
+    /// Run at every poll while the taker waits for the lock (at least
+    /// every 50 ms). A console that holds another session answers a
+    /// request to leave it here, as between commands: two consoles that
+    /// each take over the other's session at once would otherwise each
+    /// wait for an answer that never comes, and signal each other. A
+    /// taker that holds nothing else (the CLI) does nothing.
+    fn meanwhile(&mut self) {}
+}
+
+/// A taker that holds nothing else: its `say` alone (`vss grab`, `vss
+/// session redo`).
+impl<F: FnMut(String)> Taker for F {
+    fn say(&mut self, text: String) {
+        self(text)
+    }
+}
+
 /// Opens the session at `dir` for writing, taking it over from whoever
-/// holds it by the rule above; `say` hears each step ("asking process N
-/// to release…").
-pub fn open_taking_over(dir: &Path, say: &mut dyn FnMut(String)) -> Result<Session, TakeOverError> {
+/// holds it by the rule above; `taker` hears each step and answers, while
+/// it waits, requests for what it holds ([`Taker::meanwhile`]).
+pub fn open_taking_over(dir: &Path, taker: &mut dyn Taker) -> Result<Session, TakeOverError> {
     let inspected = Session::inspect(dir).ok();
     let holder = inspected.as_ref().and_then(Session::lock_holder);
     let local = holder
@@ -61,18 +88,18 @@ pub fn open_taking_over(dir: &Path, say: &mut dyn FnMut(String)) -> Result<Sessi
     let lock_path = s.lock_path();
     let leave = lock::leave_path(&lock_path);
     match lock::request_leave(&lock_path, h) {
-        Err(e) => say(format!(
+        Err(e) => taker.say(format!(
             "cannot ask process {} through {} ({e}): signalling it instead",
             h.pid,
             leave.display()
         )),
         Ok(()) => {
-            say(format!(
+            taker.say(format!(
                 "asking process {} to release session {}…",
                 h.pid,
                 dir.display()
             ));
-            if let Some(s) = wait_for_lock(dir, LEAVE_WAIT)? {
+            if let Some(s) = wait_for_lock(dir, LEAVE_WAIT, taker)? {
                 let _ = std::fs::remove_file(&leave);
                 return Ok(s);
             }
@@ -81,7 +108,7 @@ pub fn open_taking_over(dir: &Path, say: &mut dyn FnMut(String)) -> Result<Sessi
     // No answer: the request goes, and the holder is signalled — only the
     // lock's own vss.
     let _ = std::fs::remove_file(&leave);
-    say(format!(
+    taker.say(format!(
         "process {} did not release session {}: asking it to end…",
         h.pid,
         dir.display()
@@ -95,17 +122,23 @@ pub fn open_taking_over(dir: &Path, say: &mut dyn FnMut(String)) -> Result<Sessi
             why,
         });
     }
-    wait_for_lock(dir, SIGNAL_WAIT)?.ok_or_else(|| TakeOverError::NoAnswer {
+    wait_for_lock(dir, SIGNAL_WAIT, taker)?.ok_or_else(|| TakeOverError::NoAnswer {
         dir: dir.to_path_buf(),
         holder: h.to_string(),
     })
 }
 
-/// Opens `dir` once its lock is free (or stale), waiting at most `limit`;
-/// `None` if it is still held then.
-fn wait_for_lock(dir: &Path, limit: Duration) -> Result<Option<Session>, SessionError> {
+/// Opens `dir` once its lock is free (or stale), waiting at most `limit`
+/// and running `taker.meanwhile()` at every poll; `None` if it is still
+/// held then.
+fn wait_for_lock(
+    dir: &Path,
+    limit: Duration,
+    taker: &mut dyn Taker,
+) -> Result<Option<Session>, SessionError> {
     let end = Instant::now() + limit;
     loop {
+        taker.meanwhile();
         match Session::open(dir) {
             Ok(s) => return Ok(Some(s)),
             Err(SessionError::Locked { stale: true, .. }) => {
@@ -115,5 +148,64 @@ fn wait_for_lock(dir: &Path, limit: Duration) -> Result<Option<Session>, Session
             Err(SessionError::Locked { .. }) => std::thread::sleep(Duration::from_millis(50)),
             Err(e) => return Err(e),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A taker holding the session it asks for under another lock: its
+    /// `meanwhile` runs while it waits and releases that lock after a few
+    /// polls, as a console answering a request does.
+    struct Holding {
+        held: Option<Session>,
+        polls: u32,
+        said: Vec<String>,
+    }
+
+    impl Taker for Holding {
+        fn say(&mut self, text: String) {
+            self.said.push(text);
+        }
+
+        fn meanwhile(&mut self) {
+            self.polls += 1;
+            if self.polls == 3 {
+                self.held = None;
+            }
+        }
+    }
+
+    /// The wait for the lock runs the taker's `meanwhile` at each poll, so
+    /// a lock it releases there is taken at once: no signal, no 5 s wait
+    /// (the holder here is this process, which would be refused a signal).
+    #[test]
+    fn the_taker_answers_while_it_waits() {
+        let d = tempfile::tempdir().unwrap();
+        let profile = crate::profile::Profile::builtin().unwrap();
+        let held = Session::create(d.path(), "one", &profile).unwrap();
+        let dir = held.dir().to_path_buf();
+        let mut taker = Holding {
+            held: Some(held),
+            polls: 0,
+            said: Vec::new(),
+        };
+        let t0 = Instant::now();
+        let s = open_taking_over(&dir, &mut taker).expect("taken once released");
+        assert!(t0.elapsed() < LEAVE_WAIT, "{:?}", t0.elapsed());
+        assert!(taker.held.is_none() && taker.polls >= 3, "{}", taker.polls);
+        assert!(
+            taker.said[0].starts_with("asking process"),
+            "{:?}",
+            taker.said
+        );
+        assert_eq!(taker.said.len(), 1, "{:?}", taker.said);
+        // Taken: another open finds it held.
+        assert!(matches!(
+            Session::open(&dir),
+            Err(SessionError::Locked { stale: false, .. })
+        ));
+        assert!(!lock::leave_path(&s.lock_path()).exists());
     }
 }

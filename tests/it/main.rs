@@ -59,6 +59,7 @@ mod tui_harness;
 mod tui_pty;
 mod tui_pty_builtin;
 mod tui_pty_busy;
+mod tui_pty_crossover;
 mod tui_pty_edit;
 mod tui_pty_feedback;
 mod tui_pty_hidden;

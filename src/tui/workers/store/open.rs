@@ -6,7 +6,10 @@
 //! a take-over that failed) the old one stays open, its lock held, and
 //! the store says so: the console, which shows the old one until it hears
 //! [`StoreEvent::Opened`], and the store agree, and no other console can
-//! take the session this one still shows.
+//! take the session this one still shows. One exception: while a take-over
+//! waits, the old session is left to a console that asks for it (two
+//! consoles taking over each other's at once); when the new one then fails,
+//! no session is open, and that is said.
 
 use std::path::{Path, PathBuf};
 
@@ -57,8 +60,16 @@ impl Store {
             )));
             return;
         }
+        // The session held when asked: a take-over gives it up while it
+        // waits when its holder asks for it meanwhile (a crossed take-over).
+        let held = self
+            .session
+            .as_ref()
+            .filter(|_| !self.read_only)
+            .map(|s| s.name().to_string());
         match self.open_new(&how) {
             Ok(Some(s)) => {
+                // None left to close when it was given up meanwhile.
                 self.close();
                 let look = matches!(how, Opening::Look(_));
                 // Its lock is only read: a holder keeps it, unasked.
@@ -73,10 +84,10 @@ impl Store {
                     )));
                 }
             }
-            Ok(None) => self.say_kept(&how),
+            Ok(None) => self.say_kept(&how, held),
             Err(e) => {
                 self.reply(StoreEvent::Error(e));
-                self.say_kept(&how);
+                self.say_kept(&how, held);
             }
         }
     }
@@ -96,7 +107,7 @@ impl Store {
 
     /// Opens the session `how` asks for, leaving the open one alone;
     /// `None` when the operator is asked first (held, unwritable).
-    fn open_new(&self, how: &Opening) -> Result<Option<Session>, StoreError> {
+    fn open_new(&mut self, how: &Opening) -> Result<Option<Session>, StoreError> {
         let cannot = |d: &Path| session_err(format!("cannot open {}", d.display()));
         let dir = match how {
             Opening::Create(name) => {
@@ -134,35 +145,61 @@ impl Store {
         }
     }
 
-    /// Says which session stays open after `how` did not replace it.
-    fn say_kept(&self, how: &Opening) {
-        if let Some(s) = &self.session {
-            let kept = if self.read_only {
-                "only to look"
-            } else {
-                "its lock kept"
-            };
-            self.reply(StoreEvent::Note(format!(
-                "session {} is still open here, {kept}: {} was not opened",
-                s.name(),
+    /// Says which session stays open after `how` did not replace it, or,
+    /// when `held` (held when asked) was given up meanwhile, that none is.
+    fn say_kept(&self, how: &Opening, held: Option<String>) {
+        let text = match (&self.session, held) {
+            (Some(s), _) => {
+                let kept = if self.read_only {
+                    "only to look"
+                } else {
+                    "its lock kept"
+                };
+                format!(
+                    "session {} is still open here, {kept}: {} was not opened",
+                    s.name(),
+                    how.shown()
+                )
+            }
+            (None, Some(name)) => format!(
+                "no session is open here now: session {name} was left to the console that \
+                 asked for it while this one waited, and {} was not opened; choose or create \
+                 a session",
                 how.shown()
-            )));
-        }
+            ),
+            (None, None) => return,
+        };
+        self.reply(StoreEvent::Note(text));
     }
 
     /// Opens a session another vss holds, by the rule every take-over
     /// follows (`takeover::open_taking_over`: a live holder on this host
     /// is asked through the session folder, and signalled only when it
-    /// does not answer); each step is said.
-    fn take_over(&self, dir: &Path) -> Result<Session, StoreError> {
+    /// does not answer); each step is said. While it waits, a request for
+    /// the session this console holds is answered as between commands
+    /// ([`Store::leave_if_asked`]).
+    fn take_over(&mut self, dir: &Path) -> Result<Session, StoreError> {
         use crate::session::takeover::{self, TakeOverError};
-        let mut say = |text: String| self.reply(StoreEvent::Note(text));
-        takeover::open_taking_over(dir, &mut say).map_err(|e| match e {
+        takeover::open_taking_over(dir, &mut Taking(self)).map_err(|e| match e {
             TakeOverError::Session(e) => {
                 session_err(format!("cannot take over {}", dir.display()))(e)
             }
             e => StoreError::TakeOver(e),
         })
+    }
+}
+
+/// The store taking a session over: its steps are notes, and while it
+/// waits it answers a request to leave the session it still holds.
+struct Taking<'a>(&'a mut Store);
+
+impl crate::session::takeover::Taker for Taking<'_> {
+    fn say(&mut self, text: String) {
+        self.0.reply(StoreEvent::Note(text));
+    }
+
+    fn meanwhile(&mut self) {
+        self.0.leave_if_asked();
     }
 }
 
