@@ -185,6 +185,8 @@ fn a_camera_past_the_profile_s_is_said_on_the_pipeline_screen() {
         .unwrap();
     });
     c.wait_text("choose a session", 10);
+    // The list read (Enter on it before then opens nothing).
+    c.wait_text(" cube ", 10);
     c.press(SURVEY, Action::Survey(SurveyAction::Enter));
     c.wait_text("session cube", 10);
     c.press(SURVEY, Action::Survey(SurveyAction::Up));

@@ -26,6 +26,10 @@ const DOWN: &str = "\x1b[B";
 fn ask_for(c: &mut Console, from: &str, to: &str, step: &str) {
     c.press(SURVEY, Action::Survey(SurveyAction::OpenPicker));
     c.wait_words("choose a session", 10);
+    // Both rows read (a step before then moves nothing).
+    c.wait(&format!("{to} listed"), 10, |s| {
+        s.contains(&format!(" {to} ")) && s.contains(&format!(" {from} ")) && s.contains("/4 done")
+    });
     c.send(step);
     c.press(SURVEY, Action::Survey(SurveyAction::Enter));
     c.wait_words(&format!("Leave session {from} and open session {to}?"), 10);

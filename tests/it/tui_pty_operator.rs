@@ -119,6 +119,8 @@ fn a_frame_changed_since_recorded_is_said_on_the_session_screen() {
         std::fs::write(&img, bytes).unwrap();
     });
     c.wait_text("choose a session", 10);
+    // The list read (Enter on it before then opens nothing).
+    c.wait_text(" cube ", 10);
     c.send("\r");
     c.wait_text("lightings abc", 10);
     c.send("5");
