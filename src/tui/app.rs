@@ -204,6 +204,7 @@ impl App {
         };
         let before = self.chrome.log.pushed();
         let cmds = self.apply(msg);
+        self.note_opening(&cmds);
         self.close_stale_question();
         let now = std::time::Instant::now();
         if by_operator {

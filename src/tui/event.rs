@@ -320,6 +320,12 @@ pub enum StoreEvent {
         error: StoreError,
     },
     Error(StoreError),
+    /// A session asked for ([`StoreCmd::Create`], `Open`, `TakeOver`,
+    /// `OpenReadOnly`) is open, or was not opened: its outcome is said
+    /// before this. Until then the console refuses what would write
+    /// ([`crate::tui::App::refused_here`]): the store would do it in the
+    /// session it opens, not in the one on screen.
+    OpeningDone,
 }
 
 /// Commands from the UI to its workers.

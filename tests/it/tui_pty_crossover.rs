@@ -136,3 +136,60 @@ fn two_consoles_taking_over_each_others_session_at_once_both_get_it() {
     b.send("q");
     assert_eq!(b.wait_exit(10), 0);
 }
+
+/// While a take-over waits for a holder that does not answer (stopped
+/// here; SIGCONT lets it end on the signal the taker sends), `a` on the
+/// image under review is refused, saying why: the store does its commands
+/// in order, and before, the accept was done after the switch, writing
+/// this session's image 1 into the session taken over.
+#[test]
+fn writes_wait_while_another_session_is_being_opened() {
+    let mut a = Console::start(80, 24, &[]);
+    a.survey(1);
+    let cube = a.session();
+    let ldr = cube.join("cube1.ldr");
+    // Its bytes and time: B's image 1 may have the same lines (the same
+    // camera sees the same scene), its writing would still show.
+    let stamp = |p: &Path| {
+        let m = std::fs::metadata(p).expect("cube's image 1 lines");
+        (std::fs::read(p).unwrap(), m.modified().unwrap())
+    };
+    let before = stamp(&ldr);
+    let mut b = a.another(80, 24);
+    b.wait_text("in use by", 10);
+    b.create_session("two");
+    b.capture_current(1);
+    let a_pid = a.child.process_id().expect("A's pid").to_string();
+    let signal = |s: &str| {
+        let ok = std::process::Command::new("kill")
+            .args([s, &a_pid])
+            .status();
+        assert!(ok.is_ok_and(|st| st.success()), "kill {s}");
+    };
+    signal("-STOP");
+    ask_for(&mut b, "two", "cube", DOWN);
+    b.yes();
+    b.wait_words("asking process", 10);
+    b.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    let s = b.wait_words("accepting refused: session cube is being opened", 10);
+    assert!(!s.contains("image 1 accepted"), "{s}");
+    // Past the wait for an answer: A is signalled, and let go on.
+    b.wait_words("asking it to end", 15);
+    signal("-CONT");
+    wait_open(&mut b, "cube");
+    assert_eq!(
+        a.wait_exit(15),
+        143,
+        "A ended on the signal (128 + SIGTERM)"
+    );
+    // Cube's image 1 is A's, untouched; two's image 1 was not accepted.
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(stamp(&ldr) == before, "cube1.ldr untouched");
+    let two = Session::inspect(&a.sessions().join("two")).unwrap();
+    assert!(
+        two.manifest().image(1).is_none_or(|r| r.outputs.is_none()),
+        "two's image 1 not accepted"
+    );
+    b.send("q");
+    assert_eq!(b.wait_exit(10), 0);
+}

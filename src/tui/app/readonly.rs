@@ -5,9 +5,16 @@
 //! is refused here, before anything changes, with what was refused. The
 //! hint line offers only the keys [`App::refused_here`] lets through. The
 //! store refuses the same writes again.
+//!
+//! The same refusals hold while another session is being opened (a
+//! take-over waits up to seconds for its holder): the store does its
+//! commands in order, so a save asked meanwhile would land in the session
+//! it opens, not in the one on screen.
 
 use super::App;
+use crate::tui::event::{Cmd, StoreCmd};
 use crate::tui::keymap::{Action, EditAction, FilesAction, PipelineAction, SurveyAction};
+use crate::tui::text::clean;
 
 /// The status line's words for such a session.
 pub const READ_ONLY: &str = "read-only: nothing will be saved";
@@ -23,7 +30,7 @@ impl App {
     /// what works read-only: the refusal ([`App::act`]) and the hint line
     /// both follow it.
     pub fn refused_here(&self, a: Action) -> Option<&'static str> {
-        if !self.read_only() {
+        if !self.read_only() && self.session.opening.is_empty() {
             return None;
         }
         match a {
@@ -31,6 +38,25 @@ impl App {
             Action::Survey(SurveyAction::Camera) => Some("choosing a capture's camera"),
             Action::Survey(SurveyAction::Location) => Some("choosing a capture's location"),
             a => self.would_write(a),
+        }
+    }
+
+    /// Notes a session asked of the store in `cmds` ([`App::update`]'s),
+    /// as said: writes wait until the store says it is done
+    /// ([`crate::tui::event::StoreEvent::OpeningDone`]).
+    pub(super) fn note_opening(&mut self, cmds: &[Cmd]) {
+        for c in cmds {
+            let asked = match c {
+                Cmd::Store(StoreCmd::Create(name)) => format!("new session {name}"),
+                Cmd::Store(
+                    StoreCmd::Open(d) | StoreCmd::TakeOver(d) | StoreCmd::OpenReadOnly(d),
+                ) => format!(
+                    "session {}",
+                    d.file_name().unwrap_or(d.as_os_str()).to_string_lossy()
+                ),
+                _ => continue,
+            };
+            self.session.opening.push(clean(&asked));
         }
     }
 
@@ -77,6 +103,14 @@ impl App {
         let Some(what) = self.refused_here(a) else {
             return false;
         };
+        if let Some(next) = self.session.opening.last() {
+            let msg = format!(
+                "{what} refused: {next} is being opened — wait until it is (the store would \
+                 write it there, not into the session on screen)"
+            );
+            self.ctx().warn(msg);
+            return true;
+        }
         let name = self
             .session
             .view

@@ -299,6 +299,12 @@ impl App {
                 self.ctx().info(clean(&what));
                 Vec::new()
             }
+            StoreEvent::OpeningDone => {
+                if !self.session.opening.is_empty() {
+                    self.session.opening.remove(0);
+                }
+                Vec::new()
+            }
             StoreEvent::Reports { paths, problems } => {
                 // One message: the survey's page and how many image pages,
                 // and the problems the report shows (said here, not only

@@ -27,6 +27,13 @@ pub struct SessionState {
     ///
     /// [`App::due`]: super::App::due
     pub looked: Option<std::time::Instant>,
+    /// Sessions asked of the store and not opened or refused yet (what was
+    /// asked, as said; oldest first, one [`StoreEvent::OpeningDone`] each):
+    /// until none is left, writes are refused ([`App::refused_here`]).
+    ///
+    /// [`StoreEvent::OpeningDone`]: crate::tui::event::StoreEvent::OpeningDone
+    /// [`App::refused_here`]: super::App::refused_here
+    pub opening: Vec<String>,
 }
 
 /// An image whose outputs are not saved, and why.

@@ -51,8 +51,14 @@ impl Store {
     /// Replaces the open session by `how` (the rule above), saying each
     /// outcome: [`StoreEvent::Opened`], or why not — a question for the
     /// operator ([`StoreEvent::Locked`], [`StoreEvent::Unwritable`]) or an
-    /// error — followed by which session stays open, if one does.
+    /// error — followed by which session stays open, if one does; then
+    /// [`StoreEvent::OpeningDone`], whatever the outcome.
     pub(super) fn replace(&mut self, how: Opening) {
+        self.open_instead(how);
+        self.reply(StoreEvent::OpeningDone);
+    }
+
+    fn open_instead(&mut self, how: Opening) {
         if let Some(name) = self.holding(&how) {
             // Its lock is ours: opening it again would find it held.
             self.reply(StoreEvent::Note(format!(
