@@ -93,6 +93,28 @@ fn name_of(pid: u32) -> String {
 mod tests {
     use super::*;
 
+    /// What [`describe`] says of `asked` while `sh -c script FILE` runs
+    /// (it says "ready" once it holds what it holds), and the shell's
+    /// process number.
+    fn while_held(script: &str, file: &Path, asked: &Path) -> (String, u32) {
+        let mut child = std::process::Command::new("sh")
+            .arg("-c")
+            .arg(script)
+            .arg("sh")
+            .arg(file)
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut out = child.stdout.take().unwrap();
+        let mut buf = [0u8; 6];
+        std::io::Read::read_exact(&mut out, &mut buf).unwrap();
+        let said = describe(asked);
+        drop(child.stdin.take());
+        child.wait().unwrap();
+        (said, child.id())
+    }
+
     #[test]
     fn finds_the_process_that_holds_a_file_open_through_a_link() {
         let dir = tempfile::tempdir().unwrap();
@@ -102,22 +124,8 @@ mod tests {
         std::os::unix::fs::symlink(&file, &link).unwrap();
         assert_eq!(describe(&link), "another program", "nobody holds it yet");
         // A child holds it open (this process's own files do not count).
-        let mut child = std::process::Command::new("sh")
-            .arg("-c")
-            .arg("exec 3<\"$1\"; echo ready; read _")
-            .arg("sh")
-            .arg(&file)
-            .stdin(std::process::Stdio::piped())
-            .stdout(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
-        let mut out = child.stdout.take().unwrap();
-        let mut buf = [0u8; 6];
-        std::io::Read::read_exact(&mut out, &mut buf).unwrap();
-        let said = describe(&link);
-        drop(child.stdin.take());
-        child.wait().unwrap();
-        assert_eq!(said, format!("sh (process {})", child.id()));
+        let (said, sh) = while_held("exec 3<\"$1\"; echo ready; read _", &file, &link);
+        assert_eq!(said, format!("sh (process {sh})"));
     }
 
     #[test]
@@ -125,26 +133,16 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let file = dir.path().join("port");
         std::fs::write(&file, b"").unwrap();
-        // `sh` opens the file, then `flock` locks it (its own open file)
-        // while `sh` still has it open: the lock's holder is the answer.
-        let mut child = std::process::Command::new("sh")
-            .arg("-c")
-            .arg("exec 3<\"$1\"; flock \"$1\" sh -c 'echo ready; read _'")
-            .arg("sh")
-            .arg(&file)
-            .stdin(std::process::Stdio::piped())
-            .stdout(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
-        let mut out = child.stdout.take().unwrap();
-        let mut buf = [0u8; 6];
-        std::io::Read::read_exact(&mut out, &mut buf).unwrap();
-        let said = describe(&file);
-        drop(child.stdin.take());
-        child.wait().unwrap();
+        // `sh` opens the file, then `flock`, its child, locks it (its own
+        // open file) while `sh` still has it open.
+        let (said, sh) = while_held(
+            "exec 3<\"$1\"; flock \"$1\" sh -c 'echo ready; read _'",
+            &file,
+            &file,
+        );
         // The first `sh` (the lowest process number with the file open)
-        // does not hold the lock; `flock`, its child, does.
+        // does not hold the lock; `flock` does.
         assert!(said.starts_with("flock (process "), "{said}");
-        assert_ne!(said, format!("flock (process {})", child.id()));
+        assert_ne!(said, format!("flock (process {sh})"));
     }
 }

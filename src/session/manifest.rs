@@ -680,46 +680,32 @@ mod tests {
     fn records_naming_a_camera_the_session_lacks_are_refused_at_their_line() {
         // The session has cameras 1 to 4; `full` names 3 (image 7) and 2
         // (its calibration).
+        let refused = |m: Manifest, record: &str, camera: u32| {
+            let text = m.to_toml().unwrap();
+            let err = Manifest::parse(&text, Path::new("cube.toml"))
+                .unwrap_err()
+                .to_string();
+            let line = text
+                .lines()
+                .position(|l| l == format!("camera = {camera}"))
+                .unwrap()
+                + 1;
+            assert!(err.starts_with(&format!("cube.toml:{line}:")), "{err}");
+            assert!(
+                err.contains(&format!(
+                    "{record}: camera {camera} is not one of the session's cameras, which run \
+                     from 1 to 4"
+                )),
+                "{err}"
+            );
+        };
         for camera in [0, 5, 9, u32::MAX] {
             let mut m = full();
             m.image[0].camera = camera;
-            let text = m.to_toml().unwrap();
-            let err = Manifest::parse(&text, Path::new("cube.toml"))
-                .unwrap_err()
-                .to_string();
-            let line = text
-                .lines()
-                .position(|l| l == format!("camera = {camera}"))
-                .unwrap()
-                + 1;
-            assert!(err.starts_with(&format!("cube.toml:{line}:")), "{err}");
-            assert!(
-                err.contains(&format!(
-                    "[[image]] number 7: camera {camera} is not one of the session's cameras, \
-                     which run from 1 to 4"
-                )),
-                "{err}"
-            );
-
+            refused(m, "[[image]] number 7", camera);
             let mut m = full();
             m.calibration[0].camera = camera;
-            let text = m.to_toml().unwrap();
-            let err = Manifest::parse(&text, Path::new("cube.toml"))
-                .unwrap_err()
-                .to_string();
-            let line = text
-                .lines()
-                .position(|l| l == format!("camera = {camera}"))
-                .unwrap()
-                + 1;
-            assert!(err.starts_with(&format!("cube.toml:{line}:")), "{err}");
-            assert!(
-                err.contains(&format!(
-                    "[[calibration]] made 2026-01-01T00:00:00Z: camera {camera} is not one of \
-                     the session's cameras"
-                )),
-                "{err}"
-            );
+            refused(m, "[[calibration]] made 2026-01-01T00:00:00Z", camera);
         }
         // The last camera is one of them.
         let mut m = full();
