@@ -42,6 +42,11 @@ pub enum TakeOverError {
         dir.display()
     )]
     NoAnswer { dir: PathBuf, holder: String },
+    #[error(
+        "the take-over of session {} was given up before {holder} was signalled; nothing changed",
+        dir.display()
+    )]
+    GivenUp { dir: PathBuf, holder: String },
     #[error("session {} is held by {holder}, which was not asked to end: {why}; nothing changed", dir.display())]
     Refused {
         dir: PathBuf,
@@ -63,6 +68,12 @@ pub trait Taker {
     /// wait for an answer that never comes, and signal each other. A
     /// taker that holds nothing else (the CLI) does nothing.
     fn meanwhile(&mut self) {}
+
+    /// Whether the taker gave up meanwhile (a console that quits): the
+    /// request is withdrawn and the holder not signalled.
+    fn given_up(&self) -> bool {
+        false
+    }
 }
 
 /// A taker that holds nothing else: its `say` alone (`vss grab`, `vss
@@ -106,8 +117,14 @@ pub fn open_taking_over(dir: &Path, taker: &mut dyn Taker) -> Result<Session, Ta
         }
     }
     // No answer: the request goes, and the holder is signalled — only the
-    // lock's own vss.
+    // lock's own vss — unless the taker gave up meanwhile.
     let _ = std::fs::remove_file(&leave);
+    if taker.given_up() {
+        return Err(TakeOverError::GivenUp {
+            dir: dir.to_path_buf(),
+            holder: h.to_string(),
+        });
+    }
     taker.say(format!(
         "process {} did not release session {}: asking it to end…",
         h.pid,
@@ -130,7 +147,7 @@ pub fn open_taking_over(dir: &Path, taker: &mut dyn Taker) -> Result<Session, Ta
 
 /// Opens `dir` once its lock is free (or stale), waiting at most `limit`
 /// and running `taker.meanwhile()` at every poll; `None` if it is still
-/// held then.
+/// held then, or at once when the taker gives up.
 fn wait_for_lock(
     dir: &Path,
     limit: Duration,
@@ -139,6 +156,9 @@ fn wait_for_lock(
     let end = Instant::now() + limit;
     loop {
         taker.meanwhile();
+        if taker.given_up() {
+            return Ok(None);
+        }
         match Session::open(dir) {
             Ok(s) => return Ok(Some(s)),
             Err(SessionError::Locked { stale: true, .. }) => {

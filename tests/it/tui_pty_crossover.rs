@@ -193,3 +193,52 @@ fn writes_wait_while_another_session_is_being_opened() {
     b.send("q");
     assert_eq!(b.wait_exit(10), 0);
 }
+
+/// A console that quits while its take-over waits for a holder that does
+/// not answer gives the take-over up: the request is withdrawn and the
+/// holder is never signalled. Before, the quitting console went on
+/// waiting (up to 10 s, nothing on screen) and signalled the holder after
+/// 5 s: the operator had changed their mind, and the other console ended.
+#[test]
+fn a_console_that_quits_during_a_take_over_signals_nobody() {
+    let mut a = Console::start(80, 24, &[]);
+    a.survey(1);
+    let cube = a.session();
+    let a_pid = a.child.process_id().expect("A's pid").to_string();
+    let signal = |s: &str| {
+        let ok = std::process::Command::new("kill")
+            .args([s, &a_pid])
+            .status();
+        assert!(ok.is_ok_and(|st| st.success()), "kill {s}");
+    };
+    let mut b = a.another(80, 24);
+    b.wait_text("in use by", 10);
+    signal("-STOP");
+    b.wait_text(" cube ", 10);
+    b.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    b.wait_text("over anyway?", 10);
+    b.yes();
+    b.wait_words("asking process", 10);
+    b.send("q");
+    b.wait_exit(15);
+    // Past the wait after which the holder would have been signalled.
+    std::thread::sleep(Duration::from_secs(6));
+    signal("-CONT");
+    std::thread::sleep(Duration::from_secs(2));
+    assert_eq!(
+        a.exit_code(),
+        None,
+        "A was signalled; screen:\n{}",
+        a.screen()
+    );
+    assert_eq!(
+        read_holder(&cube.join("cube.lock")).map(|h| h.pid.to_string()),
+        Some(a_pid.clone())
+    );
+    assert!(
+        !leave_path(&cube.join("cube.lock")).exists(),
+        "request withdrawn"
+    );
+    a.send("q");
+    assert_eq!(a.wait_exit(10), 0);
+}

@@ -8,6 +8,8 @@
 //! cannot be opened leaves the open one open and held.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -45,6 +47,9 @@ fn session_err(what: impl Into<String>) -> impl Fn(SessionError) -> StoreError {
 pub struct StoreHandle {
     tx: Sender<StoreCmd>,
     join: JoinHandle<()>,
+    /// Set when the console quits: a take-over still waiting gives up
+    /// rather than signal a holder for a console that is gone.
+    quitting: Arc<AtomicBool>,
 }
 
 impl StoreHandle {
@@ -54,6 +59,7 @@ impl StoreHandle {
 
     /// Closes the queue and waits (at most `limit`) for the saves in it.
     pub fn finish(self, limit: Duration) {
+        self.quitting.store(true, Ordering::SeqCst);
         drop(self.tx);
         let end = Instant::now() + limit;
         while !self.join.is_finished() && Instant::now() < end {
@@ -67,10 +73,16 @@ impl StoreHandle {
 
 pub fn spawn(profile: Profile, ui: Sender<Msg>) -> std::io::Result<StoreHandle> {
     let (tx, rx) = mpsc::channel();
+    let quitting = Arc::new(AtomicBool::new(false));
+    let q = Arc::clone(&quitting);
     let join = std::thread::Builder::new()
         .name("vss-store".into())
-        .spawn(move || Store::new(profile, ui).run(rx))?;
-    Ok(StoreHandle { tx, join })
+        .spawn(move || {
+            let mut s = Store::new(profile, ui);
+            s.quitting = q;
+            s.run(rx)
+        })?;
+    Ok(StoreHandle { tx, join, quitting })
 }
 
 /// The disk side of the console; usable without a thread (tests, benches).
@@ -88,6 +100,8 @@ pub struct Store {
     /// What the session open only to look was last read from
     /// ([`StoreCmd::Relook`]).
     looked: Option<list::Stamp>,
+    /// The console quits ([`StoreHandle::finish`]).
+    quitting: Arc<AtomicBool>,
 }
 
 /// What a session open only to look rests on: its folder, manifest and
@@ -107,6 +121,7 @@ impl Store {
             lister: list::Lister::default(),
             read_only: false,
             looked: None,
+            quitting: Arc::default(),
         }
     }
 

@@ -195,8 +195,9 @@ impl Store {
     }
 }
 
-/// The store taking a session over: its steps are notes, and while it
-/// waits it answers a request to leave the session it still holds.
+/// The store taking a session over: its steps are notes, while it waits it
+/// answers a request to leave the session it still holds, and it gives up
+/// (no signal) when the console quits.
 struct Taking<'a>(&'a mut Store);
 
 impl crate::session::takeover::Taker for Taking<'_> {
@@ -206,6 +207,10 @@ impl crate::session::takeover::Taker for Taking<'_> {
 
     fn meanwhile(&mut self) {
         self.0.leave_if_asked();
+    }
+
+    fn given_up(&self) -> bool {
+        self.0.quitting.load(std::sync::atomic::Ordering::SeqCst)
     }
 }
 
