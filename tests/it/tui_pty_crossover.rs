@@ -213,6 +213,9 @@ fn a_console_that_quits_during_a_take_over_signals_nobody() {
     };
     let mut b = a.another(80, 24);
     b.wait_text("in use by", 10);
+    // Its devices found first, so that what the take-over says is the
+    // newest message (under load the devices' line came after it).
+    b.wait_text("grabber", 20);
     signal("-STOP");
     b.wait_text(" cube ", 10);
     b.press(SURVEY, Action::Survey(SurveyAction::Enter));
