@@ -149,11 +149,12 @@ fn tries(n: u32) -> String {
 }
 
 impl RigError {
-    /// Whether the device has gone away (unplugged, powered off).
+    /// Whether another program holds the port ([`RigError::Busy`]).
     pub fn is_busy(&self) -> bool {
         matches!(self, RigError::Busy { .. })
     }
 
+    /// Whether the device has gone away (unplugged, powered off).
     pub fn is_vanished(&self) -> bool {
         matches!(
             self,

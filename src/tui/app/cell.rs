@@ -16,7 +16,8 @@ pub struct DeviceState {
     pub grabber: String,
     pub relay: String,
     pub lost: Option<String>,
-    /// What `lost` says is another program holding a port, not a fault.
+    /// What `lost` says is another program holding a port, not a fault
+    /// ([`DeviceState::lost_word`]).
     pub busy: bool,
     pub lights_on: Vec<String>,
     pub mask: u32,
@@ -55,6 +56,14 @@ pub struct CellState {
     pub device: DeviceState,
     /// The latest frame of the live view or a single grab (camera, image).
     pub live: Option<(u32, GreyImage)>,
+}
+
+impl DeviceState {
+    /// What the screens call a device that does not answer: "BUSY" when
+    /// another program holds its port, else "LOST".
+    pub fn lost_word(&self) -> &'static str {
+        if self.busy { "BUSY" } else { "LOST" }
+    }
 }
 
 impl CellState {

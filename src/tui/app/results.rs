@@ -79,10 +79,10 @@ impl App {
                 dev.lost = Some(e.clone());
                 dev.busy = busy;
                 dev.transfer = None;
+                let word = dev.lost_word().to_ascii_lowercase();
                 if new {
-                    let what = if busy { "device busy" } else { "device lost" };
                     self.ctx()
-                        .error(format!("{what}: {e} — retrying; saved work is safe"));
+                        .error(format!("device {word}: {e} — retrying; saved work is safe"));
                 }
                 Vec::new()
             }

@@ -19,10 +19,7 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     let mut lines = vec![
         Line::styled("grabber", t.title()),
         if let Some(e) = &d.lost {
-            Line::styled(
-                format!(" {}: {e}", if d.busy { "BUSY" } else { "LOST" }),
-                t.error(),
-            )
+            Line::styled(format!(" {}: {e}", d.lost_word()), t.error())
         } else if d.connected {
             Line::raw(format!(" {}", d.grabber))
         } else {

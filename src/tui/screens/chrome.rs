@@ -243,12 +243,10 @@ fn hint_spans(app: &App) -> Vec<Span<'static>> {
     let mut spans = Vec::new();
     if let Some(lost) = &d.lost {
         // Word by word, so that the hint rows wrap it whole.
-        let what = if d.busy {
-            "DEVICE BUSY: "
-        } else {
-            "DEVICE LOST: "
-        };
-        spans.push(Span::styled(what, t.error()));
+        spans.push(Span::styled(
+            format!("DEVICE {}: ", d.lost_word()),
+            t.error(),
+        ));
         for w in lost.split_whitespace() {
             spans.push(Span::styled(format!("{w} "), t.error()));
         }
