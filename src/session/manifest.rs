@@ -650,16 +650,7 @@ mod tests {
 
         let mut m = full();
         m.image[0].number = MAX_IMAGE_NUMBER + 1;
-        let text = m.to_toml().unwrap();
-        let err = Manifest::parse(&text, Path::new("cube.toml"))
-            .unwrap_err()
-            .to_string();
-        let line = text
-            .lines()
-            .position(|l| l == format!("number = {}", MAX_IMAGE_NUMBER + 1))
-            .unwrap()
-            + 1;
-        assert!(err.starts_with(&format!("cube.toml:{line}:")), "{err}");
+        let err = refused_at(&m, &format!("number = {}", MAX_IMAGE_NUMBER + 1));
         assert!(err.contains(&format!("1 to {MAX_IMAGE_NUMBER}")), "{err}");
 
         let mut m = full();
@@ -676,21 +667,24 @@ mod tests {
         assert!(err.to_string().contains("format 9"), "{err}");
     }
 
+    /// The error of `m` written and read back as `cube.toml`, which must
+    /// name the line of the first `key_line` (the record's key and value).
+    fn refused_at(m: &Manifest, key_line: &str) -> String {
+        let text = m.to_toml().unwrap();
+        let err = Manifest::parse(&text, Path::new("cube.toml"))
+            .unwrap_err()
+            .to_string();
+        let line = text.lines().position(|l| l == key_line).unwrap() + 1;
+        assert!(err.starts_with(&format!("cube.toml:{line}:")), "{err}");
+        err
+    }
+
     #[test]
     fn records_naming_a_camera_the_session_lacks_are_refused_at_their_line() {
         // The session has cameras 1 to 4; `full` names 3 (image 7) and 2
         // (its calibration).
         let refused = |m: Manifest, record: &str, camera: u32| {
-            let text = m.to_toml().unwrap();
-            let err = Manifest::parse(&text, Path::new("cube.toml"))
-                .unwrap_err()
-                .to_string();
-            let line = text
-                .lines()
-                .position(|l| l == format!("camera = {camera}"))
-                .unwrap()
-                + 1;
-            assert!(err.starts_with(&format!("cube.toml:{line}:")), "{err}");
+            let err = refused_at(&m, &format!("camera = {camera}"));
             assert!(
                 err.contains(&format!(
                     "{record}: camera {camera} is not one of the session's cameras, which run \

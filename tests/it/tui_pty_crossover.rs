@@ -8,7 +8,7 @@
 //! before is still in its session. Two real consoles on real ptys at
 //! 80 × 24.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use vss::session::Session;
@@ -75,16 +75,32 @@ fn image_1_kept(dir: &Path) {
     );
 }
 
-#[test]
-fn two_consoles_taking_over_each_others_session_at_once_both_get_it() {
-    // A surveys image 1 of cube and holds it.
+/// Console A, which surveyed image 1 of `cube` and holds it, and console
+/// B in the same folder, which sees it held; cube's folder.
+fn cube_held() -> (Console, Console, PathBuf) {
     let mut a = Console::start(80, 24, &[]);
     a.survey(1);
     let cube = a.session();
+    let b = a.another(80, 24);
+    b.wait_text("in use by", 10);
+    (a, b, cube)
+}
+
+/// Sends `sig` (`-STOP`, `-CONT`) to console `c`.
+fn signal(c: &Console, sig: &str) {
+    let pid = c.child.process_id().expect("its pid").to_string();
+    let ok = std::process::Command::new("kill")
+        .args([sig, &pid])
+        .status();
+    assert!(ok.is_ok_and(|st| st.success()), "kill {sig} {pid}");
+}
+
+#[test]
+fn two_consoles_taking_over_each_others_session_at_once_both_get_it() {
+    // A surveys image 1 of cube and holds it.
+    let (mut a, mut b, cube) = cube_held();
     let two = a.sessions().join("two");
     // B, in the same folder, makes session two and accepts image 1 there.
-    let mut b = a.another(80, 24);
-    b.wait_text("in use by", 10);
     b.create_session("two");
     b.capture_current(1);
     b.press(SURVEY, Action::Survey(SurveyAction::Accept));
@@ -144,9 +160,7 @@ fn two_consoles_taking_over_each_others_session_at_once_both_get_it() {
 /// this session's image 1 into the session taken over.
 #[test]
 fn writes_wait_while_another_session_is_being_opened() {
-    let mut a = Console::start(80, 24, &[]);
-    a.survey(1);
-    let cube = a.session();
+    let (mut a, mut b, cube) = cube_held();
     let ldr = cube.join("cube1.ldr");
     // Its bytes and time: B's image 1 may have the same lines (the same
     // camera sees the same scene), its writing would still show.
@@ -155,18 +169,9 @@ fn writes_wait_while_another_session_is_being_opened() {
         (std::fs::read(p).unwrap(), m.modified().unwrap())
     };
     let before = stamp(&ldr);
-    let mut b = a.another(80, 24);
-    b.wait_text("in use by", 10);
     b.create_session("two");
     b.capture_current(1);
-    let a_pid = a.child.process_id().expect("A's pid").to_string();
-    let signal = |s: &str| {
-        let ok = std::process::Command::new("kill")
-            .args([s, &a_pid])
-            .status();
-        assert!(ok.is_ok_and(|st| st.success()), "kill {s}");
-    };
-    signal("-STOP");
+    signal(&a, "-STOP");
     ask_for(&mut b, "two", "cube", DOWN);
     b.yes();
     b.wait_words("asking process", 10);
@@ -175,7 +180,7 @@ fn writes_wait_while_another_session_is_being_opened() {
     assert!(!s.contains("image 1 accepted"), "{s}");
     // Past the wait for an answer: A is signalled, and let go on.
     b.wait_words("asking it to end", 15);
-    signal("-CONT");
+    signal(&a, "-CONT");
     wait_open(&mut b, "cube");
     assert_eq!(
         a.wait_exit(15),
@@ -201,22 +206,12 @@ fn writes_wait_while_another_session_is_being_opened() {
 /// 5 s: the operator had changed their mind, and the other console ended.
 #[test]
 fn a_console_that_quits_during_a_take_over_signals_nobody() {
-    let mut a = Console::start(80, 24, &[]);
-    a.survey(1);
-    let cube = a.session();
+    let (mut a, mut b, cube) = cube_held();
     let a_pid = a.child.process_id().expect("A's pid").to_string();
-    let signal = |s: &str| {
-        let ok = std::process::Command::new("kill")
-            .args([s, &a_pid])
-            .status();
-        assert!(ok.is_ok_and(|st| st.success()), "kill {s}");
-    };
-    let mut b = a.another(80, 24);
-    b.wait_text("in use by", 10);
     // Its devices found first, so that what the take-over says is the
     // newest message (under load the devices' line came after it).
     b.wait_text("grabber", 20);
-    signal("-STOP");
+    signal(&a, "-STOP");
     b.wait_text(" cube ", 10);
     b.press(SURVEY, Action::Survey(SurveyAction::Enter));
     b.wait_text("over anyway?", 10);
@@ -226,7 +221,7 @@ fn a_console_that_quits_during_a_take_over_signals_nobody() {
     b.wait_exit(15);
     // Past the wait after which the holder would have been signalled.
     std::thread::sleep(Duration::from_secs(6));
-    signal("-CONT");
+    signal(&a, "-CONT");
     std::thread::sleep(Duration::from_secs(2));
     assert_eq!(
         a.exit_code(),

@@ -247,6 +247,21 @@ mod tests {
         (s.name().to_string(), lock)
     }
 
+    /// Runs `cmd` on `st`, which must keep `held` open for writing; what
+    /// it said, and `cmd` as said in the assertions.
+    fn keeps(
+        st: &mut Store,
+        rx: &Receiver<Msg>,
+        cmd: StoreCmd,
+        held: &(String, String),
+    ) -> (Vec<String>, String) {
+        let what = format!("{cmd:?}");
+        st.handle(cmd);
+        assert_eq!(&open_here(st), held, "after {what}");
+        assert!(!st.read_only, "after {what}");
+        (notes(rx), what)
+    }
+
     /// Every way a new session can fail to open — held by a live console
     /// (the operator asked), damaged, missing, a take-over of a damaged
     /// one, a name taken — leaves the open one open and its lock held,
@@ -273,11 +288,7 @@ mod tests {
             StoreCmd::Create("two".into()),
         ];
         for cmd in tries {
-            let what = format!("{cmd:?}");
-            st.handle(cmd);
-            assert_eq!(open_here(&st), held, "after {what}");
-            assert!(!st.read_only, "after {what}");
-            let said = notes(&rx);
+            let (said, what) = keeps(&mut st, &rx, cmd, &held);
             assert!(
                 said.iter()
                     .any(|n| n.starts_with("session one is still open here, its lock kept")),
@@ -311,11 +322,7 @@ mod tests {
             StoreCmd::TakeOver(one.clone()),
             StoreCmd::OpenReadOnly(one.clone()),
         ] {
-            let what = format!("{cmd:?}");
-            st.handle(cmd);
-            assert_eq!(open_here(&st), held, "after {what}");
-            assert!(!st.read_only, "after {what}");
-            let said = notes(&rx);
+            let (said, what) = keeps(&mut st, &rx, cmd, &held);
             assert_eq!(
                 said,
                 ["session one is already open here: nothing changed"],
