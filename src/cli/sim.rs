@@ -76,11 +76,13 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         ),
         None => None,
     };
+    // Whoever starts the simulator may read only the paths, or nothing
+    // (`--link` names the grabber): a closed stdout must not end it.
     let mut out = std::io::stdout().lock();
-    writeln!(out, "grabber: {}", sim.grabber_path())?;
-    writeln!(out, "relay: {}", sim.relay_path())?;
-    writeln!(out, "{}", sim.summary())?;
-    out.flush()?;
+    let _ = writeln!(out, "grabber: {}", sim.grabber_path())
+        .and_then(|()| writeln!(out, "relay: {}", sim.relay_path()))
+        .and_then(|()| writeln!(out, "{}", sim.summary()))
+        .and_then(|()| out.flush());
     drop(out);
     let mut unplugged: Option<Instant> = None;
     while !stop.load(Ordering::SeqCst) {
@@ -92,8 +94,6 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             }
             Some(t) if replug.is_some_and(|d| t.elapsed() >= d) => {
                 let path = sim.replug_grabber()?.to_string();
-                // Whoever read the first paths may have gone: a closed
-                // stdout must not end the simulator.
                 let mut out = std::io::stdout().lock();
                 let _ = writeln!(out, "grabber: {path}").and_then(|()| out.flush());
                 errln!("vss sim: the grabber is back on {path}");

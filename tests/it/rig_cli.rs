@@ -488,6 +488,49 @@ fn a_grabber_pulled_and_plugged_back_is_found_under_its_name() {
     sim.stop();
 }
 
+/// Started with nobody reading its report (`vss sim --link P | true`),
+/// the simulator still serves: it printed "Broken pipe" and ended before.
+#[test]
+fn a_simulator_whose_reader_has_gone_still_serves() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let sim_profile = write_profile(tmp.path(), "sim.toml", &base());
+    let link = tmp.path().join("ttyVSG0");
+    let mut child = vss()
+        .arg("--profile")
+        .arg(&sim_profile)
+        .arg("sim")
+        .arg("--link")
+        .arg(&link)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start vss sim");
+    drop(child.stdout.take());
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !link.exists() && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    let sim = SimProcess {
+        child,
+        grabber: link.to_string_lossy().into_owned(),
+        relay: String::new(),
+    };
+    let mut p = base();
+    p.grabber.kind = GrabberKind::Vsg;
+    p.grabber.port = sim.grabber.clone();
+    let prof = write_profile(tmp.path(), "cell.toml", &p);
+    let session = tmp.path().join("s/gone");
+    let out = grab_one(&prof, &session, &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(imgs(&session), ["gone1a.img"]);
+    sim.stop();
+}
+
 /// Starts `vss grab` with a long stall, waits until its transfer has begun
 /// (progress on stderr) and SIGKILLs it: the session's lock stays behind.
 /// The grab waits 30 s for each READ of the stall (its profile beside
