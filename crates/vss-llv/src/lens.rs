@@ -169,6 +169,36 @@ impl CameraModel {
         self.to_px(ud - du, vd - dv)
     }
 
+    /// The observed pixel nearest the centre `C` where this distortion
+    /// folds a `width × height` image, if it does: where the Jacobian of
+    /// the observed-to-ideal map (`I − ∂δ`) is not positive, two places of
+    /// the scene would be seen at one pixel, which no lens does (a `D` or
+    /// `K` mistyped: a digit, a sign). Checked on a grid of at most
+    /// 65 × 65 points over the image, its last row and column included.
+    pub fn fold_in(&self, width: usize, height: usize) -> Option<(f64, f64)> {
+        if self.is_identity() || width == 0 || height == 0 {
+            return None;
+        }
+        let points = |n: usize| {
+            let step = ((n - 1) as f64 / 64.0).max(1.0);
+            let count = ((n - 1) as f64 / step).round() as usize;
+            (0..=count).map(move |i| (i as f64 * step).min((n - 1) as f64))
+        };
+        let mut nearest: Option<(f64, (f64, f64))> = None;
+        for y in points(height) {
+            for x in points(width) {
+                let (u, v) = self.to_mm(x, y);
+                let (j, _) = self.delta_derivatives(u, v);
+                let det = (1.0 - j[0][0]) * (1.0 - j[1][1]) - j[0][1] * j[1][0];
+                let d = (x - self.cx).hypot(y - self.cy);
+                if (det.is_nan() || det <= 0.0) && nearest.is_none_or(|(n, _)| d < n) {
+                    nearest = Some((d, (x, y)));
+                }
+            }
+        }
+        nearest.map(|(_, p)| p)
+    }
+
     /// True when lens correction would change nothing.
     pub fn is_identity(&self) -> bool {
         self.distortion
@@ -307,6 +337,32 @@ mod tests {
             invalid.len(),
             invalid.first()
         );
+    }
+
+    #[test]
+    fn a_distortion_that_folds_the_image_is_found_where_it_folds() {
+        // k1 = +0.05 mm⁻² (a digit lost from −0.0005): the observed-to-ideal
+        // map turns back 2.58 mm from the centre, inside a 512² image.
+        let folds = CameraModel {
+            distortion: Some([0.05, 0.0, 0.0, 0.0, 0.0]),
+            radial: [0.0; 2],
+            ..cell_model()
+        };
+        let (x, y) = folds.fold_in(512, 512).expect("it folds");
+        let r = folds.to_mm(x, y);
+        let r = r.0.hypot(r.1);
+        // Where 1 − 3 k1 r² turns negative, to the grid's spacing.
+        let edge = (1.0f64 / (3.0 * 0.05)).sqrt();
+        assert!((r - edge).abs() < 0.1, "folds at {r} mm, not {edge}");
+        // A smaller image (its centre in the middle) stays inside the fold.
+        let small = CameraModel {
+            cx: 100.0,
+            cy: 100.0,
+            ..folds
+        };
+        assert_eq!(small.fold_in(200, 200), None);
+        assert_eq!(cell_model().fold_in(512, 512), None);
+        assert_eq!(wide_angle_model().fold_in(512, 512), None);
     }
 
     #[test]
