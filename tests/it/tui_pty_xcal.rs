@@ -53,3 +53,41 @@ fn a_camera_whose_distortion_folds_the_image_is_refused_on_the_pipeline() {
     c.send("q");
     c.wait_exit(15);
 }
+
+/// Camera 1's `.cdf` edited on disk while the console runs (a hand edit,
+/// or `vss calibrate --yes` in another terminal): the console goes on
+/// correcting with the description it read, so the image is recorded with
+/// that one too (what `vss session redo` re-runs it with), and a warning
+/// says the file changed. Before, the session recorded the edited file
+/// while the lines came from the old one.
+#[test]
+fn a_camera_file_edited_while_the_console_runs_is_not_recorded_unsaid() {
+    let mut c = Console::start_with(&five_lightings(true), 80, 24, &[], |d| {
+        write_cdfs(d, 2);
+    });
+    let read = std::fs::read_to_string(c.dir.path().join("cam1.cdf")).unwrap();
+    c.create_session("cube");
+    // Another k1: a valid file, a different lens.
+    let path = c.dir.path().join("cam1.cdf");
+    let cdf = read_cdf(&path).unwrap();
+    let mut m = cdf.camera_model().unwrap();
+    let mut d = m.distortion.unwrap();
+    d[0] *= 0.5;
+    m.distortion = Some(d);
+    let mut edited = vss::formats::cdf::Cdf::from_camera(&m, cdf.extrinsic());
+    edited.set(cdf.get("S").unwrap().clone());
+    write_cdf(&path, &edited).unwrap();
+    c.capture_current(1);
+    let recorded = std::fs::read_to_string(c.session().join("cube1.cdf")).unwrap();
+    assert_eq!(
+        recorded, read,
+        "the image is recorded with the file read at start"
+    );
+    let log = std::fs::read_to_string(c.session().join("cube.log")).unwrap();
+    assert!(
+        log.contains("cam1.cdf changed since the console read it"),
+        "{log}"
+    );
+    c.send("q");
+    c.wait_exit(15);
+}
