@@ -546,3 +546,30 @@ fn a_damaged_or_linked_out_file_is_refused_before_the_work_and_nothing_is_writte
         text.replace("NaN", "8.5")
     );
 }
+
+/// Photographs of a camera with square pixels calibrated with another
+/// camera's scale S (sy / sx = 0.696, the simulated cell's camera 1, as
+/// the Calibrate screen does when camera 1 is chosen): refused as a scale
+/// that does not fit, not as "a view whose grid was misread, or a plate
+/// file that does not match the plate".
+#[test]
+fn views_that_fit_only_another_scale_are_refused_naming_the_scale() {
+    let imgs = photos();
+    let found = calib::detect_all(&imgs, &board(9, 7));
+    let views: Vec<View> = found.views.iter().map(|(v, _)| v.clone()).collect();
+    let (w, h) = imgs[0].1.size();
+    let o = Options {
+        sx: 0.0112,
+        sy: 0.0078,
+        ..options(w, h)
+    };
+    let e = calib::calibrate(&views, &o).unwrap_err();
+    let CalibError::ScaleMismatch { stated, fits, rms } = e else {
+        panic!("{e}");
+    };
+    assert!((stated - 0.0078 / 0.0112).abs() < 1e-12);
+    assert!((fits - 1.0).abs() < 0.01, "square pixels: {fits}");
+    assert!(rms < 0.4, "{rms}");
+    let text = e.to_string();
+    assert!(text.contains("estimate sy"), "{text}");
+}
