@@ -46,7 +46,7 @@ pub use found::{Corner, DetectError, Detection};
 pub use plate::{Plate, PlateError, PlateKind};
 pub use solve::{
     CENTRE_SE, COVERAGE, Calibration, CrossCheck, Estimate, FEW_VIEWS, Options, PARALLEL_DEPTH,
-    View, ViewFit, calibrate, coverage, cross_validate, solve_pose, uncertainty_points,
+    View, ViewFit, coverage, cross_validate, solve_pose, uncertainty_points,
 };
 
 use crate::formats::cdf::{Cdf, CdfParam, Status};
@@ -88,6 +88,42 @@ pub enum CalibError {
     Symmetric(String),
     #[error("the plate file gives no [place] (the plate's pose in the cell): add one to {0}")]
     NoPlace(String),
+    #[error(
+        "the corners do not fit one camera with the stated scale S (sy / sx = {stated:.4}), but \
+         do with sy / sx = {fits:.4} (RMS {rms:.3} px): these views are not from the camera S \
+         belongs to (photographs of another camera?), or S is wrong: give that camera's S \
+         (its .cdf, or vss calibrate --scale SX,SY), or estimate sy (vss calibrate \
+         --estimate-scale)"
+    )]
+    ScaleMismatch { stated: f64, fits: f64, rms: f64 },
+}
+
+/// Calibrates a camera from `views` ([`solve::calibrate`]). A fit that
+/// does not converge with `S` stated is tried once more with `sy`
+/// estimated: when that fits with another ratio, the refusal says the
+/// scale is the cause ([`CalibError::ScaleMismatch`]), not a misread grid
+/// or plate file. (The solver's own warning that S does not fit was lost
+/// with its refusal.)
+pub fn calibrate(views: &[View], o: &Options) -> Result<Calibration, CalibError> {
+    let e = match solve::calibrate(views, o) {
+        Err(e @ CalibError::NoConvergence { .. }) if !o.estimate_scale => e,
+        r => return r,
+    };
+    let free = Options {
+        estimate_scale: true,
+        ..*o
+    };
+    let stated = o.sy / o.sx;
+    match solve::calibrate(views, &free) {
+        Ok(c) if (c.model.sy / c.model.sx / stated - 1.0).abs() > 0.01 => {
+            Err(CalibError::ScaleMismatch {
+                stated,
+                fits: c.model.sy / c.model.sx,
+                rms: c.rms,
+            })
+        }
+        _ => Err(e),
+    }
 }
 
 /// The `.cdf` with a new intrinsic calibration: `f`, `D`, `K` calibrated (`A`),

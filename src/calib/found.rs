@@ -59,7 +59,9 @@ pub enum DetectError {
         second: (usize, usize),
     },
     #[error(
-        "the board is in view ({corners} inner corners) but blurred: its edges are {width:.1} px wide (at most {} px gives sharp corners): focus, hold the board still, or give more light for a shorter exposure",
+        "the board is in view ({corners} inner corners) but blurred: its edges are {:.1} px wide (at most {} px gives sharp corners): focus, hold the board still, or give more light for a shorter exposure",
+        // Rounded up: 6.04 px is refused, so it must not read "6.0 px".
+        (width * 10.0).ceil() / 10.0,
         MAX_EDGE_WIDTH
     )]
     Blurred { width: f64, corners: usize },
@@ -87,4 +89,19 @@ pub struct Detection {
     pub oriented: bool,
     /// Segments the pipeline gave.
     pub segments: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_board_refused_as_blurred_never_reads_as_sharp_enough() {
+        let e = DetectError::Blurred {
+            width: 6.04,
+            corners: 48,
+        }
+        .to_string();
+        assert!(e.contains("6.1 px wide (at most 6 px"), "{e}");
+    }
 }

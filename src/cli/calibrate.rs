@@ -154,12 +154,24 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         Some("image") => Some([w as f64 / 2.0, h as f64 / 2.0]),
         Some(s) => Some(pair("--centre", s, "X,Y in pixels, or `image`")?),
     };
-    if out.exists() && !a.yes {
-        bail!(
-            "{} exists: --yes replaces its S, C, f and D (its other entries are kept, the old file as {}), or choose another --out",
-            out.display(),
-            calib::backup_name(&out).display()
-        );
+    // An --out that is there (a link too, even a broken one) is read now,
+    // before the work: the calibration keeps its other entries, so a
+    // damaged file or a link is refused here, not after the views were
+    // searched and the --report page written.
+    if out.symlink_metadata().is_ok() {
+        cdf::read_cdf(&out).with_context(|| {
+            format!(
+                "{} is there and cannot be read (the calibration keeps its other entries): mend it, or move it away; nothing written",
+                out.display()
+            )
+        })?;
+        if !a.yes {
+            bail!(
+                "{} exists: --yes replaces its S, C, f and D (its other entries are kept, the old file as {}), or choose another --out",
+                out.display(),
+                calib::backup_name(&out).display()
+            );
+        }
     }
     outln!(
         "plate {}: {} ({})",

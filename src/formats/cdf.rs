@@ -385,6 +385,7 @@ const MIN_VALID_SHARE: f64 = 0.1;
 /// come from inside the observed image. A model whose centre, scale or
 /// distortion sends (nearly) everything outside would give a black image
 /// and no lines; it is refused naming the file and the fields to check.
+/// So is a distortion that folds the image (`CameraModel::fold_in`).
 pub fn check_camera_area(
     m: &CameraModel,
     width: usize,
@@ -407,6 +408,19 @@ pub fn check_camera_area(
                 inside += 1;
             }
         }
+    }
+    if let Some((x, y)) = m.fold_in(width, height) {
+        return Err(FormatError::new(
+            path,
+            super::Location::None,
+            K::Range,
+            format!(
+                "D, K: the distortion folds a {width} × {height} image near pixel ({x:.0}, \
+                 {y:.0}): two places of the scene would be seen at one pixel there, which no \
+                 lens does, so lens correction would mirror part of the image; check the \
+                 distortion coefficients (a digit or a sign mistyped?)"
+            ),
+        ));
     }
     let share = inside as f64 / (N * N) as f64;
     if share < MIN_VALID_SHARE {
@@ -552,5 +566,27 @@ D=A\n-0.000527\n0.000379\n0.001330\n-0.000703\n-0.001406\nT=A\n\
             .unwrap_err()
             .to_string();
         assert!(e.contains("s.cdf") && e.contains('K'), "{e}");
+    }
+
+    #[test]
+    fn a_distortion_that_folds_the_image_is_refused_naming_the_file() {
+        let c = parse_cdf(SPEC, Path::new("cam1.cdf")).unwrap();
+        let good = c.camera_model().unwrap();
+        assert!(check_camera_area(&good, 512, 512, Path::new("cam1.cdf")).is_ok());
+        // k1 typed as 0.05 for -0.0005: most of the image still has
+        // pixels, but its outer part would be mirrored.
+        let mut d = good.distortion.unwrap();
+        d[0] = 0.05;
+        let folds = CameraModel {
+            distortion: Some(d),
+            ..good
+        };
+        let e = check_camera_area(&folds, 512, 512, Path::new("cam1.cdf"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("cam1.cdf") && e.contains("folds a 512 × 512 image near pixel"),
+            "{e}"
+        );
     }
 }

@@ -175,7 +175,7 @@ impl Runner {
     /// The lens map a run of `input` with `p` uses: none without a camera,
     /// with `lens.enabled = false` or for a camera that changes nothing.
     /// The size is checked first: a map is never made for an image the
-    /// stages refuse.
+    /// stages refuse, nor for a camera whose distortion folds the image.
     pub fn lens_map(
         &mut self,
         input: &PipelineInput,
@@ -191,6 +191,11 @@ impl Runner {
             && *sz == size
         {
             return Ok(Some(map.clone()));
+        }
+        // A distortion that folds the image (a mistyped D or K) would
+        // mirror part of it onto itself: refused, not corrected.
+        if let Some((x, y)) = m.fold_in(size.0, size.1) {
+            return Err(LlvError::LensFolds { x, y });
         }
         let map = Arc::new(LensMap::new(&m, size.0, size.1));
         self.lens = Some((m, size, map.clone()));

@@ -265,6 +265,8 @@ pub enum StoreEvent {
     OutputsSaved(u32),
     /// A note worth a log line (a stale lock taken over).
     Note(String),
+    /// A warning worth a log line (a camera's `.cdf` changed on disk).
+    Warning(String),
     /// The survey report is written: its files, and the problems marked in
     /// it (files it could not show), as `vss report` says them.
     Reports {

@@ -485,3 +485,91 @@ fn plate_files_are_read_bounded_and_never_found_by_accident() {
         assert!(se.contains(want), "{}: {se}", p.display());
     }
 }
+
+#[test]
+fn a_damaged_or_linked_out_file_is_refused_before_the_work_and_nothing_is_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let plate = write_board(tmp.path());
+    let run = |out: &Path, report: &Path| {
+        vss()
+            .args(["calibrate", "--yes", "--plate"])
+            .arg(&plate)
+            .args(["--scale", "0.001,0.001", "--out"])
+            .arg(out)
+            .arg("--report")
+            .arg(report)
+            .args(&photo_paths()[..8])
+            .output()
+            .unwrap()
+    };
+    // A hand-edited camera file: its f is not a number.
+    let damaged = tmp.path().join("cam1.cdf");
+    let text = "S=S\n0.001\n0.001\nC=A\n320\n320\nf=A\nNaN\nD=N\n0\n0\n0\n0\n0\n";
+    std::fs::write(&damaged, text).unwrap();
+    let report = tmp.path().join("cam1.ps");
+    let r = run(&damaged, &report);
+    let (so, se) = (
+        String::from_utf8_lossy(&r.stdout),
+        String::from_utf8_lossy(&r.stderr),
+    );
+    assert!(!r.status.success(), "{so}\n{se}");
+    assert!(
+        se.contains("cam1.cdf:8:") && se.contains("nothing written"),
+        "{se}"
+    );
+    // Refused before the views were searched: no table, no page.
+    assert!(!so.contains("overall:"), "{so}");
+    assert!(!report.exists(), "a report of a calibration not written");
+    assert_eq!(std::fs::read_to_string(&damaged).unwrap(), text);
+    // A link to the camera's file: refused the same way, the file and the
+    // link left as they were.
+    let target = tmp.path().join("cam2-2026.cdf");
+    std::fs::write(&target, text.replace("NaN", "8.5")).unwrap();
+    let link = tmp.path().join("cam2.cdf");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let report = tmp.path().join("cam2.ps");
+    let r = run(&link, &report);
+    let (so, se) = (
+        String::from_utf8_lossy(&r.stdout),
+        String::from_utf8_lossy(&r.stderr),
+    );
+    assert!(!r.status.success(), "{so}\n{se}");
+    assert!(
+        se.contains("symbolic link") && se.contains("nothing written"),
+        "{se}"
+    );
+    assert!(!so.contains("overall:"), "{so}");
+    assert!(!report.exists());
+    assert!(link.symlink_metadata().unwrap().file_type().is_symlink());
+    assert_eq!(
+        std::fs::read_to_string(&target).unwrap(),
+        text.replace("NaN", "8.5")
+    );
+}
+
+/// Photographs of a camera with square pixels calibrated with another
+/// camera's scale S (sy / sx = 0.696, the simulated cell's camera 1, as
+/// the Calibrate screen does when camera 1 is chosen): refused as a scale
+/// that does not fit, not as "a view whose grid was misread, or a plate
+/// file that does not match the plate".
+#[test]
+fn views_that_fit_only_another_scale_are_refused_naming_the_scale() {
+    let imgs = photos();
+    let found = calib::detect_all(&imgs, &board(9, 7));
+    let views: Vec<View> = found.views.iter().map(|(v, _)| v.clone()).collect();
+    let (w, h) = imgs[0].1.size();
+    let o = Options {
+        sx: 0.0112,
+        sy: 0.0078,
+        ..options(w, h)
+    };
+    let e = calib::calibrate(&views, &o).unwrap_err();
+    let CalibError::ScaleMismatch { stated, fits, rms } = e else {
+        panic!("{e}");
+    };
+    assert!((stated - 0.0078 / 0.0112).abs() < 1e-12);
+    assert!((fits - 1.0).abs() < 0.01, "square pixels: {fits}");
+    assert!(rms < 0.4, "{rms}");
+    let text = e.to_string();
+    assert!(text.contains("estimate sy"), "{text}");
+}

@@ -106,25 +106,58 @@ impl CameraModel {
         self.to_px(ud, vd)
     }
 
-    /// [`ideal_to_observed`](Self::ideal_to_observed) iterated to
-    /// convergence (at most 50 steps, until a step moves less than 1e-7 px):
-    /// what [`LensMap`] uses, so the map inverts `observed_to_ideal` to far
-    /// below 0.01 px even for strong distortion where three steps fall short.
+    /// Where an ideal pixel position was observed, solved to convergence:
+    /// Newton's method on `ud − δu(ud, vd) = u`, `vd − δv(ud, vd) = v`
+    /// from `(u, v)`, until a step moves less than 1e-7 px (at most 50
+    /// steps). What the calibration projects with. Where the solve fails
+    /// (see [`ideal_to_observed_checked`](Self::ideal_to_observed_checked))
+    /// the last iterate is returned.
     pub fn ideal_to_observed_converged(&self, x: f64, y: f64) -> (f64, f64) {
+        match self.solve_observed(x, y) {
+            Ok(p) | Err(p) => p,
+        }
+    }
+
+    /// [`ideal_to_observed_converged`](Self::ideal_to_observed_converged),
+    /// or `None` where the ideal position has no observed one: the solve
+    /// does not converge, or it ends where the observed-to-ideal map folds
+    /// (its Jacobian `I − ∂δ` is not positive there, so the observed image
+    /// is mirrored onto itself). What [`LensMap`] uses: such pixels come out
+    /// invalid instead of sampled from wherever the iteration stopped.
+    /// Fixed-point steps `ud = u + δu(ud, vd)` (lens.md) diverge once
+    /// `|∂δ|` exceeds 1, e.g. a wide-angle lens's corners; Newton's steps
+    /// converge wherever the map is one-to-one.
+    pub fn ideal_to_observed_checked(&self, x: f64, y: f64) -> Option<(f64, f64)> {
+        self.solve_observed(x, y).ok()
+    }
+
+    /// Newton's method for [`ideal_to_observed_checked`]: `Ok` converged
+    /// where the map is one-to-one, else `Err` with the last finite iterate.
+    fn solve_observed(&self, x: f64, y: f64) -> Result<(f64, f64), (f64, f64)> {
         let (u, v) = self.to_mm(x, y);
         let (mut ud, mut vd) = (u, v);
         let tol = 1e-7 * self.sx.abs().min(self.sy.abs());
         for _ in 0..50 {
             let (du, dv) = self.delta(ud, vd);
-            let (nu, nv) = (u + du, v + dv);
-            let step = (nu - ud).abs().max((nv - vd).abs());
-            ud = nu;
-            vd = nv;
-            if step.is_nan() || step <= tol {
-                break;
+            let (ru, rv) = (ud - du - u, vd - dv - v);
+            let (j, _) = self.delta_derivatives(ud, vd);
+            let (a, b, c, d) = (1.0 - j[0][0], -j[0][1], -j[1][0], 1.0 - j[1][1]);
+            let det = a * d - b * c;
+            // Not one-to-one here (or not a number): no step to take.
+            if det.is_nan() || det <= 0.0 {
+                return Err(self.to_px(ud, vd));
+            }
+            let (su, sv) = ((d * ru - b * rv) / det, (a * rv - c * ru) / det);
+            if !(su.is_finite() && sv.is_finite()) {
+                return Err(self.to_px(ud, vd));
+            }
+            ud -= su;
+            vd -= sv;
+            if su.abs().max(sv.abs()) <= tol {
+                return Ok(self.to_px(ud, vd));
             }
         }
-        self.to_px(ud, vd)
+        Err(self.to_px(ud, vd))
     }
 
     /// The ideal position of an observed pixel position: `u = ud - δu(ud, vd)`
@@ -134,6 +167,36 @@ impl CameraModel {
         let (ud, vd) = self.to_mm(xd, yd);
         let (du, dv) = self.delta(ud, vd);
         self.to_px(ud - du, vd - dv)
+    }
+
+    /// The observed pixel nearest the centre `C` where this distortion
+    /// folds a `width × height` image, if it does: where the Jacobian of
+    /// the observed-to-ideal map (`I − ∂δ`) is not positive, two places of
+    /// the scene would be seen at one pixel, which no lens does (a `D` or
+    /// `K` mistyped: a digit, a sign). Checked on a grid of at most
+    /// 65 × 65 points over the image, its last row and column included.
+    pub fn fold_in(&self, width: usize, height: usize) -> Option<(f64, f64)> {
+        if self.is_identity() || width == 0 || height == 0 {
+            return None;
+        }
+        let points = |n: usize| {
+            let step = ((n - 1) as f64 / 64.0).max(1.0);
+            let count = ((n - 1) as f64 / step).round() as usize;
+            (0..=count).map(move |i| (i as f64 * step).min((n - 1) as f64))
+        };
+        let mut nearest: Option<(f64, (f64, f64))> = None;
+        for y in points(height) {
+            for x in points(width) {
+                let (u, v) = self.to_mm(x, y);
+                let (j, _) = self.delta_derivatives(u, v);
+                let det = (1.0 - j[0][0]) * (1.0 - j[1][1]) - j[0][1] * j[1][0];
+                let d = (x - self.cx).hypot(y - self.cy);
+                if (det.is_nan() || det <= 0.0) && nearest.is_none_or(|(n, _)| d < n) {
+                    nearest = Some((d, (x, y)));
+                }
+            }
+        }
+        nearest.map(|(_, p)| p)
     }
 
     /// True when lens correction would change nothing.
@@ -236,6 +299,70 @@ mod tests {
             moved > 0.5,
             "the test model should distort visibly ({moved} px)"
         );
+    }
+
+    /// A wide-angle lens: the corrected image's corners were observed 28 %
+    /// nearer the centre (`k1 r²` ≈ −0.39 at the observed point), where
+    /// fixed-point steps `ud = u + δu(ud, vd)` no longer converge (their
+    /// factor `3 |k1| r²` exceeds 1).
+    fn wide_angle_model() -> CameraModel {
+        CameraModel {
+            distortion: Some([-0.08, 2.0e-4, -1.5e-4, 1.0e-4, 5.0e-5]),
+            radial: [0.0; 2],
+            ..cell_model()
+        }
+    }
+
+    #[test]
+    fn a_wide_angle_lens_is_inverted_everywhere_not_only_near_the_middle() {
+        let m = wide_angle_model();
+        let map = LensMap::new(&m, 512, 512);
+        let (mut worst, mut invalid) = (0.0f64, Vec::new());
+        for y in (0..512).step_by(7) {
+            for x in (0..512).step_by(7) {
+                // Barrel distortion: every corrected pixel was observed
+                // inside the image.
+                let Some((xs, ys)) = map.source(x, y) else {
+                    invalid.push((x, y));
+                    continue;
+                };
+                let (xi, yi) = m.observed_to_ideal(xs as f64, ys as f64);
+                worst = worst.max((xi - x as f64).hypot(yi - y as f64));
+            }
+        }
+        assert!(worst < 0.01, "round trip error {worst} px");
+        assert!(
+            invalid.is_empty(),
+            "{} pixels without a source, e.g. {:?}",
+            invalid.len(),
+            invalid.first()
+        );
+    }
+
+    #[test]
+    fn a_distortion_that_folds_the_image_is_found_where_it_folds() {
+        // k1 = +0.05 mm⁻² (a digit lost from −0.0005): the observed-to-ideal
+        // map turns back 2.58 mm from the centre, inside a 512² image.
+        let folds = CameraModel {
+            distortion: Some([0.05, 0.0, 0.0, 0.0, 0.0]),
+            radial: [0.0; 2],
+            ..cell_model()
+        };
+        let (x, y) = folds.fold_in(512, 512).expect("it folds");
+        let r = folds.to_mm(x, y);
+        let r = r.0.hypot(r.1);
+        // Where 1 − 3 k1 r² turns negative, to the grid's spacing.
+        let edge = (1.0f64 / (3.0 * 0.05)).sqrt();
+        assert!((r - edge).abs() < 0.1, "folds at {r} mm, not {edge}");
+        // A smaller image (its centre in the middle) stays inside the fold.
+        let small = CameraModel {
+            cx: 100.0,
+            cy: 100.0,
+            ..folds
+        };
+        assert_eq!(small.fold_in(200, 200), None);
+        assert_eq!(cell_model().fold_in(512, 512), None);
+        assert_eq!(wide_angle_model().fold_in(512, 512), None);
     }
 
     #[test]

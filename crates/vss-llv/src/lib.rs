@@ -73,6 +73,14 @@ pub enum LlvError {
         points: usize,
         max: usize,
     },
+    /// The camera's distortion folds the image (`CameraModel::fold_in`):
+    /// lens correction would mirror part of it onto itself.
+    #[error(
+        "the camera's distortion folds the image near pixel ({x:.0}, {y:.0}): two places of \
+         the scene would be seen at one pixel there, which no lens does; check D and K in \
+         its .cdf (a digit or a sign mistyped?)"
+    )]
+    LensFolds { x: f64, y: f64 },
     /// A parameter is outside its allowed range.
     #[error("parameter {name} = {value} is out of range ({range})")]
     Param {

@@ -299,6 +299,10 @@ impl App {
                 self.ctx().info(clean(&what));
                 Vec::new()
             }
+            StoreEvent::Warning(what) => {
+                self.ctx().warn(clean(&what));
+                Vec::new()
+            }
             StoreEvent::OpeningDone => {
                 if !self.session.opening.is_empty() {
                     self.session.opening.remove(0);

@@ -235,11 +235,13 @@ fn stage_view(
             p.cursor = Some(nav.cursor_or_centre(size));
             p.render(inner, buf);
         }
-        None => Paragraph::new(if cur.failed.is_some() {
-            "the last run failed: see the message below (!)"
-        } else {
-            "running…"
+        // Why the run failed is said here, not only in the message row,
+        // where the saves that finish after it soon take its place.
+        None => Paragraph::new(match &cur.failed {
+            Some(why) => format!("the last run failed: {}", crate::tui::text::clean(why)),
+            None => "running…".to_string(),
         })
+        .wrap(Wrap { trim: true })
         .render(inner, buf),
     }
 }

@@ -16,6 +16,7 @@ use std::time::{Duration, Instant};
 
 use super::send;
 use crate::formats;
+use crate::formats::cdf::Cdf;
 use crate::formats::img::ImgFile;
 use crate::llv::GreyImage;
 use crate::llv::lens::CameraModel;
@@ -102,6 +103,10 @@ pub struct Store {
     looked: Option<list::Stamp>,
     /// The console quits ([`StoreHandle::finish`]).
     quitting: Arc<AtomicBool>,
+    /// Each camera's description as [`Store::cameras`] last read it (index
+    /// 0 = camera 1): what the console's lens correction uses, and so what
+    /// an image is recorded with.
+    cdfs: Vec<Option<Cdf>>,
 }
 
 /// What a session open only to look rests on: its folder, manifest and
@@ -122,6 +127,7 @@ impl Store {
             read_only: false,
             looked: None,
             quitting: Arc::default(),
+            cdfs: Vec::new(),
         }
     }
 
@@ -174,9 +180,42 @@ impl Store {
         }
     }
 
-    /// Reports the camera models of the profile's `.cdf` files.
-    pub fn cameras(&self) {
+    /// Reads the profile's `.cdf` files and reports their camera models.
+    pub fn cameras(&mut self) {
+        self.cdfs = (1..=self.profile.survey.cameras.max(1))
+            .map(|c| self.profile.camera_cdf(c).ok().flatten())
+            .collect();
         self.reply(StoreEvent::Cameras(self.camera_models()));
+    }
+
+    /// Camera `camera`'s description as [`Store::cameras`] read it, which
+    /// image `k` is recorded with; a warning when the file has changed on
+    /// disk since (a hand edit, a `vss calibrate` in another terminal),
+    /// because the console goes on correcting with the one it read.
+    fn camera_read(&self, camera: u32, k: u32) -> Option<Cdf> {
+        // A store that never read them (a test driving it by hand) reads now.
+        if self.cdfs.is_empty() {
+            return self.profile.camera_cdf(camera).ok().flatten();
+        }
+        let read = camera
+            .checked_sub(1)
+            .and_then(|i| self.cdfs.get(i as usize))
+            .cloned()
+            .flatten();
+        let now = self.profile.camera_cdf(camera);
+        if now.as_ref().ok().and_then(Option::as_ref) != read.as_ref() {
+            let file = self.profile.cdf_shown(camera).unwrap_or_default();
+            let why = match now {
+                Err(e) => format!(" and cannot be read now ({e})"),
+                Ok(_) => String::new(),
+            };
+            self.reply(StoreEvent::Warning(format!(
+                "camera {camera}: {file} changed since the console read it{why}; image {k} is \
+                 recorded and corrected with the description read then (quit and start the \
+                 console again to use the file as it is now)"
+            )));
+        }
+        read
     }
 
     /// Saves a captured frame as image `k`'s lighting `letter` (recording
@@ -191,15 +230,22 @@ impl Store {
         image: GreyImage,
         settings: FrameSettings,
     ) -> Result<String, StoreError> {
-        // The camera's description as the profile serves it (built in or a
-        // file), recorded as the image's NAMEk.cdf; a problem with it is
-        // said on the Pipeline screen (`cameras`), not here.
-        let cdf = self.profile.camera_cdf(camera).ok().flatten();
-        let s = self.session_mut()?;
-        let known = s
-            .manifest()
-            .image(k)
+        // The camera's description as the console read it (built in or a
+        // file), recorded as the image's NAMEk.cdf, so the image's outputs
+        // and its record agree (`vss session redo` makes the same); a
+        // problem with it is said on the Pipeline screen (`cameras`).
+        let known = self
+            .session
+            .as_ref()
+            .and_then(|s| s.manifest().image(k))
             .map(|r| (r.camera, r.location, r.cdf.is_some()));
+        let record = known.is_none_or(|(c, l, has_cdf)| c != camera || l != location || !has_cdf);
+        let cdf = if record {
+            self.camera_read(camera, k)
+        } else {
+            None
+        };
+        let s = self.session_mut()?;
         let what = format!("image {k} lighting {letter} NOT saved");
         if known.is_none_or(|(c, l, has_cdf)| {
             c != camera || l != location || (!has_cdf && cdf.is_some())

@@ -87,8 +87,10 @@ impl LensMap {
         if m.is_identity() {
             return LensMap::identity(width, height);
         }
+        // A pixel the lens cannot have observed is outside (invalid).
         LensMap::from_sources(width, height, |x, y| {
-            m.ideal_to_observed_converged(x as f64, y as f64)
+            m.ideal_to_observed_checked(x as f64, y as f64)
+                .unwrap_or((f64::NAN, f64::NAN))
         })
     }
 
