@@ -332,11 +332,8 @@ fn extrinsic(a: &Args, plate: &Plate, out: &Path) -> anyhow::Result<ExitCode> {
             out.display()
         )
     })?;
-    let model = old.camera_model().with_context(|| {
-        format!(
-            "{} lacks S, C or f: calibrate the intrinsics first",
-            out.display()
-        )
+    let model = old.model().map_err(|why| {
+        anyhow::anyhow!("{} {why}: calibrate the intrinsics first", out.display())
     })?;
     let imgs = read_images(std::slice::from_ref(image))?;
     let (name, img) = &imgs[0];

@@ -136,8 +136,8 @@ pub fn describe(path: &Path) -> anyhow::Result<String> {
                     vals.join(" | ")
                 )?;
             }
-            match c.camera_model() {
-                Some(m) => writeln!(
+            match c.model() {
+                Ok(m) => writeln!(
                     s,
                     "  camera model: f {} mm, centre ({}, {}) px, {}",
                     m.f,
@@ -149,7 +149,7 @@ pub fn describe(path: &Path) -> anyhow::Result<String> {
                         "with lens distortion"
                     }
                 )?,
-                None => writeln!(s, "  camera model: incomplete (S, C and f are needed)")?,
+                Err(why) => writeln!(s, "  camera model: none, the description {why}")?,
             }
         }
         "lex" | "ldr" => {

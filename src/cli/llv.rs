@@ -148,16 +148,14 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         let r = from_edges(hpo, vpo, &profile, &a, &p);
         return finish(r.map(|()| 0));
     }
-    let lacks = |shown: &dyn std::fmt::Display| {
-        format!(
-            "{shown}: the camera description lacks S, C or f (or marks them N): cannot correct the lens"
-        )
+    let lacks = |shown: &dyn std::fmt::Display, why: String| {
+        anyhow::anyhow!("{shown}: the camera description {why}: cannot correct the lens")
     };
     let camera = match (&a.cdf, a.camera) {
         (Some(path), _) => Some((
             cdf::read_cdf(path)?
-                .camera_model()
-                .with_context(|| lacks(&path.display()))?,
+                .model()
+                .map_err(|why| lacks(&path.display(), why))?,
             path.clone(),
         )),
         // The one owner of a camera's description (as the console uses).
@@ -167,7 +165,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                 format!("the profile names no .cdf for camera {cam} ([survey] cdf)")
             })?;
             Some((
-                c.camera_model().with_context(|| lacks(&shown))?,
+                c.model().map_err(|why| lacks(&shown, why))?,
                 PathBuf::from(shown),
             ))
         }

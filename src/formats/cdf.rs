@@ -119,10 +119,37 @@ impl Cdf {
         }
     }
 
-    /// The intrinsic camera model: `None` if `S`, `C` or `f` is missing or
-    /// `N`. `D` missing or `N` gives no distortion; `K` missing or `N`, no
-    /// higher radial terms.
+    /// The intrinsic camera model, or why there is none ([`Cdf::model`]).
     pub fn camera_model(&self) -> Option<CameraModel> {
+        self.model().ok()
+    }
+
+    /// The intrinsic camera model, or why the description gives none, said
+    /// as "lacks …" after its file's name: `S`, `C` or `f` missing or `N`,
+    /// or no `D` line at all. `D=N` says the lens has no distortion; a
+    /// description without the line is refused, because a file cut after
+    /// `f` would otherwise read as a lens without distortion and lens
+    /// correction would silently do nothing. `K` missing or `N` gives no
+    /// higher radial terms.
+    pub fn model(&self) -> Result<CameraModel, String> {
+        let gone: Vec<&str> = ["S", "C", "f"]
+            .into_iter()
+            .filter(|n| self.available(n).is_none())
+            .collect();
+        if let [one] = gone.as_slice() {
+            return Err(format!("lacks {one} (or marks it N)"));
+        }
+        if !gone.is_empty() {
+            return Err(format!("lacks {} (or marks them N)", gone.join(", ")));
+        }
+        if self.get("D").is_none() {
+            return Err("lacks its D line (D=N says the lens has no distortion)".into());
+        }
+        self.intrinsics()
+            .ok_or_else(|| "lacks S, C or f (or marks them N)".into())
+    }
+
+    fn intrinsics(&self) -> Option<CameraModel> {
         let s = self.available("S")?;
         let c = self.available("C")?;
         let f = self.available("f")?;
@@ -518,6 +545,24 @@ D=A\n-0.000527\n0.000379\n0.001330\n-0.000703\n-0.001406\nT=A\n\
         assert_eq!(m.distortion.unwrap()[0], -0.000527);
         assert_eq!(c.extrinsic().unwrap()[2][3], 432.081189);
         assert_eq!(c.get("C").unwrap().status, Status::Estimated);
+    }
+
+    /// A description cut after `f` (at a line's end, so it parses) is not a
+    /// lens without distortion: it gives no model, and says why.
+    #[test]
+    fn a_description_without_its_d_line_gives_no_model() {
+        let cut = &SPEC[..SPEC.find("D=A").unwrap()];
+        let c = parse_cdf(cut, Path::new("cam1.cdf")).unwrap();
+        assert_eq!(c.camera_model(), None);
+        assert_eq!(
+            c.model().unwrap_err(),
+            "lacks its D line (D=N says the lens has no distortion)"
+        );
+        let no_f = &SPEC[..SPEC.find("f=A").unwrap()];
+        let c = parse_cdf(no_f, Path::new("cam1.cdf")).unwrap();
+        assert_eq!(c.model().unwrap_err(), "lacks f (or marks it N)");
+        let c = parse_cdf("C=N\n0\n0\nD=N\n", Path::new("cam1.cdf")).unwrap();
+        assert_eq!(c.model().unwrap_err(), "lacks S, C, f (or marks them N)");
     }
 
     #[test]

@@ -554,11 +554,8 @@ impl Store {
     fn camera_models(&self) -> Vec<Result<CameraModel, String>> {
         (1..=self.profile.survey.cameras.max(1))
             .map(|c| match self.profile.camera_cdf(c) {
-                Ok(Some(cdf)) => cdf.camera_model().ok_or_else(|| {
-                    format!(
-                        "{} lacks S, C or f (or marks them N)",
-                        self.profile.cdf_shown(c).unwrap_or_default()
-                    )
+                Ok(Some(cdf)) => cdf.model().map_err(|why| {
+                    format!("{} {why}", self.profile.cdf_shown(c).unwrap_or_default())
                 }),
                 Ok(None) => Err("the profile names no .cdf for it ([survey] cdf)".into()),
                 Err(e) => Err(e.to_string()),
