@@ -195,6 +195,12 @@ impl App {
         self.chrome.quit
     }
 
+    /// Whether the operator asked to suspend the console (Ctrl-Z), once:
+    /// the shell leaves the terminal and stops the process.
+    pub fn take_suspend(&mut self) -> bool {
+        std::mem::take(&mut self.chrome.suspend)
+    }
+
     /// Applies one message; returns the work it asks of the workers.
     pub fn update(&mut self, msg: Msg) -> Vec<Cmd> {
         let by_operator = match &msg {
@@ -277,6 +283,12 @@ impl App {
 
     fn on_key(&mut self, key: KeyEvent) -> Vec<Cmd> {
         if key.kind != KeyEventKind::Press {
+            return Vec::new();
+        }
+        // Ctrl-Z suspends from anywhere, as in any terminal program: a
+        // question or a field open stays as it is for the return.
+        if keymap::lookup(Scope::Global, &key) == Some(Action::Global(GlobalAction::Suspend)) {
+            self.chrome.suspend = true;
             return Vec::new();
         }
         let scope = self.scope();
@@ -409,6 +421,10 @@ impl App {
                 } else {
                     self.chrome.quit = true;
                 }
+                Vec::new()
+            }
+            GlobalAction::Suspend => {
+                self.chrome.suspend = true;
                 Vec::new()
             }
             GlobalAction::Help => {

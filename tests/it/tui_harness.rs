@@ -119,7 +119,45 @@ impl Console {
         Console::spawn(&cwd, dir, cols, rows, env, args)
     }
 
+    /// An interactive shell with job control (bash) in the terminal, in a
+    /// fresh folder holding [`PROFILE`] as `cell.toml`, which starts the
+    /// console as an operator would; `child` is the shell. When the
+    /// console ends the shell says `vss ended N` (its exit code).
+    pub fn start_under_shell(cols: u16, rows: u16) -> Console {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("cell.toml"), PROFILE).unwrap();
+        let cwd = dir.path().to_path_buf();
+        let mut c = Console::spawn_program(
+            "bash",
+            &cwd,
+            dir,
+            cols,
+            rows,
+            &[("PS1", "$ "), ("HISTFILE", "/dev/null")],
+            &["--norc", "--noprofile", "-i"],
+        );
+        // Typed at once: the shell reads it once it is ready.
+        c.send(&format!(
+            "{} --profile cell.toml; echo vss ended $?\r",
+            env!("CARGO_BIN_EXE_vss")
+        ));
+        c
+    }
+
     fn spawn(
+        cwd: &Path,
+        dir: tempfile::TempDir,
+        cols: u16,
+        rows: u16,
+        env: &[(&str, &str)],
+        args: &[&str],
+    ) -> Console {
+        let vss = env!("CARGO_BIN_EXE_vss");
+        Console::spawn_program(vss, cwd, dir, cols, rows, env, args)
+    }
+
+    fn spawn_program(
+        program: &str,
         cwd: &Path,
         dir: tempfile::TempDir,
         cols: u16,
@@ -135,7 +173,7 @@ impl Console {
             pixel_height: 0,
         };
         let pair = pty.openpty(size).unwrap();
-        let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_vss"));
+        let mut cmd = CommandBuilder::new(program);
         cmd.args(args);
         cmd.cwd(cwd);
         cmd.env("TERM", "xterm-256color");

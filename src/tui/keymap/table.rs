@@ -235,4 +235,5 @@ pub const KEYMAP: &[Binding] = rows! {
     SR, ch('N'), Search(Prev), "the previous match", "previous";
     SR, k(K::Esc), Search(Clear), "end the search", "end search";
     G, ctrl('c'), Global(Quit), "quit", "";
+    G, ctrl('z'), Global(Suspend), "suspend to the shell, anywhere (fg brings the console back)", "";
 };

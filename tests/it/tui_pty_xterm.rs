@@ -1,0 +1,155 @@
+//! The console's life in a terminal, as an operator over SSH lives it:
+//! started from a shell, suspended with Ctrl-Z and brought back with `fg`,
+//! stopped by signals, on terminals too small to draw it.
+
+use std::time::Duration;
+
+use super::tui_harness::{Console, flat};
+
+/// The pid of the process whose parent is `parent` (the console a shell
+/// runs), from `/proc`.
+fn child_of(parent: u32) -> Option<i32> {
+    std::fs::read_dir("/proc").ok()?.flatten().find_map(|e| {
+        let pid: i32 = e.file_name().to_str()?.parse().ok()?;
+        let stat = std::fs::read_to_string(e.path().join("stat")).ok()?;
+        let rest = &stat[stat.rfind(')')? + 1..];
+        let ppid: u32 = rest.split_whitespace().nth(1)?.parse().ok()?;
+        (ppid == parent).then_some(pid)
+    })
+}
+
+/// Whether the terminal is as a shell wants it: main screen, cursor
+/// shown, no mouse reports.
+fn shell_terminal(c: &Console) -> bool {
+    c.with_screen(|s| {
+        !s.alternate_screen()
+            && !s.hide_cursor()
+            && s.mouse_protocol_mode() == vt100::MouseProtocolMode::None
+    })
+}
+
+/// Ctrl-Z (and SIGTSTP sent from elsewhere) gives the terminal back to
+/// the shell, as it had it, and `fg` brings the console back whole and
+/// taking keys one by one. Before, in raw mode Ctrl-Z was a key bound to
+/// nothing; SIGTSTP stopped the console with the terminal in the
+/// alternate screen, cursor hidden, mouse reports on; after `fg` the
+/// screen was not redrawn and keys came only line by line, echoed.
+#[test]
+fn ctrl_z_gives_the_shell_back_and_fg_brings_the_console_back() {
+    let mut c = Console::start_under_shell(80, 24);
+    c.create_session("cube");
+    let shell = c.child.process_id().expect("the shell's pid");
+    let vss = child_of(shell).expect("the console runs under the shell");
+    for how in ["Ctrl-Z", "SIGTSTP"] {
+        if how == "Ctrl-Z" {
+            c.send("\x1a");
+        } else {
+            assert_eq!(
+                rustix::process::kill_process(
+                    rustix::process::Pid::from_raw(vss).unwrap(),
+                    rustix::process::Signal::TSTP
+                ),
+                Ok(())
+            );
+        }
+        let s = c.wait(&format!("the shell's job stopped after {how}"), 10, |s| {
+            s.contains("Stopped") && shell_terminal(&c)
+        });
+        assert!(
+            flat(&s).contains("session cube stays open here; fg brings the console back"),
+            "what the console says as it stops ({how}):\n{s}"
+        );
+        c.send("fg\r");
+        c.wait(&format!("the console drawn again after {how}"), 10, |s| {
+            s.contains("session cube")
+                && s.lines().last().is_some_and(|l| l.contains("quit"))
+                && !s.contains("Stopped")
+        });
+        assert!(c.with_screen(|s| s.alternate_screen() && s.hide_cursor()));
+        // Raw mode again: one key acts at once, without Enter and unechoed.
+        c.send("2");
+        c.wait_text("lights", 10);
+        c.send("1");
+        c.wait_text("lightings", 10);
+    }
+    c.send("q");
+    let end = std::time::Instant::now() + Duration::from_secs(15);
+    while !ended(vss) {
+        assert!(std::time::Instant::now() < end, "q did not end the console");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // `fg`'s status is the console's.
+    c.send("echo fg said $?\r");
+    let s = c.wait_text("fg said 0", 10);
+    assert!(shell_terminal(&c), "after q:\n{s}");
+    let log = std::fs::read_to_string(c.session().join("cube.log")).unwrap();
+    for said in [
+        "suspended (Ctrl-Z)",
+        "suspended (SIGTSTP)",
+        "back from suspension",
+    ] {
+        assert!(log.contains(said), "{said:?} in the log:\n{log}");
+    }
+}
+
+/// A console no shell could continue (here, like `ssh host vss`, it leads
+/// its own session) is not stopped by Ctrl-Z, which would leave it stopped
+/// for good holding its session: it says why and goes on.
+#[test]
+fn ctrl_z_without_a_shell_says_why_and_goes_on() {
+    let mut c = Console::start(80, 24, &[]);
+    c.wait_text("choose a session", 10);
+    c.send("\x1a");
+    c.wait_words("Ctrl-Z: not suspended", 10);
+    std::thread::sleep(Duration::from_millis(200));
+    assert_eq!(c.exit_code(), None, "the console still runs");
+    c.send("2");
+    c.wait_text("lights", 10);
+    c.send("q");
+    assert_eq!(c.wait_exit(10), 0);
+}
+
+/// Whether process `pid` has ended (gone, or a zombie not yet reaped).
+fn ended(pid: i32) -> bool {
+    match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
+        Err(_) => true,
+        Ok(stat) => stat
+            .rfind(')')
+            .and_then(|i| stat[i + 1..].split_whitespace().next())
+            .is_some_and(|st| matches!(st, "Z" | "X")),
+    }
+}
+
+/// The SSH connection drops while the console is suspended: the shell
+/// sends its stopped job SIGHUP and SIGCONT. The console ends as on any
+/// hang-up (the log says so, the lock is released) without taking the
+/// terminal again.
+#[test]
+fn a_suspended_console_whose_shell_hangs_up_ends_cleanly() {
+    let mut c = Console::start_under_shell(80, 24);
+    c.create_session("cube");
+    let shell = c.child.process_id().expect("the shell's pid");
+    let vss = child_of(shell).expect("the console runs under the shell");
+    c.send("\x1a");
+    c.wait("the shell's job stopped", 10, |s| {
+        s.contains("Stopped") && shell_terminal(&c)
+    });
+    let rc = rustix::process::kill_process(
+        rustix::process::Pid::from_raw(shell as i32).unwrap(),
+        rustix::process::Signal::HUP,
+    );
+    assert_eq!(rc, Ok(()));
+    let end = std::time::Instant::now() + Duration::from_secs(15);
+    while !ended(vss) {
+        assert!(std::time::Instant::now() < end, "the console did not end");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let log = std::fs::read_to_string(c.session().join("cube.log")).unwrap();
+    assert!(log.contains("console ended: SIGHUP"), "{log}");
+    assert!(!log.contains("back from suspension"), "{log}");
+    assert!(
+        !c.session().join("cube.lock").exists(),
+        "the lock is released"
+    );
+    assert!(shell_terminal(&c), "not taken again:\n{}", c.screen());
+}
