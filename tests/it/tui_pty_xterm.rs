@@ -109,6 +109,40 @@ fn ctrl_z_without_a_shell_says_why_and_goes_on() {
     assert_eq!(c.wait_exit(10), 0);
 }
 
+/// A console killed outright (SIGKILL, a power cut of the SSH server's
+/// side) leaves its lock: the next console's session list does not say
+/// the session is "in use" by someone, and it opens without a question.
+/// Before, the list said "(in use by root)" of a lock nobody held.
+#[test]
+fn a_session_left_by_a_killed_console_is_not_said_in_use() {
+    let mut a = Console::start(80, 24, &[]);
+    a.create_session("cube");
+    let pid = a.child.process_id().expect("pid") as i32;
+    let rc = rustix::process::kill_process(
+        rustix::process::Pid::from_raw(pid).unwrap(),
+        rustix::process::Signal::KILL,
+    );
+    assert_eq!(rc, Ok(()));
+    a.wait_exit(10);
+    assert!(a.session().join("cube.lock").is_file(), "the lock stays");
+    let mut b = a.another(80, 24);
+    // The list's rows wrap in its own column: the words are read there.
+    let s = b.wait("the lock said stale", 10, |s| {
+        let list: String = s
+            .lines()
+            .map(|l| l.split("││").next().unwrap_or("").replace('│', " "))
+            .collect::<Vec<_>>()
+            .join(" ");
+        flat(&list).contains("(stale lock: its console ended)")
+    });
+    assert!(!s.contains("in use by"), "{s}");
+    b.send("\r");
+    let s = b.wait_text("lightings", 10);
+    assert!(!s.contains("Take it over"), "{s}");
+    b.send("q");
+    assert_eq!(b.wait_exit(10), 0);
+}
+
 /// Whether process `pid` has ended (gone, or a zombie not yet reaped).
 fn ended(pid: i32) -> bool {
     match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
