@@ -4,7 +4,7 @@
 
 use std::time::Duration;
 
-use super::tui_harness::{Console, flat};
+use super::tui_harness::{Console, SURVEY, flat};
 
 /// The pid of the process whose parent is `parent` (the console a shell
 /// runs), from `/proc`.
@@ -141,6 +141,33 @@ fn a_session_left_by_a_killed_console_is_not_said_in_use() {
     assert!(!s.contains("Take it over"), "{s}");
     b.send("q");
     assert_eq!(b.wait_exit(10), 0);
+}
+
+/// A window a few rows high still says the keys of what is asked on its
+/// bottom rows, as the hint row does; why nothing else shows comes after,
+/// in the room left. Before, at 20 × 5 the explanation took four rows and
+/// the keys of an open field ("Enter accept  Esc cancel") were cut.
+#[test]
+fn a_tiny_terminal_still_says_the_keys_of_what_is_asked() {
+    let mut c = Console::start(80, 24, &[]);
+    c.wait_text("choose a session", 10);
+    c.press(
+        SURVEY,
+        vss::tui::keymap::Action::Survey(vss::tui::keymap::SurveyAction::NewSession),
+    );
+    c.wait_text("new session name", 5);
+    c.resize(5, 20);
+    let s = c.wait("the field's keys at 20 x 5", 10, |s| {
+        s.contains("terminal too small") && flat(s).contains("Esc cancel")
+    });
+    assert!(s.contains("new session name"), "{s}");
+    c.send("\x1b");
+    let s = c.wait("the key that quits at 20 x 5", 10, |s| {
+        s.lines().rev().map(str::trim).find(|l| !l.is_empty()) == Some("q quits")
+    });
+    assert!(s.contains("terminal too small"), "{s}");
+    c.send("q");
+    assert_eq!(c.wait_exit(10), 0);
 }
 
 /// Whether process `pid` has ended (gone, or a zombie not yet reaped).
