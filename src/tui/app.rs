@@ -11,10 +11,10 @@
 //! the frame, the picture, or a screen's `update(action, ctx)` — that
 //! matches its own actions exhaustively. Drawing (`screens/`) only reads.
 
-use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyEventKind};
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 
 use super::event::{Cmd, DeviceCmd, Msg, StoreCmd};
-use super::keymap::{self, Action, GlobalAction, NavAction, Scope, ScreenId};
+use super::keymap::{self, Action, GlobalAction, ModalAction, NavAction, Scope, ScreenId};
 use super::mode::Look;
 use crate::profile::Profile;
 
@@ -309,6 +309,21 @@ impl App {
             } else if let Some(a) = keymap::lookup(Scope::Search, &key) {
                 return self.act(a);
             }
+        }
+        // Ctrl-C gets out: of a field or a question as Esc does, and a
+        // second Ctrl-C at "Quit anyway?" quits, as pressing it twice means.
+        let quit_asked = matches!(
+            &self.chrome.modal,
+            Some(Modal::Confirm {
+                on_yes: Pending::Quit,
+                ..
+            })
+        );
+        if quit_asked
+            && key.modifiers.contains(KeyModifiers::CONTROL)
+            && keymap::lookup(Scope::Global, &key) == Some(Action::Global(GlobalAction::Quit))
+        {
+            return self.act(Action::Modal(ModalAction::Yes));
         }
         match keymap::lookup(scope, &key) {
             Some(a) => self.act(a),

@@ -214,3 +214,38 @@ fn a_suspended_console_whose_shell_hangs_up_ends_cleanly() {
     );
     assert!(shell_terminal(&c), "not taken again:\n{}", c.screen());
 }
+
+/// Ctrl-C gets out of what is open, as an operator's hands expect: of a
+/// field as Esc does (the console stays), and a second Ctrl-C at "Quit
+/// anyway?" (asked by the first, during a capture) quits. Before, Ctrl-C
+/// in a field or a question did nothing at all.
+#[test]
+fn ctrl_c_leaves_a_field_and_a_second_one_quits_during_a_capture() {
+    // A capture long enough to be under way when the keys come.
+    let profile = super::tui_harness::PROFILE
+        .replace("settle_ms = 5", "settle_ms = 400")
+        .replace("width = 128\nheight = 128", "width = 256\nheight = 256");
+    let mut c = Console::start_with(&profile, 80, 24, &[], |_| {});
+    c.wait_text("choose a session", 10);
+    c.press(
+        SURVEY,
+        vss::tui::keymap::Action::Survey(vss::tui::keymap::SurveyAction::NewSession),
+    );
+    c.wait_text("new session name", 5);
+    c.send("cu\x03");
+    c.wait("the field closed", 10, |s| {
+        !s.contains("new session name") && s.contains("choose a session")
+    });
+    assert_eq!(c.exit_code(), None, "the console still runs");
+    c.create_session("cube");
+    c.wait_text("Image 1: camera", 10);
+    c.press(
+        SURVEY,
+        vss::tui::keymap::Action::Survey(vss::tui::keymap::SurveyAction::Enter),
+    );
+    c.wait_text("capturing", 10);
+    c.send("\x03");
+    c.wait_words("Quit anyway?", 10);
+    c.send("\x03");
+    assert_eq!(c.wait_exit(15), 0, "the second Ctrl-C quits");
+}
