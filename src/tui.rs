@@ -194,9 +194,15 @@ fn run_loop(
     workers.dispatch(app.take_log_lines().into_iter().collect());
     let mut dirty = true;
     let mut last_draw = Instant::now();
+    // A terminal that takes no more output (its window gone, no SIGHUP
+    // seen yet) ends the loop like a hang-up: the workers still finish.
+    let mut broken: Option<io::Error> = None;
     while !app.quit() && !stop.load(Ordering::SeqCst) {
         if dirty && last_draw.elapsed() >= FRAME {
-            draw(terminal, &app)?;
+            if let Err(e) = draw(terminal, &app) {
+                broken = Some(e);
+                break;
+            }
             last_draw = Instant::now();
             dirty = false;
         }
@@ -244,6 +250,10 @@ fn run_loop(
     // The log says why the console ended: the operator, a signal, or the
     // terminal gone.
     let why = match signal.load(Ordering::SeqCst) as i32 {
+        0 if broken.is_some() => format!(
+            "the terminal cannot be written ({})",
+            broken.as_ref().map_or(String::new(), |e| e.to_string())
+        ),
         0 if app.quit() => "quit by the operator".to_string(),
         0 if stop.load(Ordering::SeqCst) => "the terminal's input ended (hang-up)".to_string(),
         0 => "its workers stopped".to_string(),
@@ -256,7 +266,10 @@ fn run_loop(
     app.ctx().info(format!("console ended: {why}"));
     workers.dispatch(app.take_log_lines().into_iter().collect());
     workers.finish();
-    Ok(())
+    match broken {
+        Some(e) => Err(anyhow::Error::from(e).context("drawing the console")),
+        None => Ok(()),
+    }
 }
 
 /// Suspends the console (Ctrl-Z, or `asked` false: SIGTSTP) if a shell can

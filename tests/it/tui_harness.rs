@@ -156,7 +156,7 @@ impl Console {
         Console::spawn_program(vss, cwd, dir, cols, rows, env, args)
     }
 
-    fn spawn_program(
+    pub fn spawn_program(
         program: &str,
         cwd: &Path,
         dir: tempfile::TempDir,

@@ -249,3 +249,59 @@ fn ctrl_c_leaves_a_field_and_a_second_one_quits_during_a_capture() {
     c.send("\x03");
     assert_eq!(c.wait_exit(15), 0, "the second Ctrl-C quits");
 }
+
+/// The terminal the console draws on stops taking output (its window is
+/// gone) while the console still runs: it ends as on a hang-up, its
+/// saves finished and its lock released, the log saying why. Here its
+/// screen is a second terminal, closed under it, so no SIGHUP comes.
+/// Before, the failed draw returned at once: the store was never told to
+/// finish, the lock stayed and the log had no last line.
+#[test]
+fn a_terminal_that_cannot_be_written_ends_the_console_cleanly() {
+    use portable_pty::{PtySize, native_pty_system};
+    let size = PtySize {
+        rows: 24,
+        cols: 80,
+        pixel_width: 0,
+        pixel_height: 0,
+    };
+    let screen = native_pty_system().openpty(size).unwrap();
+    let tty = screen.master.tty_name().expect("the screen's tty");
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("cell.toml"), super::tui_harness::PROFILE).unwrap();
+    let cwd = dir.path().to_path_buf();
+    let vss = env!("CARGO_BIN_EXE_vss");
+    let made = std::process::Command::new(vss)
+        .args(["--profile", "cell.toml", "session", "new", "cube"])
+        .current_dir(&cwd)
+        .env("XDG_STATE_HOME", cwd.join("state"))
+        .output()
+        .unwrap();
+    assert!(made.status.success(), "{made:?}");
+    let cmd = format!("exec {vss} --profile cell.toml > {}", tty.display());
+    let mut c = Console::spawn_program("sh", &cwd, dir, 80, 24, &[], &["-c", &cmd]);
+    // Keys go to the console's own terminal; it opens the one session.
+    let lock = c.session().join("cube.lock");
+    let end = std::time::Instant::now() + Duration::from_secs(20);
+    while !lock.exists() {
+        assert!(
+            std::time::Instant::now() < end,
+            "the session was not opened"
+        );
+        std::thread::sleep(Duration::from_millis(1500));
+        if !lock.exists() {
+            c.send("\r");
+        }
+        std::thread::sleep(Duration::from_millis(500));
+    }
+    drop(screen);
+    // A key makes the console draw, on a terminal that is gone.
+    c.send("2");
+    assert_ne!(c.wait_exit(15), 0, "ended by the terminal's failure");
+    let log = std::fs::read_to_string(c.session().join("cube.log")).unwrap();
+    assert!(
+        log.contains("console ended: the terminal cannot be written"),
+        "{log}"
+    );
+    assert!(!lock.exists(), "the lock is released");
+}
