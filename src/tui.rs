@@ -303,7 +303,9 @@ fn suspend_here(
     if let Err(e) = suspend::stop(&note) {
         app.ctx().error(format!("{how}: not suspended: {e}"));
     }
-    // This stop's own SIGCONT: the terminal is taken back here.
+    // This stop's own SIGTSTP (sent to the group) and SIGCONT: the
+    // terminal is taken back here.
+    job.stop.store(false, Ordering::SeqCst);
     job.cont.store(false, Ordering::SeqCst);
     take_back(terminal, app, stop);
 }

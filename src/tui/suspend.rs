@@ -74,8 +74,14 @@ pub fn stop(note: &str) -> io::Result<()> {
     let mut out = io::stdout();
     let _ = writeln!(out, "{note}");
     let _ = out.flush();
-    // The default action of SIGTSTP (the handler the console installed for
-    // it only sets a flag): SIGSTOP, which returns once continued.
+    // What the terminal's own Ctrl-Z does: SIGTSTP to the whole process
+    // group, so that a parent in it (`cargo run`, `sh -c`) stops too and
+    // the shell sees its job stopped (a console stopped alone left the
+    // shell waiting on its parent, the terminal with nobody reading it).
+    // The console's own handler of SIGTSTP only sets a flag (the caller
+    // clears it): it stops itself with SIGSTOP, which returns once
+    // continued.
+    rustix::process::kill_current_process_group(rustix::process::Signal::TSTP)?;
     signal_hook::low_level::emulate_default_handler(signal_hook::consts::SIGTSTP)
 }
 

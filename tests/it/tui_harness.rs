@@ -124,6 +124,19 @@ impl Console {
     /// console as an operator would; `child` is the shell. When the
     /// console ends the shell says `vss ended N` (its exit code).
     pub fn start_under_shell(cols: u16, rows: u16) -> Console {
+        Console::start_under_shell_as(cols, rows, |vss| {
+            format!("{vss} --profile cell.toml; echo vss ended $?")
+        })
+    }
+
+    /// As [`Console::start_under_shell`], the shell given the command line
+    /// `line` makes of the console's command (`vss --profile cell.toml`
+    /// with the binary's path).
+    pub fn start_under_shell_as(
+        cols: u16,
+        rows: u16,
+        line: impl FnOnce(&str) -> String,
+    ) -> Console {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("cell.toml"), PROFILE).unwrap();
         let cwd = dir.path().to_path_buf();
@@ -137,10 +150,7 @@ impl Console {
             &["--norc", "--noprofile", "-i"],
         );
         // Typed at once: the shell reads it once it is ready.
-        c.send(&format!(
-            "{} --profile cell.toml; echo vss ended $?\r",
-            env!("CARGO_BIN_EXE_vss")
-        ));
+        c.send(&format!("{}\r", line(env!("CARGO_BIN_EXE_vss"))));
         c
     }
 

@@ -305,3 +305,28 @@ fn a_terminal_that_cannot_be_written_ends_the_console_cleanly() {
     );
     assert!(!lock.exists(), "the lock is released");
 }
+
+/// Ctrl-Z on a console started through a parent in its own process group
+/// (`cargo run`, a wrapper script, `sh -c`) stops the whole job, as the
+/// terminal's Ctrl-Z does, so the shell gets the terminal back; `fg`
+/// continues both. Stopping the console alone left the shell waiting on
+/// the parent, with nobody reading the terminal.
+#[test]
+fn ctrl_z_stops_the_whole_job_when_the_console_runs_under_a_wrapper() {
+    let mut c = Console::start_under_shell_as(80, 24, |vss| {
+        format!("sh -c '{vss} --profile cell.toml; echo wrapper ended'")
+    });
+    c.wait_text("choose a session", 10);
+    c.send("\x1a");
+    c.wait("the shell's job stopped", 10, |s| {
+        s.contains("Stopped") && shell_terminal(&c)
+    });
+    c.send("fg\r");
+    c.wait("the console drawn again", 10, |s| {
+        s.contains("choose a session") && !s.contains("Stopped")
+    });
+    c.send("2");
+    c.wait_text("lights", 10);
+    c.send("q");
+    c.wait_text("wrapper ended", 10);
+}
