@@ -330,3 +330,43 @@ fn ctrl_z_stops_the_whole_job_when_the_console_runs_under_a_wrapper() {
     c.send("q");
     c.wait_text("wrapper ended", 10);
 }
+
+/// A console left suspended (Ctrl-Z) in a shell that still runs — a
+/// detached tmux — holds its session; another console's take-over (`y`)
+/// gets it: the holder, asked and then signalled, is continued so that it
+/// can end (saves finished, lock released) without drawing. Before, the
+/// signal waited while the holder was stopped: the take-over failed
+/// "still held … after asking it to end", and the suspended console ended
+/// the moment its operator brought it back with `fg`.
+#[test]
+fn a_suspended_console_s_session_can_be_taken_over() {
+    let mut a = Console::start_under_shell(80, 24);
+    a.create_session("cube");
+    let shell = a.child.process_id().expect("the shell's pid");
+    let vss = child_of(shell).expect("the console runs under the shell");
+    a.send("\x1a");
+    a.wait("the shell's job stopped", 10, |s| {
+        s.contains("Stopped") && shell_terminal(&a)
+    });
+    let mut b = a.another(80, 24);
+    b.wait_text("choose a session", 10);
+    b.send("\r");
+    b.wait("the question to take it over", 10, |s| {
+        flat(&s.replace('│', " ")).contains("Take it over anyway?")
+    });
+    b.yes();
+    b.wait_text("lightings", 30);
+    let end = std::time::Instant::now() + Duration::from_secs(10);
+    while !ended(vss) {
+        assert!(
+            std::time::Instant::now() < end,
+            "the suspended console did not end"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let log = std::fs::read_to_string(a.session().join("cube.log")).unwrap();
+    assert!(log.contains("console ended: SIGTERM"), "{log}");
+    assert!(shell_terminal(&a), "not drawn again:\n{}", a.screen());
+    b.send("q");
+    assert_eq!(b.wait_exit(10), 0);
+}
