@@ -370,3 +370,33 @@ fn a_suspended_console_s_session_can_be_taken_over() {
     b.send("q");
     assert_eq!(b.wait_exit(10), 0);
 }
+
+/// A name pasted with a letter outside a-z (an é, from a keyboard or a
+/// paste) is refused in words that do not call it a non-letter: the rule
+/// shown before typing and the refusal both say which letters. Before,
+/// both said "letters", and the refusal of 'é' read "use only letters".
+#[test]
+fn a_session_name_with_an_accent_is_refused_in_words_that_say_which_letters() {
+    let mut c = Console::start(80, 24, &[]);
+    c.wait_text("choose a session", 10);
+    c.press(
+        SURVEY,
+        vss::tui::keymap::Action::Survey(vss::tui::keymap::SurveyAction::NewSession),
+    );
+    let s = c.wait_text("new session name", 5);
+    assert!(
+        flat(&s.replace('│', " ")).contains("letters a-z A-Z, digits"),
+        "{s}"
+    );
+    c.send("cubé\r");
+    let s = c.wait("the refusal", 10, |s| s.contains("refused"));
+    let said = flat(&s.replace('│', " "));
+    assert!(
+        said.contains("contains 'é' at position 4; use only the letters a-z and A-Z"),
+        "{s}"
+    );
+    c.send("\x1b");
+    c.wait("the field closed", 5, |s| !s.contains("new session name"));
+    c.send("q");
+    assert_eq!(c.wait_exit(10), 0);
+}
