@@ -25,6 +25,7 @@ pub mod event;
 pub mod keymap;
 pub mod mode;
 pub mod screens;
+mod suspend;
 pub mod text;
 pub mod widgets;
 pub mod workers;
@@ -64,9 +65,16 @@ pub fn run(profile: crate::profile::Profile, look: mode::Look) -> anyhow::Result
             .context("installing signal handlers")?;
         signal_hook::flag::register(sig, stop.clone()).context("installing signal handlers")?;
     }
+    // Ctrl-Z from elsewhere (`kill -TSTP`) and `fg`: the loop leaves and
+    // takes back the terminal ([`suspend`]).
+    let job = JobSignals::default();
+    signal_hook::flag::register(signal_hook::consts::SIGTSTP, job.stop.clone())
+        .context("installing signal handlers")?;
+    signal_hook::flag::register(signal_hook::consts::SIGCONT, job.cont.clone())
+        .context("installing signal handlers")?;
     install_panic_hook();
     let mut terminal = enter().context("setting up the terminal")?;
-    let result = run_loop(&mut terminal, profile, look, &stop, &signal);
+    let result = run_loop(&mut terminal, profile, look, &stop, &signal, &job);
     // Drop the terminal first: its own clean-up writes to the screen, and
     // leaving the alternate screen must be the last thing written.
     drop(terminal);
@@ -81,6 +89,13 @@ pub fn run(profile: crate::profile::Profile, look: mode::Look) -> anyhow::Result
 }
 
 type Term = Terminal<CrosstermBackend<io::Stdout>>;
+
+/// SIGTSTP and SIGCONT as they come: the loop takes them.
+#[derive(Default)]
+struct JobSignals {
+    stop: Arc<AtomicBool>,
+    cont: Arc<AtomicBool>,
+}
 
 fn enter() -> io::Result<Term> {
     terminal::enable_raw_mode()?;
@@ -158,6 +173,7 @@ fn run_loop(
     look: mode::Look,
     stop: &Arc<AtomicBool>,
     signal: &Arc<AtomicUsize>,
+    job: &JobSignals,
 ) -> anyhow::Result<()> {
     let (tx, rx) = mpsc::channel::<Msg>();
     let mut app = App::new(&profile, look);
@@ -178,9 +194,15 @@ fn run_loop(
     workers.dispatch(app.take_log_lines().into_iter().collect());
     let mut dirty = true;
     let mut last_draw = Instant::now();
+    // A terminal that takes no more output (its window gone, no SIGHUP
+    // seen yet) ends the loop like a hang-up: the workers still finish.
+    let mut broken: Option<io::Error> = None;
     while !app.quit() && !stop.load(Ordering::SeqCst) {
         if dirty && last_draw.elapsed() >= FRAME {
-            draw(terminal, &app)?;
+            if let Err(e) = draw(terminal, &app) {
+                broken = Some(e);
+                break;
+            }
             last_draw = Instant::now();
             dirty = false;
         }
@@ -202,7 +224,7 @@ fn run_loop(
                     dirty |= !matches!(msg, Msg::Tick);
                     let cmds = app.update(msg);
                     workers.dispatch(cmds);
-                    if app.quit() {
+                    if app.quit() || app.chrome.suspend {
                         break;
                     }
                 }
@@ -212,11 +234,26 @@ fn run_loop(
             Err(RecvTimeoutError::Timeout) => dirty |= app.release_held(Instant::now()),
             Err(RecvTimeoutError::Disconnected) => break,
         }
+        let asked = app.take_suspend();
+        if (asked || job.stop.swap(false, Ordering::SeqCst)) && !stop.load(Ordering::SeqCst) {
+            suspend_here(terminal, &mut app, asked, job, &workers, stop);
+            dirty = true;
+        } else if job.cont.swap(false, Ordering::SeqCst) {
+            // Continued after a stop the console did not make (SIGSTOP):
+            // the shell may have taken the terminal back meanwhile.
+            take_back(terminal, &mut app, stop);
+            dirty = true;
+        }
+        workers.dispatch(app.take_log_lines().into_iter().collect());
         workers.dispatch(app.due(Instant::now()));
     }
     // The log says why the console ended: the operator, a signal, or the
     // terminal gone.
     let why = match signal.load(Ordering::SeqCst) as i32 {
+        0 if broken.is_some() => format!(
+            "the terminal cannot be written ({})",
+            broken.as_ref().map_or(String::new(), |e| e.to_string())
+        ),
         0 if app.quit() => "quit by the operator".to_string(),
         0 if stop.load(Ordering::SeqCst) => "the terminal's input ended (hang-up)".to_string(),
         0 => "its workers stopped".to_string(),
@@ -229,7 +266,69 @@ fn run_loop(
     app.ctx().info(format!("console ended: {why}"));
     workers.dispatch(app.take_log_lines().into_iter().collect());
     workers.finish();
-    Ok(())
+    match broken {
+        Some(e) => Err(anyhow::Error::from(e).context("drawing the console")),
+        None => Ok(()),
+    }
+}
+
+/// Suspends the console (Ctrl-Z, or `asked` false: SIGTSTP) if a shell can
+/// continue it, saying so on the main screen and in the log, and takes the
+/// terminal back when continued. A console continued to end (the shell
+/// hung up sends SIGHUP, then SIGCONT) does not draw again: the loop ends
+/// as for any hang-up, saves finished first.
+fn suspend_here(
+    terminal: &mut Term,
+    app: &mut App,
+    asked: bool,
+    job: &JobSignals,
+    workers: &Workers,
+    stop: &AtomicBool,
+) {
+    let how = if asked { "Ctrl-Z" } else { "SIGTSTP" };
+    if !suspend::can_suspend() {
+        app.ctx().warn(format!(
+            "{how}: not suspended — no shell with job control started this console, \
+             so nothing could bring it back; q quits"
+        ));
+        return;
+    }
+    let held = match &app.session.view {
+        Some(v) if !v.read_only => format!("; session {} stays open here", v.name),
+        _ => String::new(),
+    };
+    app.ctx().info(format!("suspended ({how}){held}"));
+    workers.dispatch(app.take_log_lines().into_iter().collect());
+    let note = format!("vss: suspended{held}; fg brings the console back");
+    if let Err(e) = suspend::stop(&note) {
+        app.ctx().error(format!("{how}: not suspended: {e}"));
+    }
+    // This stop's own SIGTSTP (sent to the group) and SIGCONT: the
+    // terminal is taken back here.
+    job.stop.store(false, Ordering::SeqCst);
+    job.cont.store(false, Ordering::SeqCst);
+    take_back(terminal, app, stop);
+}
+
+/// Takes the terminal again after a stop, unless the console is ending;
+/// a terminal that cannot be taken (gone) ends it.
+fn take_back(terminal: &mut Term, app: &mut App, stop: &AtomicBool) {
+    if stop.load(Ordering::SeqCst) {
+        return;
+    }
+    match suspend::take_back(terminal) {
+        Ok(()) => {
+            if let Ok(size) = terminal.size() {
+                app.update(Msg::Resize(size.width, size.height));
+            }
+            app.ctx().info("back from suspension");
+        }
+        Err(e) => {
+            app.ctx()
+                .error(format!("the terminal cannot be taken back: {e}"));
+            stop.store(true, Ordering::SeqCst);
+        }
+    }
 }
 
 /// Draws one frame as a synchronized update (DEC mode 2026): a terminal

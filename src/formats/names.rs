@@ -34,7 +34,7 @@ pub enum NameError {
     #[error("session name {name:?} starts with {c:?}; it must start with a letter or _")]
     BadStart { name: String, c: char },
     #[error(
-        "session name {name:?} contains {c:?} at position {pos}; use only letters, digits, _ or -"
+        "session name {name:?} contains {c:?} at position {pos}; use only the letters a-z and A-Z, digits, _ or -"
     )]
     BadChar { name: String, c: char, pos: usize },
     #[error(

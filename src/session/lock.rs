@@ -101,6 +101,12 @@ impl LockInfo {
 /// lock's `proc_start`, it runs as this user, and its executable is vss.
 /// The signal goes through the `kill` system call, not a program found on
 /// `PATH`. `Err` says why nothing was signalled.
+///
+/// SIGCONT follows: a console suspended with Ctrl-Z in a shell still
+/// running (a detached tmux) can only act on SIGTERM once continued; it
+/// then ends without taking the terminal again. Before, the take-over of
+/// a suspended console failed ("still held … after asking it to end") and
+/// the console ended the moment its operator brought it back with `fg`.
 pub fn ask_holder_to_leave(holder: &LockInfo) -> Result<(), String> {
     let pid = holder.pid;
     provably_vss(holder, "the lock's holder")?;
@@ -109,7 +115,9 @@ pub fn ask_holder_to_leave(holder: &LockInfo) -> Result<(), String> {
         .and_then(rustix::process::Pid::from_raw)
         .ok_or_else(|| format!("process {pid}: not a pid"))?;
     rustix::process::kill_process(pid_t, rustix::process::Signal::TERM)
-        .map_err(|e| format!("cannot signal process {pid}: {e}"))
+        .map_err(|e| format!("cannot signal process {pid}: {e}"))?;
+    rustix::process::kill_process(pid_t, rustix::process::Signal::CONT)
+        .map_err(|e| format!("cannot continue process {pid}: {e}"))
 }
 
 /// Whether `who` names a live vss of this user on this host, provably:

@@ -11,10 +11,10 @@
 //! the frame, the picture, or a screen's `update(action, ctx)` — that
 //! matches its own actions exhaustively. Drawing (`screens/`) only reads.
 
-use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyEventKind};
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 
 use super::event::{Cmd, DeviceCmd, Msg, StoreCmd};
-use super::keymap::{self, Action, GlobalAction, NavAction, Scope, ScreenId};
+use super::keymap::{self, Action, GlobalAction, ModalAction, NavAction, Scope, ScreenId};
 use super::mode::Look;
 use crate::profile::Profile;
 
@@ -195,6 +195,12 @@ impl App {
         self.chrome.quit
     }
 
+    /// Whether the operator asked to suspend the console (Ctrl-Z), once:
+    /// the shell leaves the terminal and stops the process.
+    pub fn take_suspend(&mut self) -> bool {
+        std::mem::take(&mut self.chrome.suspend)
+    }
+
     /// Applies one message; returns the work it asks of the workers.
     pub fn update(&mut self, msg: Msg) -> Vec<Cmd> {
         let by_operator = match &msg {
@@ -279,6 +285,12 @@ impl App {
         if key.kind != KeyEventKind::Press {
             return Vec::new();
         }
+        // Ctrl-Z suspends from anywhere, as in any terminal program: a
+        // question or a field open stays as it is for the return.
+        if keymap::lookup(Scope::Global, &key) == Some(Action::Global(GlobalAction::Suspend)) {
+            self.chrome.suspend = true;
+            return Vec::new();
+        }
         let scope = self.scope();
         // Too small a terminal shows no screen, only what goes on and the
         // question asked: keys act on nothing unseen. q quits, Esc stops a
@@ -297,6 +309,21 @@ impl App {
             } else if let Some(a) = keymap::lookup(Scope::Search, &key) {
                 return self.act(a);
             }
+        }
+        // Ctrl-C gets out: of a field or a question as Esc does, and a
+        // second Ctrl-C at "Quit anyway?" quits, as pressing it twice means.
+        let quit_asked = matches!(
+            &self.chrome.modal,
+            Some(Modal::Confirm {
+                on_yes: Pending::Quit,
+                ..
+            })
+        );
+        if quit_asked
+            && key.modifiers.contains(KeyModifiers::CONTROL)
+            && keymap::lookup(Scope::Global, &key) == Some(Action::Global(GlobalAction::Quit))
+        {
+            return self.act(Action::Modal(ModalAction::Yes));
         }
         match keymap::lookup(scope, &key) {
             Some(a) => self.act(a),
@@ -409,6 +436,10 @@ impl App {
                 } else {
                     self.chrome.quit = true;
                 }
+                Vec::new()
+            }
+            GlobalAction::Suspend => {
+                self.chrome.suspend = true;
                 Vec::new()
             }
             GlobalAction::Help => {

@@ -95,6 +95,8 @@ pub enum Action {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GlobalAction {
     Quit,
+    /// Back to the shell that started the console (Ctrl-Z); `fg` returns.
+    Suspend,
     Help,
     ToggleLog,
     /// The last message in full, in a window of its own.

@@ -227,59 +227,78 @@ impl App {
     }
 }
 
+/// A terminal too small for the screens: what goes on and what is asked
+/// stay in sight, with their keys on the bottom rows as the hint row has
+/// them, so a window only a few rows high still says how to answer or
+/// quit; why nothing else is drawn comes after, in what room is left.
+fn too_small(app: &App, area: Rect, buf: &mut Buffer) {
+    let t = app.theme();
+    let mut text = vec![Line::styled("terminal too small", t.error())];
+    // A capture under way.
+    if let Some((purpose, done, total)) = app.cell.device.transfer {
+        let what = match purpose {
+            crate::tui::event::FramePurpose::Survey { letter, .. } => {
+                format!("image {} lighting {letter}", app.session.work.k)
+            }
+            _ => "a frame".to_string(),
+        };
+        let pct = (done * 100).checked_div(total).unwrap_or(0);
+        text.push(Line::styled(
+            format!("capturing {what}: {pct}% — Esc stops"),
+            t.warn(),
+        ));
+    } else if app.session.work.phase == crate::tui::app::Phase::Capturing {
+        text.push(Line::styled(
+            format!("capturing image {} — Esc stops", app.session.work.k),
+            t.warn(),
+        ));
+    }
+    // The question asked, and its keys.
+    let (keys, wait) = match &app.chrome.modal {
+        Some(m @ crate::tui::app::Modal::Confirm { question, .. }) => {
+            text.push(Line::styled(question.clone(), t.title()));
+            let keys: Vec<String> = m
+                .choices()
+                .iter()
+                .map(|(k, w)| format!("{k} {w}"))
+                .collect();
+            (keys.join("  "), "")
+        }
+        Some(crate::tui::app::Modal::Prompt(p)) => {
+            text.push(Line::styled(format!("{} {}", p.title, p.text), t.title()));
+            ("Enter accept  Esc cancel".to_string(), "")
+        }
+        None => ("q quits".to_string(), "other keys wait for a larger window"),
+    };
+    text.push(Line::raw(format!(
+        "now {} × {}, vss needs {} × {}: enlarge the window",
+        area.width, area.height, MIN_SIZE.0, MIN_SIZE.1
+    )));
+    if !wait.is_empty() {
+        text.push(Line::raw(wait));
+    }
+    let keys: Vec<Line> = chrome::wrap(&keys, usize::from(area.width))
+        .into_iter()
+        .map(Line::raw)
+        .collect();
+    let rows = u16::try_from(keys.len())
+        .unwrap_or(u16::MAX)
+        .min(area.height);
+    let [upper, lower] =
+        Layout::vertical([Constraint::Min(0), Constraint::Length(rows)]).areas(area);
+    Paragraph::new(text)
+        .wrap(Wrap { trim: true })
+        .render(upper, buf);
+    Paragraph::new(keys).render(lower, buf);
+    if app.ascii() {
+        chrome::asciify(area, buf);
+    }
+}
+
 impl Widget for &App {
     fn render(self, area: Rect, buf: &mut Buffer) {
         if area.width < MIN_SIZE.0 || area.height < MIN_SIZE.1 {
-            let t = self.theme();
-            let mut text = vec![
-                Line::styled("terminal too small", t.error()),
-                Line::raw(format!(
-                    "now {} × {}, vss needs {} × {}: enlarge the window",
-                    area.width, area.height, MIN_SIZE.0, MIN_SIZE.1
-                )),
-            ];
-            // What goes on and what is asked stay in sight: a capture under
-            // way, and an open question with its keys.
-            if let Some((purpose, done, total)) = self.cell.device.transfer {
-                let what = match purpose {
-                    crate::tui::event::FramePurpose::Survey { letter, .. } => {
-                        format!("image {} lighting {letter}", self.session.work.k)
-                    }
-                    _ => "a frame".to_string(),
-                };
-                let pct = (done * 100).checked_div(total).unwrap_or(0);
-                text.push(Line::styled(
-                    format!("capturing {what}: {pct}% — Esc stops"),
-                    t.warn(),
-                ));
-            } else if self.session.work.phase == crate::tui::app::Phase::Capturing {
-                text.push(Line::styled(
-                    format!("capturing image {} — Esc stops", self.session.work.k),
-                    t.warn(),
-                ));
-            }
-            match &self.chrome.modal {
-                Some(m @ crate::tui::app::Modal::Confirm { question, .. }) => {
-                    text.push(Line::styled(question.clone(), t.title()));
-                    let keys: Vec<String> = m
-                        .choices()
-                        .iter()
-                        .map(|(k, w)| format!("{k} {w}"))
-                        .collect();
-                    text.push(Line::raw(keys.join("  ")));
-                }
-                Some(crate::tui::app::Modal::Prompt(p)) => {
-                    text.push(Line::styled(format!("{} {}", p.title, p.text), t.title()));
-                    text.push(Line::raw("Enter accept  Esc cancel"));
-                }
-                None => text.push(Line::raw("q quits; other keys wait for a larger window")),
-            }
-            Paragraph::new(text)
-                .wrap(Wrap { trim: true })
-                .render(area, buf);
-            if self.ascii() {
-                chrome::asciify(area, buf);
-            }
+            too_small(self, area, buf);
             return;
         }
         let f = self.frame(area);

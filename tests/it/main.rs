@@ -77,5 +77,6 @@ mod tui_pty_takeover;
 mod tui_pty_trouble;
 mod tui_pty_tuning;
 mod tui_pty_xcal;
+mod tui_pty_xterm;
 mod tui_screens;
 mod tui_truth;

@@ -119,7 +119,55 @@ impl Console {
         Console::spawn(&cwd, dir, cols, rows, env, args)
     }
 
+    /// An interactive shell with job control (bash) in the terminal, in a
+    /// fresh folder holding [`PROFILE`] as `cell.toml`, which starts the
+    /// console as an operator would; `child` is the shell. When the
+    /// console ends the shell says `vss ended N` (its exit code).
+    pub fn start_under_shell(cols: u16, rows: u16) -> Console {
+        Console::start_under_shell_as(cols, rows, |vss| {
+            format!("{vss} --profile cell.toml; echo vss ended $?")
+        })
+    }
+
+    /// As [`Console::start_under_shell`], the shell given the command line
+    /// `line` makes of the console's command (`vss --profile cell.toml`
+    /// with the binary's path).
+    pub fn start_under_shell_as(
+        cols: u16,
+        rows: u16,
+        line: impl FnOnce(&str) -> String,
+    ) -> Console {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("cell.toml"), PROFILE).unwrap();
+        let cwd = dir.path().to_path_buf();
+        let mut c = Console::spawn_program(
+            "bash",
+            &cwd,
+            dir,
+            cols,
+            rows,
+            &[("PS1", "$ "), ("HISTFILE", "/dev/null")],
+            &["--norc", "--noprofile", "-i"],
+        );
+        // Typed at once: the shell reads it once it is ready.
+        c.send(&format!("{}\r", line(env!("CARGO_BIN_EXE_vss"))));
+        c
+    }
+
     fn spawn(
+        cwd: &Path,
+        dir: tempfile::TempDir,
+        cols: u16,
+        rows: u16,
+        env: &[(&str, &str)],
+        args: &[&str],
+    ) -> Console {
+        let vss = env!("CARGO_BIN_EXE_vss");
+        Console::spawn_program(vss, cwd, dir, cols, rows, env, args)
+    }
+
+    pub fn spawn_program(
+        program: &str,
         cwd: &Path,
         dir: tempfile::TempDir,
         cols: u16,
@@ -135,7 +183,7 @@ impl Console {
             pixel_height: 0,
         };
         let pair = pty.openpty(size).unwrap();
-        let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_vss"));
+        let mut cmd = CommandBuilder::new(program);
         cmd.args(args);
         cmd.cwd(cwd);
         cmd.env("TERM", "xterm-256color");

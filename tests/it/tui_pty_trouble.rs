@@ -38,7 +38,7 @@ fn a_long_message_is_readable_and_kept() {
     c.wait_text("new session name", 5);
     c.send("a bad name with spaces\r");
     let s = c.wait_words(
-        "contains ' ' at position 2; use only letters, digits, _ or -",
+        "contains ' ' at position 2; use only the letters a-z and A-Z, digits, _ or -",
         10,
     );
     assert!(
@@ -49,7 +49,10 @@ fn a_long_message_is_readable_and_kept() {
     c.wait("the field closed", 5, |s| !s.contains("new session name"));
     global(&mut c, GlobalAction::LastMessage);
     let s = c.wait_text("last message", 5);
-    assert!(flat(&s).contains("use only letters, digits, _ or -"), "{s}");
+    assert!(
+        flat(&s).contains("use only the letters a-z and A-Z, digits, _ or -"),
+        "{s}"
+    );
     c.send("\x1b");
     c.wait("the window closed", 5, |s| !s.contains("last message"));
     global(&mut c, GlobalAction::ToggleLog);

@@ -97,6 +97,9 @@ pub struct Chrome {
     /// The answer to the last key, held on the message line.
     pub held: Option<Held>,
     pub quit: bool,
+    /// The operator asked to suspend the console (Ctrl-Z): the shell
+    /// takes it ([`crate::tui::App::take_suspend`]).
+    pub suspend: bool,
 }
 
 impl Chrome {
@@ -113,6 +116,7 @@ impl Chrome {
             size: (80, 24),
             held: None,
             quit: false,
+            suspend: false,
         }
     }
 

@@ -57,7 +57,7 @@ pub struct SurveyScreen {
 }
 
 /// The rule of session names, shown before typing one.
-pub const NAME_RULE: &str = "letters, digits, _ and -, starting with a letter or _, at most \
+pub const NAME_RULE: &str = "letters a-z A-Z, digits, _ and -, starting with a letter or _, at most \
      32; end with a letter: q1 would name its image 1 q11a.img, which reads as image 11 of q";
 
 impl SurveyScreen {

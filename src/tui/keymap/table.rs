@@ -90,11 +90,13 @@ pub const KEYMAP: &[Binding] = rows! {
     CO, ch('y'), Modal(Yes), "yes, go ahead", "yes";
     CO, ch('n'), Modal(No), "no, keep what is there", "no";
     CO, k(K::Esc), Modal(No), "no", "";
+    CO, ctrl('c'), Modal(No), "no; at \"Quit anyway?\" yes: a second C-c quits", "";
     CO, ch('a'), Modal(All), "all (where the question offers it)", "all";
     CO, ch('r'), Modal(Look), "read-only: only look, nothing saved (where the question offers it)", "read-only";
     // Typing.
     PR, k(K::Enter), Modal(Submit), "accept the typed text", "accept";
     PR, k(K::Esc), Modal(Cancel), "cancel typing", "cancel";
+    PR, ctrl('c'), Modal(Cancel), "cancel typing", "";
     PR, k(K::Left), Modal(Left), "cursor left", "";
     PR, k(K::Right), Modal(Right), "cursor right", "";
     PR, k(K::Home), Modal(Home), "to the start", "";
@@ -235,4 +237,5 @@ pub const KEYMAP: &[Binding] = rows! {
     SR, ch('N'), Search(Prev), "the previous match", "previous";
     SR, k(K::Esc), Search(Clear), "end the search", "end search";
     G, ctrl('c'), Global(Quit), "quit", "";
+    G, ctrl('z'), Global(Suspend), "suspend to the shell, anywhere (fg brings the console back)", "";
 };

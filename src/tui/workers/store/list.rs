@@ -9,8 +9,21 @@ use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 use std::time::{SystemTime, UNIX_EPOCH};
 
+use crate::session::lock::LockInfo;
 use crate::session::{Session, SessionError};
 use crate::tui::event::SessionEntry;
+
+/// What the list says of a session's lock. Whether its holder still runs
+/// is looked at each time (a console killed changes nothing in the folder):
+/// a lock a console left behind when it was killed is not "in use", and
+/// the session opens (the lock is taken over).
+fn in_use(h: &LockInfo) -> String {
+    if h.is_stale() {
+        " (stale lock: its console ended)".to_string()
+    } else {
+        format!(" (in use by {})", crate::formats::sanitize(&h.user))
+    }
+}
 
 /// What a folder's entry rests on: the folder, `FOLDER.toml` and
 /// `FOLDER.lock`, each by inode, change time (any write, rename or
@@ -38,7 +51,7 @@ enum Read {
         done: usize,
         all: usize,
         /// Who the lock names, if anyone.
-        holder: Option<String>,
+        holder: Option<LockInfo>,
         /// When its manifest was last written.
         when: SystemTime,
     },
@@ -57,7 +70,7 @@ fn read(dir: &Path) -> Read {
             Read::Session {
                 done,
                 all,
-                holder: s.lock_holder().map(|h| h.user),
+                holder: s.lock_holder(),
                 when,
                 name,
             }
@@ -120,7 +133,7 @@ impl Lister {
                     let busy = if here == Some(dir.as_path()) {
                         " (open here)".to_string()
                     } else {
-                        holder.map_or(String::new(), |h| format!(" (in use by {h})"))
+                        holder.map_or(String::new(), |h| in_use(&h))
                     };
                     let summary = format!("{done}/{all} done{busy}");
                     let entry = SessionEntry {
