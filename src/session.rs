@@ -114,6 +114,8 @@ pub enum SessionError {
         path.display()
     )]
     LockLost { path: PathBuf, holder: String },
+    #[error(transparent)]
+    FolderGone(#[from] lock::FolderGone),
     #[error(
         "{}{}: {message}; the manifest was left as it is: fix it by hand or restore it",
         path.display(),
@@ -130,8 +132,9 @@ pub enum SessionError {
     UnknownLighting { letter: char, known: String },
     #[error(
         "{}: the session folder's path is {len} bytes long; with the files' names it would \
-         exceed the system's limit of {PATH_MAX} bytes: make the session in a shorter path",
-        dir.display()
+         exceed the system's limit of {} bytes: make the session in a shorter path",
+        dir.display(),
+        fresh::PATH_MAX
     )]
     PathTooLong { dir: PathBuf, len: usize },
     #[error("image number {0} is out of range: image numbers run from 1 to {MAX_IMAGE_NUMBER}")]
@@ -159,25 +162,6 @@ pub enum SessionError {
         image: u32,
         what: String,
     },
-}
-
-/// The longest path the system takes (`PATH_MAX`, with its final NUL).
-const PATH_MAX: usize = libc::PATH_MAX as usize;
-
-/// Refuses a session folder whose files' paths would exceed `PATH_MAX`
-/// (the longest: a temporary name of `NAME9999z.img`), before anything is
-/// made: such a session was made, then not found.
-fn check_path_len(dir: &Path, name: &SessionName) -> Result<(), SessionError> {
-    let abs = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
-    // "/.NAME9999z.img.tmp.PID.HHHHHHHHRRRRRRRR" and the final NUL.
-    let longest = abs.as_os_str().len() + 2 + name.as_str().len() + 9 + 5 + 10 + 17 + 1;
-    if longest > PATH_MAX {
-        return Err(SessionError::PathTooLong {
-            dir: dir.to_path_buf(),
-            len: abs.as_os_str().len(),
-        });
-    }
-    Ok(())
 }
 
 fn locked_message(path: &Path, holder: &str, stale: bool, foreign: bool) -> String {
@@ -225,7 +209,7 @@ impl Session {
         if dir.join(format!("{n}.toml")).exists() {
             return Err(SessionError::Exists { dir });
         }
-        check_path_len(&dir, &n)?;
+        fresh::check_path_len(&dir, &n)?;
         let before = fresh::Before::look(&dir);
         // The session (and its lock) is dropped before its folder goes.
         let made = Self::make(dir.clone(), n, profile).and_then(|mut s| setup(&mut s).map(|()| s));

@@ -76,5 +76,6 @@ mod tui_pty_switch;
 mod tui_pty_takeover;
 mod tui_pty_trouble;
 mod tui_pty_tuning;
+mod tui_pty_xfile;
 mod tui_screens;
 mod tui_truth;
