@@ -164,6 +164,11 @@ pub enum SessionError {
     },
 }
 
+/// Whether anything is at `path` (a dangling link too).
+fn present(path: &Path) -> bool {
+    fs::symlink_metadata(path).is_ok()
+}
+
 fn locked_message(path: &Path, holder: &str, stale: bool, foreign: bool) -> String {
     let what = if stale {
         "that process is gone: take the session over with --take-over".to_string()
@@ -206,7 +211,7 @@ impl Session {
     ) -> Result<Session, SessionError> {
         let n = SessionName::new(name)?;
         let dir = parent.join(n.as_str());
-        if dir.join(format!("{n}.toml")).exists() {
+        if present(&dir.join(format!("{n}.toml"))) {
             return Err(SessionError::Exists { dir });
         }
         fresh::check_path_len(&dir, &n)?;
@@ -302,7 +307,7 @@ impl Session {
     pub fn open_existing(parent: &Path, name: &str) -> Result<Option<Session>, SessionError> {
         let n = SessionName::new(name)?;
         let dir = parent.join(n.as_str());
-        if dir.join(format!("{n}.toml")).exists() {
+        if present(&dir.join(format!("{n}.toml"))) {
             Self::open(&dir).map(Some)
         } else {
             Ok(None)
@@ -338,7 +343,9 @@ impl Session {
             manifest: "NAME.toml".into(),
         })?;
         let manifest_path = dir.join(format!("{name}.toml"));
-        if !manifest_path.is_file() {
+        // Anything there is read, and what it is said (a folder, a FIFO, a
+        // link): only a folder without one is "not a session folder".
+        if !present(&manifest_path) {
             return Err(SessionError::NotASession {
                 dir,
                 manifest: format!("{name}.toml"),

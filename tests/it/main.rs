@@ -47,6 +47,7 @@ mod robust_fuzz;
 mod robust_inputs;
 mod robust_report;
 mod robust_session;
+mod robust_xfile;
 mod session_api;
 mod session_big;
 mod session_cli;

@@ -35,3 +35,23 @@ fn a_session_folder_moved_away_while_open_is_said_and_nothing_is_written() {
     c.send("q");
     c.wait_exit(10);
 }
+
+/// A session whose manifest was replaced by a folder is listed DAMAGED
+/// with why, not left out of the list as if there were no session.
+#[test]
+fn a_session_whose_manifest_is_a_folder_is_listed_damaged() {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("cube");
+    let m = c.session().join("cube.toml");
+    let mut c = c.restart_after(|_| {
+        std::fs::remove_file(&m).unwrap();
+        std::fs::create_dir(&m).unwrap();
+    });
+    c.wait_text("choose a session", 10);
+    c.wait("cube listed DAMAGED", 10, |s| {
+        s.lines()
+            .any(|r| r.contains("cube") && r.contains("DAMAGED"))
+    });
+    c.send("q");
+    c.wait_exit(10);
+}
