@@ -91,3 +91,73 @@ fn a_manifest_that_is_not_a_file_is_named_as_what_it_is() {
         assert!(!ok && out.contains("already exists"), "{what}: {out}");
     }
 }
+
+/// A session `s/g` of one image grabbed in lighting a on the simulated
+/// cell (64² frames), with its outputs.
+fn grabbed_session(dir: &Path) {
+    let mut p = vss::rig::sim::cell_profile(64, 64);
+    p.sim.noise = 0.0;
+    p.relay.settle_ms = 5;
+    std::fs::write(dir.join("cell.toml"), toml::to_string(&p).unwrap()).unwrap();
+    let (ok, out) = vss(
+        dir,
+        &[
+            "--profile",
+            "cell.toml",
+            "grab",
+            "--session",
+            "s/g",
+            "--image",
+            "1",
+            "--camera",
+            "1",
+            "--lighting",
+            "a",
+        ],
+    );
+    assert!(ok, "{out}");
+    let (ok, out) = vss(
+        dir,
+        &[
+            "--profile",
+            "cell.toml",
+            "session",
+            "redo",
+            "s/g",
+            "--image",
+            "1",
+            "--from",
+            "lens",
+        ],
+    );
+    assert!(ok, "{out}");
+}
+
+/// A report that stops after some of its files are written (here an SVG
+/// whose name is taken by a folder; a full disk alike) says which files it
+/// did write: they replaced the old ones. Before, it said only "cannot
+/// write all1.svg", as if the PostScript report on disk were still the old
+/// one.
+#[test]
+fn a_report_stopped_part_way_names_what_it_wrote() {
+    let t = tempfile::tempdir().unwrap();
+    grabbed_session(t.path());
+    std::fs::write(t.path().join("all.ps"), "the old report\n").unwrap();
+    std::fs::create_dir(t.path().join("all1.svg")).unwrap();
+    let (ok, out) = vss(
+        t.path(),
+        &["report", "s/g", "--ps", "all.ps", "--svg", "all.svg"],
+    );
+    assert!(!ok, "{out}");
+    let ps = std::fs::read_to_string(t.path().join("all.ps")).unwrap();
+    assert!(ps.starts_with("%!PS"), "all.ps is the new report");
+    assert!(out.contains("cannot write all1.svg"), "{out}");
+    assert!(
+        !out.contains("all1.svg on disk is the OLD report"),
+        "a folder is no report:\n{out}"
+    );
+    assert!(
+        out.contains("written before it stopped (the NEW report): all.ps"),
+        "says all.ps was replaced:\n{out}"
+    );
+}
