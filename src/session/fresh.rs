@@ -47,8 +47,17 @@ impl Before {
     /// which held the session's lock), else the new files of `dir`. `Ok`
     /// when nothing made is left; else the first thing that could not go.
     pub(super) fn undo(&self) -> Result<(), (PathBuf, std::io::Error)> {
+        // Not there, or a file where a folder above it should be (a survey
+        // folder that is a file): nothing was made.
         let gone = |p: &Path, r: std::io::Result<()>| match r {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err((p.to_path_buf(), e)),
+            Err(e)
+                if !matches!(
+                    e.kind(),
+                    std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
+                ) =>
+            {
+                Err((p.to_path_buf(), e))
+            }
             _ => Ok(()),
         };
         if self.missing.is_empty() {

@@ -161,3 +161,30 @@ fn a_report_stopped_part_way_names_what_it_wrote() {
         "says all.ps was replaced:\n{out}"
     );
 }
+
+/// A session asked for under a file (a survey folder that is a file, as a
+/// profile's `dir` or `--dir`) is refused saying nothing was made; before,
+/// it said "what it had made could not all be removed …: remove afile/w by
+/// hand", sending the operator after a folder that never was.
+#[test]
+fn a_session_under_a_file_is_refused_without_sending_anyone_to_clean_up() {
+    let t = tempfile::tempdir().unwrap();
+    std::fs::write(t.path().join("p.toml"), ONE_CAMERA).unwrap();
+    std::fs::write(t.path().join("afile"), "a file\n").unwrap();
+    for dir in ["afile", "afile/sub"] {
+        let (ok, out) = vss(
+            t.path(),
+            &["--profile", "p.toml", "session", "new", "w", "--dir", dir],
+        );
+        assert!(!ok, "{out}");
+        assert!(out.contains("Not a directory"), "why:\n{out}");
+        assert!(
+            out.contains("nothing of it is left") && !out.contains("by hand"),
+            "{dir}:\n{out}"
+        );
+    }
+    assert_eq!(
+        std::fs::read_to_string(t.path().join("afile")).unwrap(),
+        "a file\n"
+    );
+}
