@@ -621,7 +621,7 @@ impl Session {
         let rec = self.manifest.image(k);
         rec.map_or(&[][..], |r| r.grey.as_slice())
             .iter()
-            .map(|g| Ok((g.letter, formats::img::read_img(&self.path(&g.file))?)))
+            .map(|g| Ok((g.letter, input::read_frame(&self.path(&g.file), g)?)))
             .collect()
     }
 

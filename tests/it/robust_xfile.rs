@@ -188,3 +188,54 @@ fn a_session_under_a_file_is_refused_without_sending_anyone_to_clean_up() {
         "a file\n"
     );
 }
+
+/// A sparse `.img` whose header and size agree on `w` × `h` pixels.
+fn sparse_img(p: &Path, w: u16, h: u16) {
+    let mut head = vec![0u8; 64];
+    head[0] = b'I';
+    head[1] = b'M';
+    head[4..6].copy_from_slice(&w.to_le_bytes());
+    head[6..8].copy_from_slice(&h.to_le_bytes());
+    std::fs::write(p, &head).unwrap();
+    let f = std::fs::OpenOptions::new().write(true).open(p).unwrap();
+    f.set_len(64 + u64::from(w) * u64::from(h)).unwrap();
+}
+
+/// A session's frame replaced by a huge one (a 40000² `.img`, 1.6 GB,
+/// consistent with its own size) is refused from its header by `session
+/// check` and `session redo`, within 256 MiB of address space: they read it
+/// whole (check took 3.1 GB, redo 1.5 GB). A frame of another size than
+/// the manifest records is refused by redo naming both sizes.
+#[test]
+fn a_frame_replaced_by_a_huge_one_is_refused_from_its_header() {
+    let t = tempfile::tempdir().unwrap();
+    grabbed_session(t.path());
+    let frame = t.path().join("s/g/g1a.img");
+    std::fs::remove_file(&frame).unwrap();
+    sparse_img(&frame, 40000, 40000);
+    for args in [
+        &["session", "check", "s/g"][..],
+        &["session", "redo", "s/g", "--image", "1", "--from", "lens"],
+    ] {
+        let o = super::support::limited::vss_under(t.path(), "ulimit -v 262144", args);
+        let out =
+            String::from_utf8_lossy(&o.stdout).to_string() + &String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {out}");
+        assert!(
+            out.contains("g1a.img") && out.contains("40000") && out.contains("too large"),
+            "{args:?}: {out}"
+        );
+    }
+    // 80 × 64: a frame the stages take, but not the one recorded (64 × 64).
+    std::fs::remove_file(&frame).unwrap();
+    sparse_img(&frame, 80, 64);
+    let (ok, out) = vss(
+        t.path(),
+        &["session", "redo", "s/g", "--image", "1", "--from", "lens"],
+    );
+    assert!(!ok, "{out}");
+    assert!(
+        out.contains("g1a.img") && out.contains("80 x 64") && out.contains("records 64 x 64"),
+        "{out}"
+    );
+}

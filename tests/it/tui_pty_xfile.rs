@@ -55,3 +55,48 @@ fn a_session_whose_manifest_is_a_folder_is_listed_damaged() {
     c.send("q");
     c.wait_exit(10);
 }
+
+/// The peak resident memory (VmHWM) of process `pid`, KiB.
+fn vm_hwm_kib(pid: u32) -> u64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap()
+}
+
+/// A frame of a session replaced by a huge one (a sparse 40000² `.img`,
+/// 1.6 GB) is marked damaged when the console opens the session, read no
+/// further than its header: the console stays small. It read the frame
+/// whole (1.5 GB resident).
+#[test]
+fn a_frame_replaced_by_a_huge_one_is_marked_and_not_read() {
+    let mut c = Console::start(80, 24, &[]);
+    c.survey(1);
+    let frame = c.session().join("cube1a.img");
+    let mut c = c.restart_after(|_| {
+        std::fs::remove_file(&frame).unwrap();
+        let mut head = vec![0u8; 64];
+        head[..2].copy_from_slice(b"IM");
+        head[4..6].copy_from_slice(&40000u16.to_le_bytes());
+        head[6..8].copy_from_slice(&40000u16.to_le_bytes());
+        std::fs::write(&frame, &head).unwrap();
+        let f = std::fs::OpenOptions::new()
+            .write(true)
+            .open(&frame)
+            .unwrap();
+        f.set_len(64 + 40000 * 40000).unwrap();
+    });
+    c.wait_text("choose a session", 10);
+    c.wait("the session listed", 10, |s| s.contains("1/4 done"));
+    c.send("\r");
+    let s = c.wait_text("too large", 30);
+    assert!(flat(&s).contains("cube1a.img"), "{s}");
+    let pid = c.child.process_id().unwrap();
+    let kib = vm_hwm_kib(pid);
+    assert!(kib < 256 << 10, "the console's peak is {kib} KiB");
+    c.send("q");
+    c.wait_exit(10);
+}
