@@ -100,3 +100,33 @@ fn a_frame_replaced_by_a_huge_one_is_marked_and_not_read() {
     c.send("q");
     c.wait_exit(10);
 }
+
+/// On the Calibrate screen, `o` with the name of one photograph whose name
+/// holds a space (as a phone or a file manager names them) loads it. The
+/// text was split at the space: "plate: no such file".
+#[test]
+fn a_photograph_whose_name_holds_a_space_is_loaded() {
+    use vss::tui::keymap::{CalibrateAction as CA, GlobalAction, Scope, ScreenId};
+    let mut c = Console::start(80, 24, &[]);
+    let img = vss::llv::GreyImage::new(64, 64, vec![128; 64 * 64]).unwrap();
+    let photo = c.dir.path().join("plate 1.img");
+    vss::formats::img::write_img(&photo, &vss::formats::img::ImgFile::new(img)).unwrap();
+    c.wait_text("Survey", 10);
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
+    );
+    c.wait_text("views kept: 0", 10);
+    c.press(
+        Scope::Screen(ScreenId::Calibrate),
+        Action::Calibrate(CA::Open),
+    );
+    c.wait_text("photographs to load:", 10);
+    c.send("plate 1.img\r");
+    let s = c.wait("the photograph read", 20, |s| {
+        flat(s).contains("1 photographs loaded") || flat(s).contains("no such file")
+    });
+    assert!(flat(&s).contains("1 photographs loaded"), "{s}");
+    c.send("q");
+    c.wait_exit(10);
+}
