@@ -74,7 +74,12 @@ pub enum SessionError {
     },
     /// The session's lock cannot be written because its folder cannot be
     /// (a read-only mount, no write permission): it can be looked at only.
-    #[error("{}: {source}", path.display())]
+    #[error(
+        "{}: {source}: the session folder cannot be written (a read-only mount, or no write \
+         permission), so nothing was changed; it can still be looked at (`vss session show`, \
+         `vss session check`, `vss report`)",
+        path.display()
+    )]
     Unwritable {
         path: PathBuf,
         source: std::io::Error,

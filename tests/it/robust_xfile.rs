@@ -239,3 +239,75 @@ fn a_frame_replaced_by_a_huge_one_is_refused_from_its_header() {
         "{out}"
     );
 }
+
+/// Folder `dir` made read-only until dropped: bind-mounted read-only over
+/// itself (root), or its write permission taken away (anyone else).
+struct ReadOnly(std::path::PathBuf, bool);
+
+impl ReadOnly {
+    fn make(dir: &Path) -> Option<ReadOnly> {
+        use std::os::unix::fs::PermissionsExt;
+        let mount = |args: &[&str]| {
+            std::process::Command::new("mount")
+                .stderr(std::process::Stdio::null())
+                .args(args)
+                .arg(dir)
+                .arg(dir)
+                .status()
+                .is_ok_and(|s| s.success())
+        };
+        if mount(&["--bind"]) {
+            let ro = ReadOnly(dir.to_path_buf(), true);
+            return mount(&["-o", "remount,bind,ro"]).then_some(ro);
+        }
+        std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o555)).ok()?;
+        let ro = ReadOnly(dir.to_path_buf(), false);
+        std::fs::write(dir.join("probe"), "x")
+            .is_err()
+            .then_some(ro)
+    }
+}
+
+impl Drop for ReadOnly {
+    fn drop(&mut self) {
+        use std::os::unix::fs::PermissionsExt;
+        if self.1 {
+            let _ = std::process::Command::new("umount").arg(&self.0).status();
+        } else {
+            let _ = std::fs::set_permissions(&self.0, std::fs::Permissions::from_mode(0o755));
+        }
+    }
+}
+
+/// A command that would write a session whose folder cannot be written (a
+/// read-only mount, an archive) says so and what can still be done; it
+/// said only "s/g/g.lock: Read-only file system (os error 30)".
+#[test]
+fn writing_a_read_only_session_says_what_and_what_is_left() {
+    let t = tempfile::tempdir().unwrap();
+    grabbed_session(t.path());
+    let Some(_ro) = ReadOnly::make(&t.path().join("s/g")) else {
+        eprintln!("SKIPPED: root here cannot mount, and writes through permissions");
+        return;
+    };
+    let (ok, out) = vss(
+        t.path(),
+        &[
+            "--profile",
+            "cell.toml",
+            "session",
+            "redo",
+            "s/g",
+            "--image",
+            "1",
+            "--from",
+            "lines",
+        ],
+    );
+    assert!(!ok, "{out}");
+    assert!(
+        out.contains("g.lock") && out.contains("the session folder cannot be written"),
+        "{out}"
+    );
+    assert!(out.contains("vss session show"), "what is left:\n{out}");
+}
