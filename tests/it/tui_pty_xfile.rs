@@ -130,3 +130,49 @@ fn a_photograph_whose_name_holds_a_space_is_loaded() {
     c.send("q");
     c.wait_exit(10);
 }
+
+/// A folder of photographs loaded on the Calibrate screen with a FIFO
+/// among them (named as a photograph) says it did not load it, and why; it
+/// was passed over without a word.
+#[test]
+fn a_fifo_among_the_photographs_is_said_not_loaded() {
+    use vss::tui::keymap::{CalibrateAction as CA, GlobalAction, Scope, ScreenId};
+    let mut c = Console::start(80, 24, &[]);
+    let photos = c.dir.path().join("photos");
+    std::fs::create_dir(&photos).unwrap();
+    let img = vss::llv::GreyImage::new(64, 64, vec![128; 64 * 64]).unwrap();
+    vss::formats::img::write_img(
+        &photos.join("p1.img"),
+        &vss::formats::img::ImgFile::new(img),
+    )
+    .unwrap();
+    let fifo = photos.join("p2.png");
+    assert!(
+        std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    c.wait_text("Survey", 10);
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
+    );
+    c.wait_text("views kept: 0", 10);
+    c.press(
+        Scope::Screen(ScreenId::Calibrate),
+        Action::Calibrate(CA::Open),
+    );
+    c.wait_text("photographs to load:", 10);
+    c.send("photos\r");
+    c.wait_words("1 photographs loaded", 20);
+    c.send("m");
+    let s = c.wait("the log", 10, |s| flat(s).contains("not loaded"));
+    assert!(
+        flat(&s).contains("p2.png") && flat(&s).contains("FIFO"),
+        "{s}"
+    );
+    c.send("q");
+    c.wait_exit(10);
+}

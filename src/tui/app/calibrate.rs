@@ -564,7 +564,9 @@ fn photo_paths(text: &str) -> Result<Vec<PathBuf>, String> {
         let mut v: Vec<PathBuf> = rd
             .filter_map(Result::ok)
             .map(|e| e.path())
-            .filter(|p| p.is_file() && crate::formats::imageio::ImageKind::of(p).is_some())
+            // By name alone: one that is not a file (a FIFO, a link) is
+            // said "not loaded" with why, not passed over without a word.
+            .filter(|p| crate::formats::imageio::ImageKind::of(p).is_some())
             .collect();
         v.sort_by_key(|p| natural_key(&p.to_string_lossy()));
         if v.is_empty() {
