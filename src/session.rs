@@ -74,7 +74,12 @@ pub enum SessionError {
     },
     /// The session's lock cannot be written because its folder cannot be
     /// (a read-only mount, no write permission): it can be looked at only.
-    #[error("{}: {source}", path.display())]
+    #[error(
+        "{}: {source}: the session folder cannot be written (a read-only mount, or no write \
+         permission), so nothing was changed; it can still be looked at (`vss session show`, \
+         `vss session check`, `vss report`)",
+        path.display()
+    )]
     Unwritable {
         path: PathBuf,
         source: std::io::Error,
@@ -114,6 +119,8 @@ pub enum SessionError {
         path.display()
     )]
     LockLost { path: PathBuf, holder: String },
+    #[error(transparent)]
+    FolderGone(#[from] lock::FolderGone),
     #[error(
         "{}{}: {message}; the manifest was left as it is: fix it by hand or restore it",
         path.display(),
@@ -130,8 +137,9 @@ pub enum SessionError {
     UnknownLighting { letter: char, known: String },
     #[error(
         "{}: the session folder's path is {len} bytes long; with the files' names it would \
-         exceed the system's limit of {PATH_MAX} bytes: make the session in a shorter path",
-        dir.display()
+         exceed the system's limit of {} bytes: make the session in a shorter path",
+        dir.display(),
+        fresh::PATH_MAX
     )]
     PathTooLong { dir: PathBuf, len: usize },
     #[error("image number {0} is out of range: image numbers run from 1 to {MAX_IMAGE_NUMBER}")]
@@ -161,23 +169,9 @@ pub enum SessionError {
     },
 }
 
-/// The longest path the system takes (`PATH_MAX`, with its final NUL).
-const PATH_MAX: usize = libc::PATH_MAX as usize;
-
-/// Refuses a session folder whose files' paths would exceed `PATH_MAX`
-/// (the longest: a temporary name of `NAME9999z.img`), before anything is
-/// made: such a session was made, then not found.
-fn check_path_len(dir: &Path, name: &SessionName) -> Result<(), SessionError> {
-    let abs = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
-    // "/.NAME9999z.img.tmp.PID.HHHHHHHHRRRRRRRR" and the final NUL.
-    let longest = abs.as_os_str().len() + 2 + name.as_str().len() + 9 + 5 + 10 + 17 + 1;
-    if longest > PATH_MAX {
-        return Err(SessionError::PathTooLong {
-            dir: dir.to_path_buf(),
-            len: abs.as_os_str().len(),
-        });
-    }
-    Ok(())
+/// Whether anything is at `path` (a dangling link too).
+fn present(path: &Path) -> bool {
+    fs::symlink_metadata(path).is_ok()
 }
 
 fn locked_message(path: &Path, holder: &str, stale: bool, foreign: bool) -> String {
@@ -222,10 +216,10 @@ impl Session {
     ) -> Result<Session, SessionError> {
         let n = SessionName::new(name)?;
         let dir = parent.join(n.as_str());
-        if dir.join(format!("{n}.toml")).exists() {
+        if present(&dir.join(format!("{n}.toml"))) {
             return Err(SessionError::Exists { dir });
         }
-        check_path_len(&dir, &n)?;
+        fresh::check_path_len(&dir, &n)?;
         let before = fresh::Before::look(&dir);
         // The session (and its lock) is dropped before its folder goes.
         let made = Self::make(dir.clone(), n, profile).and_then(|mut s| setup(&mut s).map(|()| s));
@@ -318,7 +312,7 @@ impl Session {
     pub fn open_existing(parent: &Path, name: &str) -> Result<Option<Session>, SessionError> {
         let n = SessionName::new(name)?;
         let dir = parent.join(n.as_str());
-        if dir.join(format!("{n}.toml")).exists() {
+        if present(&dir.join(format!("{n}.toml"))) {
             Self::open(&dir).map(Some)
         } else {
             Ok(None)
@@ -354,7 +348,9 @@ impl Session {
             manifest: "NAME.toml".into(),
         })?;
         let manifest_path = dir.join(format!("{name}.toml"));
-        if !manifest_path.is_file() {
+        // Anything there is read, and what it is said (a folder, a FIFO, a
+        // link): only a folder without one is "not a session folder".
+        if !present(&manifest_path) {
             return Err(SessionError::NotASession {
                 dir,
                 manifest: format!("{name}.toml"),
@@ -630,7 +626,7 @@ impl Session {
         let rec = self.manifest.image(k);
         rec.map_or(&[][..], |r| r.grey.as_slice())
             .iter()
-            .map(|g| Ok((g.letter, formats::img::read_img(&self.path(&g.file))?)))
+            .map(|g| Ok((g.letter, input::read_frame(&self.path(&g.file), g)?)))
             .collect()
     }
 

@@ -31,6 +31,24 @@ pub enum ReportError {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// Stopped after some files were written: they are the new report, and
+    /// the message says so (else "cannot write all1.svg" reads as if
+    /// nothing had changed, while all.ps was replaced).
+    #[error(
+        "{source}{}; written before it stopped (the NEW report): {}",
+        source.on_disk().map_or(String::new(), |o| format!(" ({o})")),
+        list(written)
+    )]
+    Partly {
+        source: Box<ReportError>,
+        written: Vec<PathBuf>,
+    },
+}
+
+/// `a.ps, a1.svg`.
+fn list(paths: &[PathBuf]) -> String {
+    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    names.join(", ")
 }
 
 impl ReportError {
@@ -40,16 +58,29 @@ impl ReportError {
         match self {
             ReportError::Write { path, .. } => Some(on_disk(path)),
             ReportError::Session(_) => None,
+            // Said in its message, with what was written.
+            ReportError::Partly { .. } => None,
         }
+    }
+
+    /// Whether some files of the report were written before it stopped
+    /// (then [`ReportError::on_disk`] is `None`: its message says it all).
+    pub fn wrote_some(&self) -> bool {
+        matches!(self, ReportError::Partly { .. })
     }
 }
 
 /// What a failed write left at `path`: the file that was there before,
 /// untouched (the writes are atomic), with the time it was written, or
 /// nothing. For the message after "cannot write …", so the operator knows
-/// the report on disk is not the new one.
+/// the report on disk is not the new one. Something there that is not a
+/// file (a folder, a link) is not called a report.
 pub fn on_disk(path: &Path) -> String {
-    match std::fs::metadata(path).and_then(|m| m.modified()) {
+    let meta = std::fs::symlink_metadata(path);
+    if meta.as_ref().is_ok_and(|m| !m.is_file()) {
+        return format!("nothing was written at {}", path.display());
+    }
+    match meta.and_then(|m| m.modified()) {
         Ok(t) => {
             let secs = t
                 .duration_since(std::time::UNIX_EPOCH)
@@ -129,9 +160,29 @@ pub fn image_numbers(s: &Session, image: Option<u32>) -> Result<Vec<u32>, Sessio
 /// than holding all its pictures). A failure half-way (a full disk, a file
 /// that changed so the pages no longer match the count) leaves the file
 /// that was there untouched, and the error names it.
+///
+/// A failure after some files were written is [`ReportError::Partly`],
+/// naming them.
 pub fn write(s: &Session, image: Option<u32>, targets: &Targets) -> Result<Written, ReportError> {
-    let numbers = image_numbers(s, image)?;
     let mut written = Written::default();
+    match write_into(s, image, targets, &mut written) {
+        Ok(()) => Ok(written),
+        Err(e) if written.files.is_empty() => Err(e),
+        Err(e) => Err(ReportError::Partly {
+            source: Box::new(e),
+            written: written.files,
+        }),
+    }
+}
+
+/// [`write()`], adding to `written` as it goes.
+fn write_into(
+    s: &Session,
+    image: Option<u32>,
+    targets: &Targets,
+    written: &mut Written,
+) -> Result<(), ReportError> {
+    let numbers = image_numbers(s, image)?;
     let mut found = |r: &ImageReport| {
         for p in &r.problems {
             if !written.problems.contains(p) {
@@ -174,7 +225,7 @@ pub fn write(s: &Session, image: Option<u32>, targets: &Targets) -> Result<Writt
             written.files.push(path);
         }
     }
-    Ok(written)
+    Ok(())
 }
 
 /// Writes `path` atomically with `fill`, which writes into the temporary

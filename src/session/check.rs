@@ -134,6 +134,18 @@ fn unrecorded(s: &Session, recorded: &HashSet<String>) -> Vec<String> {
 /// Reads and parses one recorded file, with its problems and warnings in
 /// `r`; gives the pixel size of an image (`.img`, `.imc`) that parsed.
 fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) -> Option<(usize, usize)> {
+    let ext = file.rsplit_once('.').map_or("", |(_, e)| e);
+    // An image larger than the stages take (one of 40000² is 1.6 GB) is
+    // refused from its header, not read whole to be hashed and parsed.
+    if matches!(ext, "img" | "imc")
+        && let Ok(h) = formats::img::read_header(path)
+        && let Err(e @ crate::llv::LlvError::TooLarge { .. }) =
+            crate::llv::image::check_stage_size(h.width.into(), h.height.into())
+    {
+        r.problems
+            .push(format!("{}: byte 4: {e}; not read", path.display()));
+        return None;
+    }
     let bytes = match crate::fsutil::read_input(path, formats::max_len(path)) {
         Ok(b) => b,
         Err(e) => {
@@ -141,7 +153,6 @@ fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) -> Optio
             return None;
         }
     };
-    let ext = file.rsplit_once('.').map_or("", |(_, e)| e);
     let parsed = match ext {
         "img" | "imc" => formats::img::parse_img(&bytes, path).map(|f| Some(f.image.size())),
         "hpo" | "vpo" => formats::edgefile::parse_edges(&bytes, path).map(|_| None),

@@ -8,6 +8,9 @@ use std::ffi::OsString;
 use std::fs;
 use std::path::{Path, PathBuf};
 
+use super::SessionError;
+use crate::formats::names::SessionName;
+
 /// What was in place before a session was made at `dir`.
 #[derive(Debug)]
 pub(super) struct Before {
@@ -44,8 +47,17 @@ impl Before {
     /// which held the session's lock), else the new files of `dir`. `Ok`
     /// when nothing made is left; else the first thing that could not go.
     pub(super) fn undo(&self) -> Result<(), (PathBuf, std::io::Error)> {
+        // Not there, or a file where a folder above it should be (a survey
+        // folder that is a file): nothing was made.
         let gone = |p: &Path, r: std::io::Result<()>| match r {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err((p.to_path_buf(), e)),
+            Err(e)
+                if !matches!(
+                    e.kind(),
+                    std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
+                ) =>
+            {
+                Err((p.to_path_buf(), e))
+            }
             _ => Ok(()),
         };
         if self.missing.is_empty() {
@@ -70,4 +82,23 @@ fn names(dir: &Path) -> Vec<OsString> {
     fs::read_dir(dir)
         .map(|r| r.filter_map(|e| e.ok().map(|e| e.file_name())).collect())
         .unwrap_or_default()
+}
+
+/// The longest path the system takes (`PATH_MAX`, with its final NUL).
+pub(super) const PATH_MAX: usize = libc::PATH_MAX as usize;
+
+/// Refuses a session folder whose files' paths would exceed `PATH_MAX`
+/// (the longest: a temporary name of `NAME9999z.img`), before anything is
+/// made: such a session was made, then not found.
+pub(super) fn check_path_len(dir: &Path, name: &SessionName) -> Result<(), SessionError> {
+    let abs = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
+    // "/.NAME9999z.img.tmp.PID.HHHHHHHHRRRRRRRR" and the final NUL.
+    let longest = abs.as_os_str().len() + 2 + name.as_str().len() + 9 + 5 + 10 + 17 + 1;
+    if longest > PATH_MAX {
+        return Err(SessionError::PathTooLong {
+            dir: dir.to_path_buf(),
+            len: abs.as_os_str().len(),
+        });
+    }
+    Ok(())
 }

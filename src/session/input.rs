@@ -25,6 +25,33 @@ use crate::llv::pipeline::{Input, Saved, StageOutputs, Workspace};
 use crate::llv::{GreyImage, LlvError, Params};
 use crate::profile::Profile;
 
+/// Reads a session's grey image (`.img`) or its lens-corrected copy
+/// (`.imc`) as the manifest records it: the header must give the size
+/// `record` says (a grey image's `width` × `height`), not more pixels than
+/// the stages take, or it is refused after 64 bytes. A file replaced by a huge one (a
+/// 40000² frame is 1.6 GB) is not read into memory by the console, `session
+/// redo` or `session check`.
+pub fn read_frame(
+    path: &std::path::Path,
+    record: &super::manifest::GreyRecord,
+) -> Result<formats::img::ImgFile, formats::FormatError> {
+    let want = (record.width as usize, record.height as usize);
+    formats::img::read_img_sized(path, |w, h| {
+        if let Err(e @ LlvError::TooLarge { .. }) = crate::llv::image::check_stage_size(w, h) {
+            return Err(e.to_string());
+        }
+        if (w, h) == want {
+            Ok(())
+        } else {
+            Err(format!(
+                "the image is {w} x {h} pixels, but the manifest records {} x {} for it; \
+                 not read",
+                want.0, want.1
+            ))
+        }
+    })
+}
+
 /// Which of an image's frames are lit and which is the ambient one.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct FrameRule {

@@ -226,6 +226,46 @@ fn random_token() -> String {
 pub struct Lock {
     path: PathBuf,
     info: LockInfo,
+    /// The session folder as it was when the lock was taken (device and
+    /// inode), to tell a lock taken over from a folder moved away.
+    folder: Option<(u64, u64)>,
+}
+
+/// The folder of the lock file at `path`.
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// The device and inode of folder `dir`, not followed if it is a link.
+fn identity(dir: &Path) -> Option<(u64, u64)> {
+    use std::os::unix::fs::MetadataExt;
+    fs::symlink_metadata(dir)
+        .ok()
+        .filter(fs::Metadata::is_dir)
+        .map(|m| (m.dev(), m.ino()))
+}
+
+/// The session folder a lock was taken in is no longer at its path: moved,
+/// renamed or deleted while the session was open (and maybe another folder
+/// made in its place). Nothing is written then: not at the path, which is
+/// not the session's, and not where the folder went, which is not known.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "the session folder {} {}: this change was NOT saved, and nothing was written anywhere \
+     else; put the folder back where it was and try again, or open the session where it now is",
+    dir.display(),
+    if *replaced {
+        "is not the one opened (it was moved or deleted and another folder made in its place)"
+    } else {
+        "is gone (moved, renamed or deleted since it was opened)"
+    }
+)]
+pub struct FolderGone {
+    pub dir: PathBuf,
+    pub replaced: bool,
 }
 
 impl Lock {
@@ -241,10 +281,7 @@ impl Lock {
             path: path.to_path_buf(),
             source,
         };
-        let dir = match path.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d,
-            _ => Path::new("."),
-        };
+        let dir = folder_of(path);
         let name = path.file_name().unwrap_or_default();
         // Created exclusively under a random name: a link planted in the
         // folder is never written through. (No sweep of stale temporary
@@ -299,6 +336,7 @@ impl Lock {
             Some(h) if h == info => Ok(Lock {
                 path: path.to_path_buf(),
                 info,
+                folder: identity(dir),
             }),
             h => Err(SessionError::Locked {
                 path: path.to_path_buf(),
@@ -354,9 +392,18 @@ impl Lock {
     /// Checks that the lock file still names this lock: after a take-over
     /// (or a removed lock) this writer no longer owns the session, and its
     /// saves must fail rather than overwrite the new holder's.
+    /// A lock file that is gone because its folder is (moved, renamed or
+    /// deleted) is said as that ([`FolderGone`]), not as a take-over.
     pub fn check_held(&self) -> Result<(), SessionError> {
         match read_holder(&self.path) {
             Some(h) if h == self.info => Ok(()),
+            None if self.folder.is_some() && identity(folder_of(&self.path)) != self.folder => {
+                let dir = folder_of(&self.path);
+                Err(SessionError::FolderGone(FolderGone {
+                    dir: dir.to_path_buf(),
+                    replaced: identity(dir).is_some(),
+                }))
+            }
             h => Err(SessionError::LockLost {
                 path: self.path.clone(),
                 holder: h.map_or_else(
@@ -669,6 +716,34 @@ mod tests {
         fs::remove_file(&p).unwrap();
         let b = Lock::acquire(&p, false).unwrap();
         assert!(b.check_held().is_ok() && a.check_held().is_err());
+    }
+
+    #[test]
+    fn a_folder_moved_away_is_said_as_gone_not_as_a_take_over() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("s");
+        fs::create_dir(&dir).unwrap();
+        let a = Lock::acquire(&dir.join("s.lock"), false).unwrap();
+        // Renamed while open: gone, not taken over.
+        fs::rename(&dir, root.path().join("t")).unwrap();
+        let e = a.check_held().expect_err("moved").to_string();
+        assert!(
+            e.contains("is gone (moved") && e.contains("NOT saved"),
+            "{e}"
+        );
+        assert!(!e.contains("taken over"), "{e}");
+        // Another folder made in its place.
+        fs::create_dir(&dir).unwrap();
+        let e = a.check_held().expect_err("replaced").to_string();
+        assert!(e.contains("is not the one opened"), "{e}");
+        // Put back: held again.
+        fs::remove_dir(&dir).unwrap();
+        fs::rename(root.path().join("t"), &dir).unwrap();
+        assert!(a.check_held().is_ok());
+        // Its lock removed in its own folder is still a lost lock.
+        fs::remove_file(dir.join("s.lock")).unwrap();
+        let e = a.check_held().expect_err("lock gone").to_string();
+        assert!(e.contains("held by nobody"), "{e}");
     }
 
     #[test]

@@ -552,7 +552,8 @@ pub fn short_name(name: &str) -> String {
 }
 
 /// The photographs a typed text names: a folder's images (by name, numbers
-/// in order), or files separated by spaces.
+/// in order), a file (its name may hold spaces), or files separated by
+/// spaces.
 fn photo_paths(text: &str) -> Result<Vec<PathBuf>, String> {
     if text.is_empty() {
         return Err("type a folder or files".into());
@@ -563,7 +564,9 @@ fn photo_paths(text: &str) -> Result<Vec<PathBuf>, String> {
         let mut v: Vec<PathBuf> = rd
             .filter_map(Result::ok)
             .map(|e| e.path())
-            .filter(|p| p.is_file() && crate::formats::imageio::ImageKind::of(p).is_some())
+            // By name alone: one that is not a file (a FIFO, a link) is
+            // said "not loaded" with why, not passed over without a word.
+            .filter(|p| crate::formats::imageio::ImageKind::of(p).is_some())
             .collect();
         v.sort_by_key(|p| natural_key(&p.to_string_lossy()));
         if v.is_empty() {
@@ -572,6 +575,9 @@ fn photo_paths(text: &str) -> Result<Vec<PathBuf>, String> {
             ));
         }
         v
+    } else if p.is_file() {
+        // One file, whose name may hold spaces ("plate 1.jpg").
+        vec![p.to_path_buf()]
     } else {
         let v: Vec<PathBuf> = text.split_whitespace().map(PathBuf::from).collect();
         if let Some(missing) = v.iter().find(|p| !p.is_file()) {

@@ -571,11 +571,12 @@ impl Store {
         let targets = report::survey::Targets::in_session(s);
         let ps = targets.ps.clone().unwrap_or_default();
         report::survey::write(s, None, &targets).map_err(|e| {
-            // The file that failed, else the PostScript report.
-            let old = format!(
-                "; {}",
-                e.on_disk().unwrap_or_else(|| report::survey::on_disk(&ps))
-            );
+            // The file that failed, else the PostScript report (unless it
+            // was written: the message names what was).
+            let old = e
+                .on_disk()
+                .or_else(|| (!e.wrote_some()).then(|| report::survey::on_disk(&ps)))
+                .map_or(String::new(), |o| format!("; {o}"));
             StoreError::Report {
                 why: e.to_string(),
                 old,

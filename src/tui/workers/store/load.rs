@@ -16,7 +16,7 @@ pub fn image(s: &Session, k: u32) -> LoadedImage {
         return out;
     };
     for g in &rec.grey {
-        match formats::img::read_img(&s.path(&g.file)) {
+        match crate::session::input::read_frame(&s.path(&g.file), g) {
             Ok(f) => out.images.push((g.letter, f.image)),
             Err(e) => out.damaged.push((g.letter, e.to_string())),
         }
@@ -65,9 +65,16 @@ fn saved(
         .filter(|f| f.ends_with(".imc"))
         .collect();
     imc.sort_unstable();
+    let grey = s.manifest().image(k).map_or(&[][..], |r| r.grey.as_slice());
     for f in imc {
+        // The size of its grey image (cube1a.imc of cube1a.img).
+        let of = grey
+            .iter()
+            .find(|g| g.file.strip_suffix(".img") == f.strip_suffix(".imc"))
+            .or(grey.first())
+            .ok_or_else(|| format!("{f}: no grey image of image {k} is recorded"))?;
         corrected.push(
-            formats::img::read_img(&s.path(f))
+            crate::session::input::read_frame(&s.path(f), of)
                 .map_err(|e| text(&e))?
                 .image,
         );
