@@ -98,7 +98,7 @@ pub enum CalibError {
     ScaleMismatch { stated: f64, fits: f64, rms: f64 },
 }
 
-/// Calibrates a camera from `views` ([`solve::calibrate`]). A fit that
+/// Calibrates a camera from `views` (the solver in `calib/solve.rs`). A fit that
 /// does not converge with `S` stated is tried once more with `sy`
 /// estimated: when that fits with another ratio, the refusal says the
 /// scale is the cause ([`CalibError::ScaleMismatch`]), not a misread grid
