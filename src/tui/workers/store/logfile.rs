@@ -3,10 +3,12 @@
 //! `NAME.log` in the open session's folder, or `vss/console.log` in the
 //! XDG state folder (`$XDG_STATE_HOME`, else `~/.local/state`) while no
 //! session is open. The file is opened once and written through that
-//! handle; an existing path that is not a plain file (a symlink) is refused.
+//! handle; a path that is not a plain file (a symlink, a folder, a FIFO) is
+//! refused.
 
 use std::fs::{File, OpenOptions};
 use std::io::{self, Write};
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, Default)]
@@ -33,19 +35,26 @@ impl LogFile {
         if let Some(dir) = path.parent() {
             std::fs::create_dir_all(dir)?;
         }
-        let f = match std::fs::symlink_metadata(path) {
-            Err(e) if e.kind() == io::ErrorKind::NotFound => OpenOptions::new()
-                .append(true)
-                .create_new(true)
-                .open(path)?,
-            Err(e) => return Err(e),
-            Ok(m) if m.file_type().is_file() => OpenOptions::new().append(true).open(path)?,
-            Ok(_) => {
-                return Err(io::Error::other(
-                    "not a plain file (a symlink or a folder): not written through",
-                ));
-            }
+        // One open that neither follows a link nor waits on a FIFO, then
+        // the opened file itself checked: a look at the path before the
+        // open would leave a moment for a link to be put in its place.
+        let not_plain = || {
+            io::Error::other(
+                "not a plain file (a symlink, a folder or a FIFO): not written through",
+            )
         };
+        let f = OpenOptions::new()
+            .append(true)
+            .create(true)
+            .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK)
+            .open(path)
+            .map_err(|e| match e.raw_os_error() {
+                Some(libc::ELOOP | libc::EISDIR | libc::ENXIO) => not_plain(),
+                _ => e,
+            })?;
+        if !f.metadata()?.file_type().is_file() {
+            return Err(not_plain());
+        }
         let mut f = f;
         writeln!(
             f,
@@ -95,5 +104,16 @@ mod tests {
         let link = d.path().join("link.log");
         std::os::unix::fs::symlink(&p, &link).unwrap();
         assert!(LogFile::default().open(&link).is_err());
+        assert!(LogFile::default().open(d.path()).is_err());
+        let fifo = d.path().join("fifo.log");
+        assert!(
+            std::process::Command::new("mkfifo")
+                .arg(&fifo)
+                .status()
+                .unwrap()
+                .success()
+        );
+        let e = LogFile::default().open(&fifo).unwrap_err();
+        assert!(e.to_string().contains("not a plain file"), "{e}");
     }
 }
