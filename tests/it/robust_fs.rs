@@ -9,7 +9,6 @@ use std::os::unix::fs::symlink;
 use std::path::Path;
 use std::time::Duration;
 
-use assert_cmd::Command;
 use vss::formats::img::{ImgFile, write_img};
 use vss::llv::{GreyImage, Point, Segment};
 
@@ -31,19 +30,7 @@ fn square() -> ImgFile {
 }
 
 fn vss(cwd: &Path, args: &[&str]) -> (bool, String) {
-    let o = Command::cargo_bin("vss")
-        .expect("the vss binary")
-        .args(args)
-        .current_dir(cwd)
-        .timeout(Duration::from_secs(120))
-        .output()
-        .expect("run vss");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    (o.status.success(), text)
+    crate::support::run::run_in(cwd, args, Duration::from_secs(120))
 }
 
 /// `outside/secret`, the file a planted link points at.

@@ -14,19 +14,7 @@ use vss::session::MAX_IMAGE_NUMBER;
 /// `vss` run in `cwd`. The timeout turns a regression into a failure, not
 /// a hang (the checklist of image 30 000 000 took over a minute).
 fn vss(cwd: &Path, args: &[&str]) -> (bool, String) {
-    let o = Command::cargo_bin("vss")
-        .expect("the vss binary")
-        .args(args)
-        .current_dir(cwd)
-        .timeout(Duration::from_secs(60))
-        .output()
-        .expect("run vss");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    (o.status.success(), text)
+    crate::support::run::run_in(cwd, args, Duration::from_secs(60))
 }
 
 /// A simulated cell with small frames: cameras 1 to 4, lightings a to e.

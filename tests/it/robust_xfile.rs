@@ -5,23 +5,9 @@
 use std::path::Path;
 use std::time::Duration;
 
-use assert_cmd::Command;
-
 /// `vss` run in `cwd`: whether it succeeded, and stdout then stderr.
 fn vss(cwd: &Path, args: &[&str]) -> (bool, String) {
-    let o = Command::cargo_bin("vss")
-        .expect("the vss binary")
-        .args(args)
-        .current_dir(cwd)
-        .timeout(Duration::from_secs(60))
-        .output()
-        .expect("run vss");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    (o.status.success(), text)
+    crate::support::run::run_in(cwd, args, Duration::from_secs(60))
 }
 
 /// A profile with one camera and one lighting.

@@ -10,5 +10,6 @@ pub mod golden;
 pub mod gs;
 pub mod limited;
 pub mod llv_scene;
+pub mod run;
 
 pub use bin::vss;
