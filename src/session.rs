@@ -98,10 +98,7 @@ pub enum SessionError {
         dir.display()
     )]
     Exists { dir: PathBuf },
-    #[error(
-        "{} is not a session folder: no manifest {manifest} in it (make one with `vss session new NAME`)",
-        dir.display()
-    )]
+    #[error("{}", fresh::not_a_session(dir, manifest))]
     NotASession { dir: PathBuf, manifest: String },
     #[error("{}", locked_message(path, holder, *stale, *foreign))]
     Locked {

@@ -102,3 +102,19 @@ pub(super) fn check_path_len(dir: &Path, name: &SessionName) -> Result<(), Sessi
     }
     Ok(())
 }
+
+/// Why `dir` is not a session: there is no folder there at all (a name
+/// mistyped), or a folder without the manifest `manifest`.
+pub(super) fn not_a_session(dir: &Path, manifest: &str) -> String {
+    if std::fs::symlink_metadata(dir).is_err() {
+        format!(
+            "{}: no such folder, so no session there (`vss session new NAME` makes one)",
+            dir.display()
+        )
+    } else {
+        format!(
+            "{} is not a session folder: no manifest {manifest} in it (make one with `vss session new NAME`)",
+            dir.display()
+        )
+    }
+}

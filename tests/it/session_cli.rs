@@ -138,10 +138,15 @@ fn a_bare_session_name_is_found_under_the_survey_folder() {
         let o = vss(&a, d);
         assert!(o.status.success(), "{args:?}: {}", text(&o));
     }
-    // A name that is nowhere is still reported as missing.
+    // A name that is nowhere is said to be nowhere, not a folder without
+    // a manifest (which sent the operator looking for a lost file).
     let o = vss(&["--profile", "p.toml", "session", "check", "hull"], d);
     assert!(!o.status.success());
-    assert!(text(&o).contains("hull"), "{}", text(&o));
+    assert!(
+        text(&o).contains("hull: no such folder") && !text(&o).contains("manifest"),
+        "{}",
+        text(&o)
+    );
 }
 
 #[test]
