@@ -350,6 +350,8 @@ fn a_suspended_console_s_session_can_be_taken_over() {
     });
     let mut b = a.another(80, 24);
     b.wait_text("choose a session", 10);
+    // The list's row first: an Enter before the folder is read asks nothing.
+    b.wait_text(" cube ", 10);
     b.send("\r");
     b.wait("the question to take it over", 10, |s| {
         flat(&s.replace('│', " ")).contains("Take it over anyway?")
