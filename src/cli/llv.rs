@@ -379,7 +379,9 @@ fn write_outputs(
 /// Stages one output; an error says that no output was replaced.
 fn stage(set: &mut crate::fsutil::StagedWrites, path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     crate::formats::stage(set, path, bytes).map_err(|e| {
-        anyhow::anyhow!("{e}; no output was replaced: the files on disk are the previous run's")
+        anyhow::anyhow!(
+            "{e}; no output was replaced (those of an earlier run, if any, are as they were)"
+        )
     })
 }
 
@@ -388,7 +390,7 @@ fn commit(set: crate::fsutil::StagedWrites) -> anyhow::Result<Vec<PathBuf>> {
     set.commit().map_err(|e| {
         anyhow::anyhow!(
             "cannot put the outputs in place: {e}; outputs renamed before it are new, the rest \
-             are the previous run's"
+             as they were (an earlier run's, if any)"
         )
     })
 }

@@ -493,3 +493,34 @@ fn set_names_what_a_value_should_be_and_an_unknown_key_first() {
         assert!(err.contains(says), "{set}: {err}");
     }
 }
+
+/// An output that cannot be staged (a folder at its name) replaces none,
+/// and the refusal does not speak of a previous run's files where there
+/// were none: it said "the files on disk are the previous run's".
+#[test]
+fn an_output_that_cannot_be_written_replaces_none_and_claims_no_earlier_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "cube1a.img", |x, y| rect(x, y, 200, 40));
+    let out = d.join("out");
+    std::fs::create_dir_all(out.join("cube1.ldr")).unwrap();
+    let r = vss()
+        .args(["llv", "--out"])
+        .arg(&out)
+        .arg(d.join("cube1a.img"))
+        .output()
+        .unwrap();
+    assert!(!r.status.success());
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("cube1.ldr") && err.contains("no output was replaced"),
+        "{err}"
+    );
+    assert!(!err.contains("previous run"), "{err}");
+    let mut left: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["cube1.ldr"], "nothing else written");
+}
