@@ -100,17 +100,24 @@ struct JobSignals {
 fn enter() -> io::Result<Term> {
     terminal::enable_raw_mode()?;
     let mut out = io::stdout();
-    // Mouse reports where the terminal sends them; others ignore the request.
-    if let Err(e) = execute!(
-        out,
-        terminal::EnterAlternateScreen,
-        cursor::Hide,
-        term_event::EnableMouseCapture
-    ) {
+    if let Err(e) = screen_modes(&mut out) {
         leave();
         return Err(e);
     }
     Terminal::new(CrosstermBackend::new(out))
+}
+
+/// The console's screen modes, after raw mode: the alternate screen, no
+/// cursor, and mouse reports where the terminal sends them (others ignore
+/// the request). At start and when taken back after a suspension
+/// ([`suspend::take_back`]); [`leave`] undoes them.
+fn screen_modes(out: &mut impl Write) -> io::Result<()> {
+    execute!(
+        out,
+        terminal::EnterAlternateScreen,
+        cursor::Hide,
+        term_event::EnableMouseCapture
+    )
 }
 
 /// Puts the terminal back as the shell had it: cooked mode, cursor shown,

@@ -18,8 +18,7 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use ratatui::crossterm::event as term_event;
-use ratatui::crossterm::{cursor, execute, terminal};
+use ratatui::crossterm::terminal;
 
 use super::Term;
 
@@ -93,12 +92,7 @@ pub fn take_back(term: &mut Term) -> io::Result<()> {
     // raw mode is set again rather than taken as already on.
     let _ = terminal::disable_raw_mode();
     terminal::enable_raw_mode()?;
-    execute!(
-        term.backend_mut(),
-        terminal::EnterAlternateScreen,
-        cursor::Hide,
-        term_event::EnableMouseCapture
-    )?;
+    super::screen_modes(term.backend_mut())?;
     // Cleared and drawn whole next time, at the size the terminal has now
     // (it may have changed meanwhile). Not `Terminal::clear`, which asks
     // the terminal where its cursor is and waits for the answer.
