@@ -287,9 +287,9 @@ impl App {
         }
         // Ctrl-Z suspends from anywhere, as in any terminal program: a
         // question or a field open stays as it is for the return.
-        if keymap::lookup(Scope::Global, &key) == Some(Action::Global(GlobalAction::Suspend)) {
-            self.chrome.suspend = true;
-            return Vec::new();
+        let suspend = Action::Global(GlobalAction::Suspend);
+        if keymap::lookup(Scope::Global, &key) == Some(suspend) {
+            return self.act(suspend);
         }
         let scope = self.scope();
         // Too small a terminal shows no screen, only what goes on and the
