@@ -19,7 +19,6 @@ use crate::formats;
 use crate::formats::cdf::Cdf;
 use crate::formats::img::ImgFile;
 use crate::llv::GreyImage;
-use crate::llv::lens::CameraModel;
 use crate::profile::Profile;
 use crate::report;
 use crate::session::takeover::LEAVE_POLL;
@@ -180,12 +179,24 @@ impl Store {
         }
     }
 
-    /// Reads the profile's `.cdf` files and reports their camera models.
+    /// Reads the profile's `.cdf` files, once, and reports their camera
+    /// models, or why lens correction cannot use one.
     pub fn cameras(&mut self) {
-        self.cdfs = (1..=self.profile.survey.cameras.max(1))
-            .map(|c| self.profile.camera_cdf(c).ok().flatten())
+        let read: Vec<_> = (1..=self.profile.survey.cameras.max(1))
+            .map(|c| (c, self.profile.camera_cdf(c)))
             .collect();
-        self.reply(StoreEvent::Cameras(self.camera_models()));
+        let models = read
+            .iter()
+            .map(|(c, r)| match r {
+                Ok(Some(cdf)) => cdf.model().map_err(|why| {
+                    format!("{} {why}", self.profile.cdf_shown(*c).unwrap_or_default())
+                }),
+                Ok(None) => Err("the profile names no .cdf for it ([survey] cdf)".into()),
+                Err(e) => Err(e.to_string()),
+            })
+            .collect();
+        self.cdfs = read.into_iter().map(|(_, r)| r.ok().flatten()).collect();
+        self.reply(StoreEvent::Cameras(models));
     }
 
     /// Camera `camera`'s description as [`Store::cameras`] read it, which
@@ -547,20 +558,6 @@ impl Store {
         if self.lister.say(&list) || !if_changed {
             self.reply(StoreEvent::Sessions(list));
         }
-    }
-
-    /// Each camera's model (index 0 = camera 1) from
-    /// [`Profile::camera_cdf`], or why lens correction cannot use it.
-    fn camera_models(&self) -> Vec<Result<CameraModel, String>> {
-        (1..=self.profile.survey.cameras.max(1))
-            .map(|c| match self.profile.camera_cdf(c) {
-                Ok(Some(cdf)) => cdf.model().map_err(|why| {
-                    format!("{} {why}", self.profile.cdf_shown(c).unwrap_or_default())
-                }),
-                Ok(None) => Err("the profile names no .cdf for it ([survey] cdf)".into()),
-                Err(e) => Err(e.to_string()),
-            })
-            .collect()
     }
 
     /// Writes the survey report `NAME.ps` and one `NAMEk.svg` per image in
