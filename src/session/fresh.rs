@@ -106,7 +106,7 @@ pub(super) fn check_path_len(dir: &Path, name: &SessionName) -> Result<(), Sessi
 /// Why `dir` is not a session: there is no folder there at all (a name
 /// mistyped), or a folder without the manifest `manifest`.
 pub(super) fn not_a_session(dir: &Path, manifest: &str) -> String {
-    if std::fs::symlink_metadata(dir).is_err() {
+    if !super::present(dir) {
         format!(
             "{}: no such folder, so no session there (`vss session new NAME` makes one)",
             dir.display()
