@@ -140,9 +140,7 @@ impl CameraModel {
         for _ in 0..50 {
             let (du, dv) = self.delta(ud, vd);
             let (ru, rv) = (ud - du - u, vd - dv - v);
-            let (j, _) = self.delta_derivatives(ud, vd);
-            let (a, b, c, d) = (1.0 - j[0][0], -j[0][1], -j[1][0], 1.0 - j[1][1]);
-            let det = a * d - b * c;
+            let ([[a, b], [c, d]], det) = self.observed_to_ideal_jacobian(ud, vd);
             // Not one-to-one here (or not a number): no step to take.
             if det.is_nan() || det <= 0.0 {
                 return Err(self.to_px(ud, vd));
@@ -169,6 +167,14 @@ impl CameraModel {
         self.to_px(ud - du, vd - dv)
     }
 
+    /// `I − ∂δ` at `(u, v)` (mm), the Jacobian of the observed-to-ideal
+    /// map, and its determinant: not positive where that map folds.
+    fn observed_to_ideal_jacobian(&self, u: f64, v: f64) -> ([[f64; 2]; 2], f64) {
+        let (j, _) = self.delta_derivatives(u, v);
+        let m = [[1.0 - j[0][0], -j[0][1]], [-j[1][0], 1.0 - j[1][1]]];
+        (m, m[0][0] * m[1][1] - m[0][1] * m[1][0])
+    }
+
     /// The observed pixel nearest the centre `C` where this distortion
     /// folds a `width × height` image, if it does: where the Jacobian of
     /// the observed-to-ideal map (`I − ∂δ`) is not positive, two places of
@@ -188,8 +194,7 @@ impl CameraModel {
         for y in points(height) {
             for x in points(width) {
                 let (u, v) = self.to_mm(x, y);
-                let (j, _) = self.delta_derivatives(u, v);
-                let det = (1.0 - j[0][0]) * (1.0 - j[1][1]) - j[0][1] * j[1][0];
+                let (_, det) = self.observed_to_ideal_jacobian(u, v);
                 let d = (x - self.cx).hypot(y - self.cy);
                 if (det.is_nan() || det <= 0.0) && nearest.is_none_or(|(n, _)| d < n) {
                     nearest = Some((d, (x, y)));
