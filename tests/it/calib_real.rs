@@ -6,7 +6,6 @@
 //! these photographs: each refused with what was found.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use crate::support::vss;
 use vss::calib::{self, CalibError, DetectError, Detector, Options, Plate, View};
@@ -445,13 +444,7 @@ fn plate_files_are_read_bounded_and_never_found_by_accident() {
     );
     // A FIFO does not block the reader; /dev/zero behind a link is refused.
     let fifo = tmp.path().join("fifo.toml");
-    assert!(
-        Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .unwrap()
-            .success()
-    );
+    crate::support::files::mkfifo(&fifo);
     let zero = tmp.path().join("zero.toml");
     std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
     let big = tmp.path().join("big.toml");

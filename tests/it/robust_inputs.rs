@@ -17,6 +17,8 @@ use vss::formats::img::{ImgFile, write_img};
 use vss::llv::GreyImage;
 use vss::session::Session;
 
+use crate::support::files::{mkfifo, sparse_img};
+
 /// Runs `vss ARGS` in `cwd` with at most `mem_mb` of address space and a
 /// time limit (a reader blocked on a FIFO fails the test instead of hanging
 /// it).
@@ -66,15 +68,6 @@ fn session_with_image(root: &Path) -> PathBuf {
     let mut s = Session::create(&root.join("s"), "cube", &profile).expect("session");
     s.set_image_info(1, 1, 1, None).expect("image info");
     s.save_image(1, 'a', &grey(64, 64)).expect("save")
-}
-
-fn mkfifo(p: &Path) {
-    let ok = std::process::Command::new("mkfifo")
-        .arg(p)
-        .status()
-        .expect("mkfifo")
-        .success();
-    assert!(ok, "mkfifo {}", p.display());
 }
 
 #[test]
@@ -131,21 +124,6 @@ fn links_to_devices_and_outside_files_are_not_read() {
         );
         assert!(out.contains("symbolic link"), "{args:?}: {out}");
     }
-}
-
-/// A sparse `.img` whose header and size agree on `w` × `h` pixels.
-fn sparse_img(p: &Path, w: u16, h: u16) {
-    let mut head = vec![0u8; 64];
-    head[0] = b'I';
-    head[1] = b'M';
-    head[4..6].copy_from_slice(&w.to_le_bytes());
-    head[6..8].copy_from_slice(&h.to_le_bytes());
-    std::fs::write(p, &head).expect("header");
-    let f = std::fs::OpenOptions::new()
-        .write(true)
-        .open(p)
-        .expect("open");
-    f.set_len(64 + u64::from(w) * u64::from(h)).expect("grow");
 }
 
 #[test]

@@ -5,6 +5,8 @@
 use std::path::Path;
 use std::time::Duration;
 
+use crate::support::files::{ReadOnly, mkfifo, sparse_img};
+
 /// `vss` run in `cwd`: whether it succeeded, and stdout then stderr.
 fn vss(cwd: &Path, args: &[&str]) -> (bool, String) {
     crate::support::run::run_in(cwd, args, Duration::from_secs(60))
@@ -34,14 +36,7 @@ fn a_manifest_that_is_not_a_file_is_named_as_what_it_is() {
     type Case = (&'static str, fn(&Path), &'static str);
     let cases: [Case; 3] = [
         ("a folder", |p| std::fs::create_dir(p).unwrap(), "folder"),
-        (
-            "a FIFO",
-            |p| {
-                let ok = std::process::Command::new("mkfifo").arg(p).status();
-                assert!(ok.unwrap().success(), "mkfifo");
-            },
-            "FIFO",
-        ),
+        ("a FIFO", |p| mkfifo(p), "FIFO"),
         (
             "a link to nothing",
             |p| std::os::unix::fs::symlink("gone.toml", p).unwrap(),
@@ -175,18 +170,6 @@ fn a_session_under_a_file_is_refused_without_sending_anyone_to_clean_up() {
     );
 }
 
-/// A sparse `.img` whose header and size agree on `w` × `h` pixels.
-fn sparse_img(p: &Path, w: u16, h: u16) {
-    let mut head = vec![0u8; 64];
-    head[0] = b'I';
-    head[1] = b'M';
-    head[4..6].copy_from_slice(&w.to_le_bytes());
-    head[6..8].copy_from_slice(&h.to_le_bytes());
-    std::fs::write(p, &head).unwrap();
-    let f = std::fs::OpenOptions::new().write(true).open(p).unwrap();
-    f.set_len(64 + u64::from(w) * u64::from(h)).unwrap();
-}
-
 /// A session's frame replaced by a huge one (a 40000² `.img`, 1.6 GB,
 /// consistent with its own size) is refused from its header by `session
 /// check` and `session redo`, within 256 MiB of address space: they read it
@@ -224,45 +207,6 @@ fn a_frame_replaced_by_a_huge_one_is_refused_from_its_header() {
         out.contains("g1a.img") && out.contains("80 x 64") && out.contains("records 64 x 64"),
         "{out}"
     );
-}
-
-/// Folder `dir` made read-only until dropped: bind-mounted read-only over
-/// itself (root), or its write permission taken away (anyone else).
-struct ReadOnly(std::path::PathBuf, bool);
-
-impl ReadOnly {
-    fn make(dir: &Path) -> Option<ReadOnly> {
-        use std::os::unix::fs::PermissionsExt;
-        let mount = |args: &[&str]| {
-            std::process::Command::new("mount")
-                .stderr(std::process::Stdio::null())
-                .args(args)
-                .arg(dir)
-                .arg(dir)
-                .status()
-                .is_ok_and(|s| s.success())
-        };
-        if mount(&["--bind"]) {
-            let ro = ReadOnly(dir.to_path_buf(), true);
-            return mount(&["-o", "remount,bind,ro"]).then_some(ro);
-        }
-        std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o555)).ok()?;
-        let ro = ReadOnly(dir.to_path_buf(), false);
-        std::fs::write(dir.join("probe"), "x")
-            .is_err()
-            .then_some(ro)
-    }
-}
-
-impl Drop for ReadOnly {
-    fn drop(&mut self) {
-        use std::os::unix::fs::PermissionsExt;
-        if self.1 {
-            let _ = std::process::Command::new("umount").arg(&self.0).status();
-        } else {
-            let _ = std::fs::set_permissions(&self.0, std::fs::Permissions::from_mode(0o755));
-        }
-    }
 }
 
 /// A command that would write a session whose folder cannot be written (a

@@ -7,65 +7,12 @@
 //! folder's write permission away (which root would not notice).
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::SystemTime;
 
 use vss::tui::keymap::{Action, FilesAction, ModalAction, Scope, ScreenId, SurveyAction};
 
 use super::tui_harness::{Console, SURVEY, flat};
-
-/// The folder made read-only until dropped: bind-mounted read-only over
-/// itself (root), or its write permission taken away (anyone else).
-enum ReadOnly {
-    Mounted(PathBuf),
-    Unwritable(PathBuf, std::fs::Permissions),
-}
-
-impl ReadOnly {
-    fn make(dir: &Path) -> Option<ReadOnly> {
-        use std::os::unix::fs::PermissionsExt;
-        if let Some(ro) = ReadOnly::mount(dir) {
-            return Some(ro);
-        }
-        let before = std::fs::metadata(dir).ok()?.permissions();
-        std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o555)).ok()?;
-        let ro = ReadOnly::Unwritable(dir.to_path_buf(), before);
-        // Root writes through the permission: no way left to test here.
-        std::fs::write(dir.join("probe"), "x")
-            .is_err()
-            .then_some(ro)
-    }
-
-    fn mount(dir: &Path) -> Option<ReadOnly> {
-        let run = |args: &[&str]| {
-            Command::new("mount")
-                .stderr(std::process::Stdio::null())
-                .args(args)
-                .arg(dir)
-                .arg(dir)
-                .status()
-                .is_ok_and(|s| s.success())
-        };
-        if !run(&["--bind"]) {
-            return None;
-        }
-        let ro = ReadOnly::Mounted(dir.to_path_buf());
-        run(&["-o", "remount,bind,ro"]).then_some(ro)
-    }
-}
-
-impl Drop for ReadOnly {
-    fn drop(&mut self) {
-        match self {
-            ReadOnly::Mounted(dir) => {
-                let _ = Command::new("umount").arg(&*dir).status();
-            }
-            ReadOnly::Unwritable(dir, before) => {
-                let _ = std::fs::set_permissions(&*dir, before.clone());
-            }
-        }
-    }
-}
+use crate::support::files::ReadOnly;
 
 /// Every file of `dir` with its length and modification time.
 pub fn files(dir: &Path) -> Vec<(PathBuf, u64, SystemTime)> {

@@ -101,16 +101,16 @@ fn a_frame_replaced_by_a_huge_one_is_marked_and_not_read() {
     c.wait_exit(10);
 }
 
-/// On the Calibrate screen, `o` with the name of one photograph whose name
-/// holds a space (as a phone or a file manager names them) loads it. The
-/// text was split at the space: "plate: no such file".
-#[test]
-fn a_photograph_whose_name_holds_a_space_is_loaded() {
-    use vss::tui::keymap::{CalibrateAction as CA, GlobalAction, Scope, ScreenId};
-    let mut c = Console::start(80, 24, &[]);
+/// A flat grey 64 × 64 `.img` at `p`, a photograph to load.
+fn grey_photo(p: &std::path::Path) {
     let img = vss::llv::GreyImage::new(64, 64, vec![128; 64 * 64]).unwrap();
-    let photo = c.dir.path().join("plate 1.img");
-    vss::formats::img::write_img(&photo, &vss::formats::img::ImgFile::new(img)).unwrap();
+    vss::formats::img::write_img(p, &vss::formats::img::ImgFile::new(img)).unwrap();
+}
+
+/// From the start: the Calibrate screen, and `o`'s question of which
+/// photographs to load.
+fn ask_for_photographs(c: &mut Console) {
+    use vss::tui::keymap::{CalibrateAction as CA, GlobalAction, Scope, ScreenId};
     c.wait_text("Survey", 10);
     c.press(
         Scope::Global,
@@ -122,6 +122,16 @@ fn a_photograph_whose_name_holds_a_space_is_loaded() {
         Action::Calibrate(CA::Open),
     );
     c.wait_text("photographs to load:", 10);
+}
+
+/// On the Calibrate screen, `o` with the name of one photograph whose name
+/// holds a space (as a phone or a file manager names them) loads it. The
+/// text was split at the space: "plate: no such file".
+#[test]
+fn a_photograph_whose_name_holds_a_space_is_loaded() {
+    let mut c = Console::start(80, 24, &[]);
+    grey_photo(&c.dir.path().join("plate 1.img"));
+    ask_for_photographs(&mut c);
     c.send("plate 1.img\r");
     let s = c.wait("the photograph read", 20, |s| {
         flat(s).contains("1 photographs loaded") || flat(s).contains("no such file")
@@ -136,35 +146,13 @@ fn a_photograph_whose_name_holds_a_space_is_loaded() {
 /// was passed over without a word.
 #[test]
 fn a_fifo_among_the_photographs_is_said_not_loaded() {
-    use vss::tui::keymap::{CalibrateAction as CA, GlobalAction, Scope, ScreenId};
     let mut c = Console::start(80, 24, &[]);
     let photos = c.dir.path().join("photos");
     std::fs::create_dir(&photos).unwrap();
-    let img = vss::llv::GreyImage::new(64, 64, vec![128; 64 * 64]).unwrap();
-    vss::formats::img::write_img(
-        &photos.join("p1.img"),
-        &vss::formats::img::ImgFile::new(img),
-    )
-    .unwrap();
+    grey_photo(&photos.join("p1.img"));
     let fifo = photos.join("p2.png");
-    assert!(
-        std::process::Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .unwrap()
-            .success()
-    );
-    c.wait_text("Survey", 10);
-    c.press(
-        Scope::Global,
-        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
-    );
-    c.wait_text("views kept: 0", 10);
-    c.press(
-        Scope::Screen(ScreenId::Calibrate),
-        Action::Calibrate(CA::Open),
-    );
-    c.wait_text("photographs to load:", 10);
+    crate::support::files::mkfifo(&fifo);
+    ask_for_photographs(&mut c);
     c.send("photos\r");
     c.wait_words("1 photographs loaded", 20);
     c.send("m");
