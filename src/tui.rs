@@ -206,6 +206,7 @@ fn run_loop(
     let mut broken: Option<io::Error> = None;
     while !app.quit() && !stop.load(Ordering::SeqCst) {
         if dirty && last_draw.elapsed() >= FRAME {
+            workers.dispatch(sync_size(terminal, &mut app));
             if let Err(e) = draw(terminal, &app) {
                 broken = Some(e);
                 break;
@@ -294,10 +295,15 @@ fn suspend_here(
 ) {
     let how = if asked { "Ctrl-Z" } else { "SIGTSTP" };
     if !suspend::can_suspend() {
+        let before = app.chrome.log.pushed();
         app.ctx().warn(format!(
             "{how}: not suspended — no shell with job control started this console, \
              so nothing could bring it back; q quits"
         ));
+        // The answer to the key, held as any key's is.
+        if asked {
+            app.chrome.hold_answer(before, Instant::now());
+        }
         return;
     }
     let held = match &app.session.view {
@@ -342,6 +348,20 @@ fn take_back(terminal: &mut Term, app: &mut App, stop: &AtomicBool) {
 /// that knows the mode shows the frame whole, never half old and half new
 /// (over a slow SSH link, or while the machine is loaded); others ignore
 /// the two sequences.
+/// The terminal's size now, given to the App before a frame is drawn
+/// when its last resize event has not come yet: the frame (drawn at the
+/// terminal's size) and the keys that follow it (read against the App's)
+/// then agree on one size, so a key never acts on a screen that is not
+/// drawn ("too small") or drawn otherwise.
+fn sync_size(term: &Term, app: &mut App) -> Vec<Cmd> {
+    match term.size() {
+        Ok(size) if (size.width, size.height) != app.chrome.size => {
+            app.update(Msg::Resize(size.width, size.height))
+        }
+        _ => Vec::new(),
+    }
+}
+
 fn draw(term: &mut Term, app: &App) -> io::Result<()> {
     ratatui::crossterm::queue!(term.backend_mut(), terminal::BeginSynchronizedUpdate)?;
     term.draw(|f| f.render_widget(app, f.area()))?;

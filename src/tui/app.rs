@@ -13,7 +13,7 @@
 
 use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 
-use super::event::{Cmd, DeviceCmd, Msg, StoreCmd};
+use super::event::{Cmd, DeviceCmd, Msg, StoreCmd, StoreEvent};
 use super::keymap::{self, Action, GlobalAction, ModalAction, NavAction, Scope, ScreenId};
 use super::mode::Look;
 use crate::profile::Profile;
@@ -47,7 +47,7 @@ pub use modal::{Modal, Pending, Prompt, PromptPurpose};
 pub use nav::PreviewNav;
 pub use pipeline::{GreySource, PipelineScreen, StageView};
 pub use readonly::READ_ONLY;
-pub use session::{Refused, SessionEntry, SessionState};
+pub use session::{Opening, Refused, SessionEntry, SessionState};
 pub use survey::{Phase, SurveyScreen, Work};
 pub use tracker::{Loaded, Tracker};
 
@@ -208,6 +208,12 @@ impl App {
             Msg::Pointer(_) => true,
             _ => false,
         };
+        // A session the operator asked for, opened or refused now: its
+        // outcome is the answer to that key.
+        let opened = match &msg {
+            Msg::Store(StoreEvent::OpeningDone) => self.session.opening.first().map(|o| o.since),
+            _ => None,
+        };
         let before = self.chrome.log.pushed();
         let cmds = self.apply(msg);
         self.note_opening(&cmds);
@@ -215,6 +221,8 @@ impl App {
         let now = std::time::Instant::now();
         if by_operator {
             self.chrome.hold_answer(before, now);
+        } else if let Some(since) = opened {
+            self.chrome.hold_outcome(since, now);
         } else {
             self.chrome.release_held(now);
         }

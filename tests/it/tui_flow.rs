@@ -11,8 +11,8 @@ use vss::llv::pipeline::StageOutputs;
 use vss::llv::{Point, Segment};
 use vss::tui::app::{App, Modal, Phase};
 use vss::tui::event::{
-    Cmd, DeviceCmd, FramePurpose, ImageState, LoadedImage, Msg, SavedOutputs, SessionEntry,
-    StoreCmd, StoreEvent,
+    Cmd, DeviceCmd, DeviceEvent, FramePurpose, ImageState, LoadedImage, Msg, SavedOutputs,
+    SessionEntry, StoreCmd, StoreEvent,
 };
 use vss::tui::keymap::{
     Action, EditAction, GlobalAction, ModalAction, Scope, ScreenId, SurveyAction,
@@ -619,4 +619,35 @@ fn accepting_the_last_image_while_the_one_before_saves_ends_the_survey() {
     app.update(Msg::Store(StoreEvent::OutputsSaved(1)));
     let (s, _) = draw(&app, 80, 24);
     assert!(!s.contains("NOT accepted"), "{s}");
+}
+
+/// What opening a session found (a damaged frame's warning) is the answer
+/// to the Enter that opened it: a device note that arrives just after
+/// (the cell connecting late, under load) goes to the log and does not
+/// push the warning off the message line. Before, the warning was gone at
+/// once and the line said "grabber … connected".
+#[test]
+fn a_session_s_warning_is_not_pushed_off_the_line_by_a_device_note() {
+    let mut app = App::new(&profile(), colour());
+    app.start();
+    app.update(Msg::Store(StoreEvent::Sessions(vec![entry("cube", None)])));
+    let cmds = survey(&mut app, SurveyAction::Enter);
+    assert!(
+        cmds.iter()
+            .any(|c| matches!(c, Cmd::Store(StoreCmd::Open(d)) if d.ends_with("cube"))),
+        "{cmds:?}"
+    );
+    app.update(Msg::Store(StoreEvent::Opened(view())));
+    app.update(Msg::Store(StoreEvent::Warning(
+        "cube1a.img: too large for this session".into(),
+    )));
+    app.update(Msg::Store(StoreEvent::OpeningDone));
+    app.update(Msg::Device(DeviceEvent::Connected {
+        grabber: "VSS-SIM".into(),
+        relay: "sim relays".into(),
+    }));
+    let (s, _) = draw(&app, 80, 24);
+    let bottom = flat(&s.lines().rev().take(5).collect::<Vec<_>>().join(" "));
+    assert!(bottom.contains("cube1a.img: too large"), "{s}");
+    assert!(bottom.contains("(+1 newer in the log)"), "{s}");
 }

@@ -92,7 +92,11 @@ fn a_frame_replaced_by_a_huge_one_is_marked_and_not_read() {
     c.wait_text("choose a session", 10);
     c.wait("the session listed", 10, |s| s.contains("1/4 done"));
     c.send("\r");
-    let s = c.wait_text("too large", 30);
+    // The message line says the session has damage (held as the answer to
+    // Enter); the log, as an operator opens it, says which file and why.
+    c.wait_words("1 damaged or missing file(s) in this session", 30);
+    c.send("m");
+    let s = c.wait("the log", 30, |s| flat(s).contains("too large"));
     assert!(flat(&s).contains("cube1a.img"), "{s}");
     let pid = c.child.process_id().unwrap();
     let kib = vm_hwm_kib(pid);

@@ -159,6 +159,34 @@ impl Chrome {
         });
     }
 
+    /// Work a key asked for ended (a session opened or refused): its worst
+    /// message since `since` ([`Log::pushed`] when it was asked), an error
+    /// before a warning before the last note, is held like the key's own
+    /// answer, so a device note arriving meanwhile does not push a damaged
+    /// file's warning off the line. The answer to a later key stays.
+    pub fn hold_outcome(&mut self, since: usize, now: Instant) {
+        if self.held.is_some_and(|h| h.seq >= since)
+            || matches!(self.overlay, Some(Overlay::Message { .. }))
+        {
+            return;
+        }
+        let pushed = self.log.pushed();
+        let worst = [Level::Error, Level::Warn]
+            .into_iter()
+            .find_map(|level| {
+                (since..pushed)
+                    .rev()
+                    .find(|&n| self.log.nth_pushed(n).is_some_and(|e| e.level == level))
+            })
+            .or((pushed > since).then(|| pushed - 1));
+        if let Some(seq) = worst {
+            self.held = Some(Held {
+                seq,
+                until: now + HOLD,
+            });
+        }
+    }
+
     /// Lets the held answer go once its time is over (not while the
     /// message window shows it); whether the message line changes.
     pub fn release_held(&mut self, now: Instant) -> bool {

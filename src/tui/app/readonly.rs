@@ -12,6 +12,7 @@
 //! it opens, not in the one on screen.
 
 use super::App;
+use super::session::Opening;
 use crate::tui::event::{Cmd, StoreCmd};
 use crate::tui::keymap::{Action, EditAction, FilesAction, PipelineAction, SurveyAction};
 use crate::tui::text::clean;
@@ -56,7 +57,11 @@ impl App {
                 ),
                 _ => continue,
             };
-            self.session.opening.push(clean(&asked));
+            let since = self.chrome.log.pushed();
+            self.session.opening.push(Opening {
+                what: clean(&asked),
+                since,
+            });
         }
     }
 
@@ -103,7 +108,7 @@ impl App {
         let Some(what) = self.refused_here(a) else {
             return false;
         };
-        if let Some(next) = self.session.opening.last() {
+        if let Some(Opening { what: next, .. }) = self.session.opening.last() {
             let msg = format!(
                 "{what} refused: {next} is being opened — wait until it is (the store would \
                  write it there, not into the session on screen)"

@@ -33,7 +33,19 @@ pub struct SessionState {
     ///
     /// [`StoreEvent::OpeningDone`]: crate::tui::event::StoreEvent::OpeningDone
     /// [`App::refused_here`]: super::App::refused_here
-    pub opening: Vec<String>,
+    pub opening: Vec<Opening>,
+}
+
+/// A session asked of the store and not opened yet.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Opening {
+    /// What was asked, as said ("session cube", "new session hull").
+    pub what: String,
+    /// The log's [`Log::pushed`] when it was asked: the opening's messages
+    /// are those pushed since.
+    ///
+    /// [`Log::pushed`]: super::log::Log::pushed
+    pub since: usize,
 }
 
 /// An image whose outputs are not saved, and why.
