@@ -317,6 +317,20 @@ impl Session {
         Ok(formats::cdf::read_cdf(&self.path(&cdf.file))?.camera_model())
     }
 
+    /// Whether image `k` is recorded with the camera description `cdf`,
+    /// byte for byte as [`Session::set_image_camera`] writes it (`None`:
+    /// with none).
+    pub fn recorded_with(&self, k: u32, cdf: Option<&formats::cdf::Cdf>) -> bool {
+        let recorded = self.manifest.image(k).and_then(|r| r.cdf.as_ref());
+        match (recorded, cdf) {
+            (None, None) => true,
+            (Some(r), Some(c)) => {
+                r.hash == super::stamp::hash(formats::cdf::format_cdf(c).as_bytes())
+            }
+            _ => false,
+        }
+    }
+
     /// Image `k`'s captured frames, split by [`Session::frame_rule`], with
     /// its camera.
     pub fn pipeline_input(&self, k: u32) -> Result<PipelineInput, SessionError> {

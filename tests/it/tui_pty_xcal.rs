@@ -6,7 +6,9 @@
 use vss::formats::cdf::{read_cdf, write_cdf};
 use vss::tui::keymap::{Action, GlobalAction, ScreenId, SurveyAction};
 
-use super::tui_harness::{Console, SURVEY, five_lightings, flat, write_cdfs};
+use super::tui_harness::{
+    Console, PIPELINE, SURVEY, five_lightings, flat, panel_value, write_cdfs,
+};
 
 /// Camera 1's `.cdf` in `dir` with `k1` set to `k1`, the rest kept.
 fn set_k1(dir: &std::path::Path, k1: f64) {
@@ -90,4 +92,149 @@ fn a_camera_file_edited_while_the_console_runs_is_not_recorded_unsaid() {
     );
     c.send("q");
     c.wait_exit(15);
+}
+
+/// Image 1 surveyed, then camera 1 recalibrated (its `.cdf` replaced,
+/// another `k1` and centre, while no console runs), the console started
+/// again and image 1 shown: the console, image 1's recorded `.cdf` and
+/// `.lex` as surveyed.
+fn surveyed_then_recalibrated() -> (Console, Vec<u8>, Vec<u8>) {
+    let mut c = Console::start_with(&five_lightings(true), 80, 24, &[], |d| {
+        write_cdfs(d, 2);
+    });
+    c.survey(1);
+    let session = c.session();
+    let recorded = std::fs::read(session.join("cube1.cdf")).unwrap();
+    let first = std::fs::read(session.join("cube1.lex")).unwrap();
+    let mut c = c.restart_after(|d| {
+        let path = d.join("cam1.cdf");
+        let cdf = read_cdf(&path).unwrap();
+        let mut m = cdf.camera_model().unwrap();
+        let mut k = m.distortion.unwrap();
+        k[0] *= 2.0;
+        m.distortion = Some(k);
+        m.cx += 6.0;
+        assert!(m.fold_in(128, 128).is_none(), "a lens that does not fold");
+        let mut out = vss::formats::cdf::Cdf::from_camera(&m, cdf.extrinsic());
+        out.set(cdf.get("S").unwrap().clone());
+        write_cdf(&path, &out).unwrap();
+    });
+    c.wait_text("choose a session", 10);
+    c.wait_text(" cube ", 10);
+    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    c.wait_text("session cube", 10);
+    c.press(SURVEY, Action::Survey(SurveyAction::Up));
+    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    c.wait("image 1 shown with its saved outputs", 20, |s| {
+        s.contains("Image 1: ") && s.contains("saved")
+    });
+    (c, recorded, first)
+}
+
+/// Waits until the log has said `n` times that image 1's outputs were saved.
+fn wait_saved(c: &Console, n: usize) {
+    let log = c.session().join("cube.log");
+    c.wait("image 1's outputs saved", 30, |_| {
+        std::fs::read_to_string(&log)
+            .is_ok_and(|t| t.matches("image 1 accepted: outputs saved").count() == n)
+    });
+}
+
+/// Image 1's `.lex` after `vss session redo --from lens`, with the
+/// console's profile.
+fn redone(c: &Console) -> Vec<u8> {
+    let session = c.session();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_vss"))
+        .current_dir(c.dir.path())
+        .env("HOME", c.dir.path())
+        .args(["session", "redo", "--profile", "cell.toml", "--image", "1"])
+        .args(["--from", "lens"])
+        .arg(&session)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    std::fs::read(session.join("cube1.lex")).unwrap()
+}
+
+/// After a recalibration, an image surveyed before it and run again in
+/// the console (here lens correction off and on) is corrected with the
+/// description recorded with it, as `vss session redo` does, so the
+/// outputs the console saves are those redo makes. Before, the console
+/// used the new file while the session still recorded the old one.
+#[test]
+fn an_image_surveyed_before_a_recalibration_runs_with_its_recorded_camera() {
+    use vss::tui::keymap::{PipelineAction, Scope};
+    let (mut c, recorded, first) = surveyed_then_recalibrated();
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
+    );
+    c.wait_text("parameters", 10);
+    c.choose_param("lens.enabled");
+    for action in [PipelineAction::Dec, PipelineAction::Inc] {
+        c.press(PIPELINE, Action::Pipeline(action));
+        let want = if action == PipelineAction::Dec {
+            "0"
+        } else {
+            "1"
+        };
+        c.wait(&format!("lens.enabled = {want} run"), 20, |s| {
+            panel_value(s, "lens.enabled").as_deref() == Some(want)
+                && !s.contains("running")
+                && !s.contains("stale")
+        });
+    }
+    c.press(PIPELINE, Action::Pipeline(PipelineAction::Save));
+    c.wait_text("Replace its saved outputs", 10);
+    c.yes();
+    wait_saved(&c, 2);
+    c.send("q");
+    c.wait_exit(15);
+    let session = c.session();
+    assert!(
+        std::fs::read(session.join("cube1.cdf")).unwrap() == recorded,
+        "still recorded with the description it was captured with"
+    );
+    let saved = std::fs::read(session.join("cube1.lex")).unwrap();
+    assert!(
+        saved == first,
+        "run again with its recorded camera, the same lines as when surveyed"
+    );
+    assert!(
+        redone(&c) == saved,
+        "vss session redo makes what the console saved"
+    );
+}
+
+/// After a recalibration, an image surveyed before it and captured again
+/// (R) is recorded with the new description, which the console corrected
+/// its new frames with: `vss session redo` makes what the console saved.
+/// Before, the image kept the old description on record while the console
+/// used the new one.
+#[test]
+fn an_image_captured_again_after_a_recalibration_is_recorded_with_the_new_camera() {
+    let (mut c, recorded, _) = surveyed_then_recalibrated();
+    c.press(SURVEY, Action::Survey(SurveyAction::Redo));
+    c.wait_text("Capture image 1 again", 10);
+    c.yes();
+    c.capture_current(1);
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    c.wait_text("Replace its saved outputs", 10);
+    c.yes();
+    wait_saved(&c, 2);
+    c.send("q");
+    c.wait_exit(15);
+    let session = c.session();
+    let now = vss::formats::cdf::format_cdf(&read_cdf(&c.dir.path().join("cam1.cdf")).unwrap());
+    let on_record = std::fs::read(session.join("cube1.cdf")).unwrap();
+    assert!(
+        on_record != recorded,
+        "the old description is no longer on record"
+    );
+    assert_eq!(String::from_utf8_lossy(&on_record), now, "the new one is");
+    let saved = std::fs::read(session.join("cube1.lex")).unwrap();
+    assert!(
+        redone(&c) == saved,
+        "vss session redo makes what the console saved"
+    );
 }

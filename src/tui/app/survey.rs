@@ -337,6 +337,9 @@ impl Ctx<'_> {
             }
         };
         cur.camera = camera;
+        // A new frame runs with the camera as read now, which the store
+        // records with the image if it was recorded with another.
+        cur.recorded_camera = None;
         cur.version = version;
         cur.frames.retain(|f| f.0 != letter);
         cur.damaged.retain(|d| d.0 != letter);
@@ -539,6 +542,12 @@ impl Ctx<'_> {
         l.damaged = img.damaged;
         l.version = version;
         l.accepted = img.accepted;
+        l.recorded_camera = img.camera;
+        if let Some(Err(_)) = &l.recorded_camera
+            && let Some(why) = l.lens_problem(self.cell)
+        {
+            self.warn(format!("{why} — lens correction is off for it"));
+        }
         let complete = self.cell.letters.iter().all(|c| l.frame(*c).is_some());
         let mut cmds = Vec::new();
         match img.saved {

@@ -6,8 +6,9 @@
 
 use std::sync::Arc;
 
-use super::{Ctx, Pending};
+use super::{CellState, Ctx, Pending};
 use crate::llv::edit::LineEditor;
+use crate::llv::lens::CameraModel;
 use crate::llv::pipeline::StageOutputs;
 use crate::llv::{GreyImage, Params, Segment};
 use crate::tui::event::{Cmd, ImageKey, PipelineRequest, StoreCmd};
@@ -46,6 +47,11 @@ pub struct Loaded {
     /// Lightings captured in this run that the session could not save,
     /// with why: the image is not accepted until they are captured again.
     pub unsaved: Vec<(char, String)>,
+    /// The camera description recorded with the image in the session, as
+    /// read back ([`crate::tui::event::LoadedImage::camera`]); `None` for
+    /// an image with a frame captured in this run, which runs with the
+    /// profile's camera as the console read it (and is recorded so).
+    pub recorded_camera: Option<Result<Option<CameraModel>, String>>,
 }
 
 impl Loaded {
@@ -67,6 +73,38 @@ impl Loaded {
             edit_confirmed: false,
             damaged: Vec::new(),
             unsaved: Vec::new(),
+            recorded_camera: None,
+        }
+    }
+
+    /// The camera model lens correction uses on this image: the one
+    /// recorded with it, so that a re-run here makes what `vss session
+    /// redo` makes (after a recalibration too), else the profile's camera
+    /// as the console read it. None where either gives none
+    /// ([`Loaded::lens_problem`] says why).
+    pub fn camera_model(&self, cell: &CellState) -> Option<CameraModel> {
+        match &self.recorded_camera {
+            Some(recorded) => recorded.clone().ok().flatten(),
+            None => cell.camera_model(self.camera),
+        }
+    }
+
+    /// Why lens correction has no camera model for this image, in words
+    /// for the Pipeline panel (`None` when it has one, or while the store
+    /// has not read the profile's cameras).
+    pub fn lens_problem(&self, cell: &CellState) -> Option<String> {
+        let k = self.k;
+        match &self.recorded_camera {
+            Some(Ok(Some(_))) => None,
+            Some(Ok(None)) => Some(format!(
+                "image {k}: the camera description recorded with it gives no camera model"
+            )),
+            Some(Err(why)) => Some(format!(
+                "image {k}: its recorded camera description does not read: {why}"
+            )),
+            None => cell
+                .camera_problem(self.camera)
+                .map(|why| format!("camera {}: {why}", self.camera)),
         }
     }
 
@@ -178,7 +216,7 @@ impl Tracker {
         if cur.frames.is_empty() {
             return None;
         }
-        let camera = cell.camera_model(cur.camera);
+        let camera = cur.camera_model(cell);
         // A copy of the frames per request, as before: keeping one with the
         // image would hold every frame twice for the whole survey.
         let input = Arc::new(

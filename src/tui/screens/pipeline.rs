@@ -279,12 +279,9 @@ fn params_panel(app: &App, area: Rect, buf: &mut Buffer) {
     // would show, with why (the log has it whole).
     if params.lens.enabled
         && let Some(c) = cur
-        && let Some(why) = app.cell.camera_problem(c.camera)
+        && let Some(why) = c.lens_problem(&app.cell)
     {
-        lines.push(Line::styled(
-            format!("lens OFF — camera {}: {why}", c.camera),
-            t.warn(),
-        ));
+        lines.push(Line::styled(format!("lens OFF — {why}"), t.warn()));
     }
     match cur.and_then(|c| c.outputs.as_ref()) {
         Some(o) => {

@@ -199,6 +199,19 @@ impl Store {
         self.reply(StoreEvent::Cameras(models));
     }
 
+    /// Camera `camera`'s description as [`Store::cameras`] read it (read
+    /// now by a store that never read them: a test driving it by hand).
+    fn read_copy(&self, camera: u32) -> Option<Cdf> {
+        if self.cdfs.is_empty() {
+            return self.profile.camera_cdf(camera).ok().flatten();
+        }
+        camera
+            .checked_sub(1)
+            .and_then(|i| self.cdfs.get(i as usize))
+            .cloned()
+            .flatten()
+    }
+
     /// Camera `camera`'s description as [`Store::cameras`] read it, which
     /// image `k` is recorded with; a warning when the file has changed on
     /// disk since (a hand edit, a `vss calibrate` in another terminal),
@@ -206,13 +219,9 @@ impl Store {
     fn camera_read(&self, camera: u32, k: u32) -> Option<Cdf> {
         // A store that never read them (a test driving it by hand) reads now.
         if self.cdfs.is_empty() {
-            return self.profile.camera_cdf(camera).ok().flatten();
+            return self.read_copy(camera);
         }
-        let read = camera
-            .checked_sub(1)
-            .and_then(|i| self.cdfs.get(i as usize))
-            .cloned()
-            .flatten();
+        let read = self.read_copy(camera);
         let now = self.profile.camera_cdf(camera);
         if now.as_ref().ok().and_then(Option::as_ref) != read.as_ref() {
             let file = self.profile.cdf_shown(camera).unwrap_or_default();
@@ -245,12 +254,16 @@ impl Store {
         // file), recorded as the image's NAMEk.cdf, so the image's outputs
         // and its record agree (`vss session redo` makes the same); a
         // problem with it is said on the Pipeline screen (`cameras`).
-        let known = self
-            .session
-            .as_ref()
-            .and_then(|s| s.manifest().image(k))
-            .map(|r| (r.camera, r.location, r.cdf.is_some()));
-        let record = known.is_none_or(|(c, l, has_cdf)| c != camera || l != location || !has_cdf);
+        // A frame captured into an image recorded with another description
+        // (one read before a recalibration) records this one: the console
+        // runs a newly captured frame with the camera as read now.
+        let known = self.session.as_ref().and_then(|s| {
+            s.manifest().image(k).map(|r| {
+                let same = r.cdf.is_some() && s.recorded_with(k, self.read_copy(camera).as_ref());
+                (r.camera, r.location, same)
+            })
+        });
+        let record = known.is_none_or(|(c, l, same)| c != camera || l != location || !same);
         let cdf = if record {
             self.camera_read(camera, k)
         } else {
@@ -258,9 +271,7 @@ impl Store {
         };
         let s = self.session_mut()?;
         let what = format!("image {k} lighting {letter} NOT saved");
-        if known.is_none_or(|(c, l, has_cdf)| {
-            c != camera || l != location || (!has_cdf && cdf.is_some())
-        }) {
+        if known.is_none_or(|(c, l, same)| c != camera || l != location || !same && cdf.is_some()) {
             s.set_image_camera(k, camera, location, cdf.as_ref())
                 .map_err(session_err(what.clone()))?;
         }
