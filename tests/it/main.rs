@@ -53,6 +53,7 @@ mod session_big;
 mod session_cli;
 mod session_crash;
 mod session_redo;
+mod tui_answers;
 mod tui_device;
 mod tui_flow;
 mod tui_golden;
