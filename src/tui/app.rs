@@ -343,10 +343,41 @@ impl App {
                 if scope == Scope::Viewer {
                     // Any other key closes the window, as help always did.
                     self.chrome.overlay = None;
+                } else {
+                    self.unbound(&key, scope);
                 }
                 Vec::new()
             }
         }
+    }
+
+    /// A key with no binding where it was pressed says so, by its name,
+    /// and where the keys that work are listed; keys that are no key of
+    /// their own (a modifier or a lock alone) say nothing.
+    fn unbound(&mut self, key: &KeyEvent, scope: Scope) {
+        if matches!(
+            key.code,
+            KeyCode::Modifier(_)
+                | KeyCode::CapsLock
+                | KeyCode::NumLock
+                | KeyCode::ScrollLock
+                | KeyCode::Null
+        ) {
+            return;
+        }
+        let name = keymap::key_name(key);
+        let where_ = match (scope, &self.chrome.modal) {
+            (Scope::Screen(_), _) => "? lists this screen's keys".to_string(),
+            (Scope::Confirm, Some(m)) => m
+                .choices()
+                .iter()
+                .map(|(k, w)| format!("{k} {w}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            _ => return,
+        };
+        self.ctx()
+            .info(format!("{name} does nothing here — {where_}"));
     }
 
     /// Carries out one action through its owner.
