@@ -164,6 +164,7 @@ impl App {
     pub fn start(&mut self) -> Vec<Cmd> {
         let (name, file) = (&self.cell.profile_name, &self.cell.profile_file);
         let text = format!("profile {name}: {file}");
+        self.chrome.starting = Some(self.chrome.log.pushed());
         self.ctx().info(text);
         self.session.listed = Some(std::time::Instant::now());
         vec![Cmd::Store(StoreCmd::List)]
@@ -214,6 +215,8 @@ impl App {
             Msg::Store(StoreEvent::OpeningDone) => self.session.opening.first().map(|o| o.since),
             _ => None,
         };
+        // The first list of sessions ends the start-up.
+        let started = matches!(msg, Msg::Store(StoreEvent::Sessions(_)));
         let before = self.chrome.log.pushed();
         let cmds = self.apply(msg);
         self.note_opening(&cmds);
@@ -223,6 +226,8 @@ impl App {
             self.chrome.hold_answer(before, now);
         } else if let Some(since) = opened {
             self.chrome.hold_outcome(since, now);
+        } else if started && self.chrome.starting.is_some() {
+            self.chrome.started(now);
         } else {
             self.chrome.release_held(now);
         }

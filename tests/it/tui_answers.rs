@@ -1,12 +1,13 @@
 //! What the console answers to what the operator does, through messages
 //! alone: a letter a session name cannot hold refused as it is typed; a
-//! key that does nothing where it is pressed says so.
+//! key that does nothing where it is pressed says so; a warning at
+//! start-up stays on the message line.
 
 use ratatui::crossterm::event::{
     KeyCode, KeyEvent, KeyEventKind, KeyEventState, KeyModifiers, ModifierKeyCode,
 };
 use vss::tui::app::{App, Modal, Overlay};
-use vss::tui::event::Msg;
+use vss::tui::event::{DeviceEvent, Msg, StoreEvent};
 use vss::tui::keymap::SurveyAction;
 
 use super::tui_harness::flat;
@@ -126,4 +127,49 @@ fn a_key_bound_to_nothing_says_so() {
         line.contains("F5 does nothing here — y yes, n no"),
         "{line}"
     );
+}
+
+/// A camera description the profile names that cannot be used is
+/// warned of at start-up; the grabber's "connected" note that comes just
+/// after goes to the log and does not push the warning off the line
+/// (before, the line said "grabber … connected" at once).
+#[test]
+fn a_start_up_warning_is_not_pushed_off_the_line_by_the_grabber_s_note() {
+    let mut app = App::new(&profile(), colour());
+    app.tracker.params.lens.enabled = true;
+    app.start();
+    app.update(Msg::Store(StoreEvent::Cameras(vec![Err(
+        "/srv/vss/cam1.cdf: line 3: k1 is not a number".into(),
+    )])));
+    app.update(Msg::Store(StoreEvent::Sessions(Vec::new())));
+    app.update(Msg::Device(DeviceEvent::Connected {
+        grabber: "VSS-SIM".into(),
+        relay: "sim relays".into(),
+    }));
+    let line = message_line(&app);
+    assert!(
+        line.contains("lens correction OFF for camera 1") && line.contains("k1 is not a number"),
+        "{line}"
+    );
+    assert!(line.contains("(+1 newer in the log)"), "{line}");
+    // A key's answer takes the line as always.
+    code(&mut app, KeyCode::F(5));
+    assert!(message_line(&app).contains("F5 does nothing here"));
+}
+
+/// A start-up with nothing to warn of holds nothing: the grabber's note
+/// shows at once.
+#[test]
+fn a_quiet_start_up_lets_the_grabber_s_note_show() {
+    let mut app = App::new(&profile(), colour());
+    app.start();
+    app.update(Msg::Store(StoreEvent::Cameras(Vec::new())));
+    app.update(Msg::Store(StoreEvent::Sessions(Vec::new())));
+    app.update(Msg::Device(DeviceEvent::Connected {
+        grabber: "VSS-SIM".into(),
+        relay: "sim relays".into(),
+    }));
+    let line = message_line(&app);
+    assert!(line.contains("VSS-SIM"), "{line}");
+    assert!(!line.contains("newer in the log"), "{line}");
 }
