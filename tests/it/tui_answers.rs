@@ -48,6 +48,8 @@ fn a_letter_a_session_name_cannot_hold_is_refused_as_it_is_typed() {
         key(&mut app, c);
     }
     assert_eq!(field_text(&app).0, "cube2x");
+    let line = message_line(&app);
+    assert!(line.contains("contains '.' at position 6"), "still said: {line}");
     code(&mut app, KeyCode::Home);
     key(&mut app, ' ');
     assert_eq!(field_text(&app).0, "cube2x", "a space at the start too");

@@ -290,7 +290,9 @@ impl Prompt {
 impl App {
     /// A printable key typed into the open text field. A session name's
     /// field refuses a character the name can never hold as it is typed,
-    /// with the words Enter would say, the text left as it was.
+    /// with the words Enter would say, the text left as it was; the
+    /// refusal is also logged, so that a paste's last refusal stays said
+    /// on the message line when its next letters are taken.
     pub(super) fn prompt_typed(&mut self, key: &KeyEvent) {
         let Some(Modal::Prompt(p)) = self.chrome.modal.as_mut() else {
             return;
@@ -304,7 +306,9 @@ impl App {
         if p.purpose == PromptPurpose::SessionName
             && let Some(e) = p.refused_letter(c)
         {
-            p.error = Some(format!("session name refused: {e}"));
+            let why = format!("session name refused: {e}");
+            p.error = Some(why.clone());
+            self.chrome.log.push(Level::Error, why);
             return;
         }
         if !p.insert(c) {
