@@ -71,6 +71,7 @@ mod tui_pty_narrow;
 mod tui_pty_operator;
 mod tui_pty_polish;
 mod tui_pty_readonly;
+mod tui_pty_repeats;
 mod tui_pty_review;
 mod tui_pty_search;
 mod tui_pty_shared;

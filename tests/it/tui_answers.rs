@@ -1,7 +1,8 @@
 //! What the console answers to what the operator does, through messages
 //! alone: a letter a session name cannot hold refused as it is typed; a
 //! key that does nothing where it is pressed says so; a warning at
-//! start-up stays on the message line.
+//! start-up stays on the message line; the same message again and again
+//! is one entry with its count.
 
 use ratatui::crossterm::event::{
     KeyCode, KeyEvent, KeyEventKind, KeyEventState, KeyModifiers, ModifierKeyCode,
@@ -49,7 +50,10 @@ fn a_letter_a_session_name_cannot_hold_is_refused_as_it_is_typed() {
     }
     assert_eq!(field_text(&app).0, "cube2x");
     let line = message_line(&app);
-    assert!(line.contains("contains '.' at position 6"), "still said: {line}");
+    assert!(
+        line.contains("contains '.' at position 6"),
+        "still said: {line}"
+    );
     code(&mut app, KeyCode::Home);
     key(&mut app, ' ');
     assert_eq!(field_text(&app).0, "cube2x", "a space at the start too");
@@ -174,4 +178,52 @@ fn a_quiet_start_up_lets_the_grabber_s_note_show() {
     let line = message_line(&app);
     assert!(line.contains("VSS-SIM"), "{line}");
     assert!(!line.contains("newer in the log"), "{line}");
+}
+
+/// F5 pressed again and again says its answer once, with a count, on
+/// the message line and in the log; each press is still the answer to
+/// its key, held against a background note; the log file gets the line
+/// once, and the count once another message ends the run.
+#[test]
+fn the_same_answer_again_is_one_entry_with_its_count() {
+    let mut app = App::new(&profile(), colour());
+    app.start();
+    app.take_log_lines();
+    let n = app.chrome.log.len();
+    for _ in 0..500 {
+        code(&mut app, KeyCode::F(5));
+    }
+    assert_eq!(app.chrome.log.len(), n + 1, "one entry");
+    let line = message_line(&app);
+    assert!(line.contains("? lists this screen's keys (×500)"), "{line}");
+    app.update(Msg::Device(DeviceEvent::Connected {
+        grabber: "VSS-SIM".into(),
+        relay: "sim relays".into(),
+    }));
+    code(&mut app, KeyCode::F(5));
+    app.update(Msg::Device(DeviceEvent::Connected {
+        grabber: "VSS-SIM".into(),
+        relay: "sim relays".into(),
+    }));
+    let line = message_line(&app);
+    assert!(
+        line.contains("F5 does nothing here") && line.contains("(+1 newer in the log)"),
+        "the answer held, not the note: {line}"
+    );
+    let file = |app: &mut App| match app.take_log_lines() {
+        Some(vss::tui::event::Cmd::Store(vss::tui::event::StoreCmd::Log(l))) => l,
+        other => panic!("{other:?}"),
+    };
+    let lines = file(&mut app);
+    let f5 = lines
+        .iter()
+        .filter(|l| l.contains("F5 does nothing"))
+        .count();
+    assert_eq!(f5, 2, "{lines:#?}");
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.ends_with("last message repeated 499 times")),
+        "{lines:#?}"
+    );
 }

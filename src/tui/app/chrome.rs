@@ -143,7 +143,7 @@ impl Chrome {
                 })
                 .flatten();
             let (n, e) = error.unwrap_or((h.seq, e));
-            return Some((e, pushed - 1 - n));
+            return Some((e, self.log.newer_than(n)));
         }
         self.log.last().map(|e| (e, 0))
     }
