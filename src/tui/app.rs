@@ -164,6 +164,7 @@ impl App {
     pub fn start(&mut self) -> Vec<Cmd> {
         let (name, file) = (&self.cell.profile_name, &self.cell.profile_file);
         let text = format!("profile {name}: {file}");
+        self.chrome.starting = Some(self.chrome.log.pushed());
         self.ctx().info(text);
         self.session.listed = Some(std::time::Instant::now());
         vec![Cmd::Store(StoreCmd::List)]
@@ -214,6 +215,8 @@ impl App {
             Msg::Store(StoreEvent::OpeningDone) => self.session.opening.first().map(|o| o.since),
             _ => None,
         };
+        // The first list of sessions ends the start-up.
+        let started = matches!(msg, Msg::Store(StoreEvent::Sessions(_)));
         let before = self.chrome.log.pushed();
         let cmds = self.apply(msg);
         self.note_opening(&cmds);
@@ -223,6 +226,8 @@ impl App {
             self.chrome.hold_answer(before, now);
         } else if let Some(since) = opened {
             self.chrome.hold_outcome(since, now);
+        } else if started && self.chrome.starting.is_some() {
+            self.chrome.started(now);
         } else {
             self.chrome.release_held(now);
         }
@@ -343,10 +348,41 @@ impl App {
                 if scope == Scope::Viewer {
                     // Any other key closes the window, as help always did.
                     self.chrome.overlay = None;
+                } else {
+                    self.unbound(&key, scope);
                 }
                 Vec::new()
             }
         }
+    }
+
+    /// A key with no binding where it was pressed says so, by its name,
+    /// and where the keys that work are listed; keys that are no key of
+    /// their own (a modifier or a lock alone) say nothing.
+    fn unbound(&mut self, key: &KeyEvent, scope: Scope) {
+        if matches!(
+            key.code,
+            KeyCode::Modifier(_)
+                | KeyCode::CapsLock
+                | KeyCode::NumLock
+                | KeyCode::ScrollLock
+                | KeyCode::Null
+        ) {
+            return;
+        }
+        let name = keymap::key_name(key);
+        let where_ = match (scope, &self.chrome.modal) {
+            (Scope::Screen(_), _) => "? lists this screen's keys".to_string(),
+            (Scope::Confirm, Some(m)) => m
+                .choices()
+                .iter()
+                .map(|(k, w)| format!("{k} {w}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            _ => return,
+        };
+        self.ctx()
+            .info(format!("{name} does nothing here — {where_}"));
     }
 
     /// Carries out one action through its owner.

@@ -395,6 +395,24 @@ impl Key {
     }
 }
 
+/// How a key the terminal sent is written, as help writes the table's
+/// keys (`F5`, `C-x`, `S-Tab`, `Space`); Alt is `Alt-`.
+pub fn key_name(ev: &KeyEvent) -> String {
+    let char_key = matches!(ev.code, KeyCode::Char(_));
+    let key = Key {
+        code: ev.code,
+        ctrl: ev.modifiers.contains(KeyModifiers::CONTROL),
+        // A character's case already says Shift.
+        shift: !char_key && ev.modifiers.contains(KeyModifiers::SHIFT),
+    };
+    let alt = if ev.modifiers.contains(KeyModifiers::ALT) {
+        "Alt-"
+    } else {
+        ""
+    };
+    format!("{alt}{}", key.label())
+}
+
 /// One row of the key table.
 #[derive(Clone, Copy, Debug)]
 pub struct Binding {
@@ -509,7 +527,10 @@ pub fn markdown() -> String {
          `cargo test --lib keys_md` fails when this file is stale; \
          `VSS_WRITE_KEYS=1 cargo test --lib keys_md` rewrites it.\n\n\
          `S-` is Shift, `C-` is Ctrl. A screen's own keys win over the picture \
-         keys, which win over the keys that work everywhere.\n",
+         keys, which win over the keys that work everywhere. A key bound to nothing \
+         where it is pressed says so on the message line (\"F5 does nothing here — ? \
+         lists this screen's keys\"; in a question, its keys); in a text field it \
+         types, or does nothing.\n",
     );
     for (title, scope) in scopes() {
         out.push_str(&format!("\n## {title}\n\n| key | does |\n|---|---|\n"));

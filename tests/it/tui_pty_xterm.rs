@@ -387,6 +387,7 @@ fn a_suspended_console_s_session_can_be_taken_over() {
 /// paste) is refused in words that do not call it a non-letter: the rule
 /// shown before typing and the refusal both say which letters. Before,
 /// both said "letters", and the refusal of 'é' read "use only letters".
+/// The é is refused as it is typed, the field keeping "cub".
 #[test]
 fn a_session_name_with_an_accent_is_refused_in_words_that_say_which_letters() {
     let mut c = Console::start(80, 24, &[]);
@@ -400,7 +401,7 @@ fn a_session_name_with_an_accent_is_refused_in_words_that_say_which_letters() {
         flat(&s.replace('│', " ")).contains("letters a-z A-Z, digits"),
         "{s}"
     );
-    c.send("cubé\r");
+    c.send("cubé");
     let s = c.wait("the refusal", 10, |s| s.contains("refused"));
     let said = flat(&s.replace('│', " "));
     assert!(

@@ -96,6 +96,9 @@ pub struct Chrome {
     pub size: (u16, u16),
     /// The answer to the last key, held on the message line.
     pub held: Option<Held>,
+    /// Start-up under way (until the store first lists the sessions):
+    /// [`Log::pushed`] when it began.
+    pub starting: Option<usize>,
     pub quit: bool,
     /// The operator asked to suspend the console (Ctrl-Z): the shell
     /// takes it ([`crate::tui::App::take_suspend`]).
@@ -115,6 +118,7 @@ impl Chrome {
             search: None,
             size: (80, 24),
             held: None,
+            starting: None,
             quit: false,
             suspend: false,
         }
@@ -139,7 +143,7 @@ impl Chrome {
                 })
                 .flatten();
             let (n, e) = error.unwrap_or((h.seq, e));
-            return Some((e, pushed - 1 - n));
+            return Some((e, self.log.newer_than(n)));
         }
         self.log.last().map(|e| (e, 0))
     }
@@ -184,6 +188,23 @@ impl Chrome {
                 seq,
                 until: now + HOLD,
             });
+        }
+    }
+
+    /// Start-up ended (the profile read, its cameras' descriptions, the
+    /// sessions listed): its worst message, a warning or an error (a
+    /// damaged `.cdf`), is held like an outcome, so the grabber's note
+    /// arriving just after does not push it off the line. Notes alone
+    /// hold nothing.
+    pub fn started(&mut self, now: Instant) {
+        let Some(since) = self.starting.take() else {
+            return;
+        };
+        let worrying = (since..self.log.pushed())
+            .filter_map(|n| self.log.nth_pushed(n))
+            .any(|e| e.level != Level::Info);
+        if worrying {
+            self.hold_outcome(since, now);
         }
     }
 

@@ -2,6 +2,12 @@
 //! never loses one that flashed by in the status bar. The pane shows it
 //! wrapped and scrollable; the store worker also appends it to a log file
 //! (the session folder's, or the state folder's), which outlives a crash.
+//!
+//! A run of the same message (same level and text, one after another: a
+//! key held whose answer is a refusal) is one entry with a count, shown
+//! `… (×500)`; the file gets its first line at once and `last message
+//! repeated 499 times` when the run ends (the next message, the last one
+//! being the console's end), so a crash loses at most the count.
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -25,16 +31,35 @@ impl Level {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct LogEntry {
-    /// `HH:MM:SS` UTC.
+    /// `HH:MM:SS` UTC, of the first of its run.
     pub time: String,
     pub level: Level,
     pub text: String,
+    /// How many times it came in a row (1: once).
+    pub count: usize,
+    /// The push number ([`Log::nth_pushed`]) of the first of its run.
+    seq: usize,
+    /// `HH:MM:SS` of the last of its run.
+    last_time: String,
+    /// How many of the run the log file has: 0 none yet, 1 its line,
+    /// `count` once the repeats were said.
+    filed: usize,
 }
 
 impl LogEntry {
-    /// The entry as a line of the log file.
+    /// The entry as a line of the log file (the first of its run).
     pub fn file_line(&self) -> String {
         format!("{} {:7} {}", self.time, self.level.word(), self.text)
+    }
+
+    /// Its text as the pane and the message line show it: with the count
+    /// of a run, `… (×500)`.
+    pub fn shown(&self) -> String {
+        if self.count > 1 {
+            format!("{} (×{})", self.text, self.count)
+        } else {
+            self.text.clone()
+        }
     }
 }
 
@@ -43,25 +68,40 @@ impl LogEntry {
 #[derive(Debug, Default)]
 pub struct Log {
     entries: VecDeque<LogEntry>,
-    /// Entries pushed so far, and how many of them went to the file.
+    /// Messages pushed so far, repeats included.
     pushed: usize,
-    written: usize,
     file: Option<PathBuf>,
 }
 
 impl Log {
     pub const CAP: usize = 100_000;
 
+    /// Adds a message; the same as the newest (level and text) adds to
+    /// its count instead.
     pub fn push(&mut self, level: Level, text: impl Into<String>) {
+        let text = crate::tui::text::clean(&text.into());
+        let now = clock();
+        self.pushed += 1;
+        if let Some(last) = self.entries.back_mut()
+            && last.level == level
+            && last.text == text
+        {
+            last.count += 1;
+            last.last_time = now;
+            return;
+        }
         if self.entries.len() == Self::CAP {
             self.entries.pop_front();
         }
         self.entries.push_back(LogEntry {
-            time: clock(),
+            time: now.clone(),
             level,
-            text: crate::tui::text::clean(&text.into()),
+            text,
+            count: 1,
+            seq: self.pushed - 1,
+            last_time: now,
+            filed: 0,
         });
-        self.pushed += 1;
     }
 
     pub fn entries(&self) -> impl DoubleEndedIterator<Item = &LogEntry> + ExactSizeIterator {
@@ -72,15 +112,28 @@ impl Log {
         self.entries.back()
     }
 
-    /// How many entries were pushed in the run (the next one's number).
+    /// How many messages were pushed in the run, repeats included (the
+    /// next one's number).
     pub fn pushed(&self) -> usize {
         self.pushed
     }
 
-    /// The entry pushed `n`-th (from 0), while it is kept.
+    /// The entry of the message pushed `n`-th (from 0), while it is kept:
+    /// a repeat's is the entry of its run.
     pub fn nth_pushed(&self, n: usize) -> Option<&LogEntry> {
-        let first = self.pushed - self.entries.len();
-        n.checked_sub(first).and_then(|i| self.entries.get(i))
+        self.index_of(n).map(|i| &self.entries[i])
+    }
+
+    /// How many entries are newer than the one of push `n`.
+    pub fn newer_than(&self, n: usize) -> usize {
+        self.index_of(n).map_or(0, |i| self.entries.len() - 1 - i)
+    }
+
+    fn index_of(&self, n: usize) -> Option<usize> {
+        if n >= self.pushed || self.entries.front().is_none_or(|e| n < e.seq) {
+            return None;
+        }
+        Some(self.entries.partition_point(|e| e.seq <= n) - 1)
     }
 
     pub fn len(&self) -> usize {
@@ -91,16 +144,37 @@ impl Log {
         self.entries.is_empty()
     }
 
-    /// The lines not yet handed to the log file.
+    /// The lines not yet handed to the log file: each entry's first line
+    /// once, and the count of a run once a later message ended it.
     pub fn take_unwritten(&mut self) -> Vec<String> {
-        let new = self.pushed - self.written;
-        self.written = self.pushed;
         let n = self.entries.len();
-        self.entries
-            .iter()
-            .skip(n.saturating_sub(new))
-            .map(LogEntry::file_line)
-            .collect()
+        // Entries the file has whole are followed by none it lacks.
+        let mut start = n;
+        while start > 0 {
+            let e = &self.entries[start - 1];
+            if start < n && e.filed == e.count {
+                break;
+            }
+            start -= 1;
+        }
+        let mut out = Vec::new();
+        for (i, e) in self.entries.iter_mut().enumerate().skip(start) {
+            if e.filed == 0 {
+                out.push(e.file_line());
+                e.filed = 1;
+            }
+            if i + 1 < n && e.filed < e.count {
+                let times = e.count - e.filed;
+                let s = if times == 1 { "" } else { "s" };
+                out.push(format!(
+                    "{} {:7} last message repeated {times} time{s}",
+                    e.last_time,
+                    e.level.word()
+                ));
+                e.filed = e.count;
+            }
+        }
+        out
     }
 
     pub fn set_file(&mut self, path: PathBuf) {
@@ -141,5 +215,35 @@ mod tests {
         assert!(l.take_unwritten().is_empty());
         l.push(Level::Warn, "w");
         assert_eq!(l.take_unwritten().len(), 1);
+    }
+
+    /// 500 of the same message are one entry `(×500)`; every push still
+    /// has its number, the repeats that of their run's entry; the file
+    /// gets the first line at once and the count when the run ends.
+    #[test]
+    fn a_run_of_one_message_is_one_entry_and_its_count() {
+        let mut l = Log::default();
+        l.push(Level::Info, "start");
+        for _ in 0..500 {
+            l.push(Level::Warn, "F5 does nothing here");
+        }
+        assert_eq!((l.len(), l.pushed()), (2, 501));
+        assert_eq!(l.last().unwrap().shown(), "F5 does nothing here (×500)");
+        assert_eq!(l.nth_pushed(1), l.nth_pushed(500));
+        assert_eq!(l.nth_pushed(0).unwrap().text, "start");
+        assert!(l.nth_pushed(501).is_none());
+        assert_eq!(l.newer_than(0), 1);
+        let lines = l.take_unwritten();
+        assert_eq!(lines.len(), 2, "{lines:?}");
+        assert!(lines[1].ends_with("warning F5 does nothing here"));
+        l.push(Level::Warn, "F5 does nothing here");
+        assert!(l.take_unwritten().is_empty(), "the run goes on");
+        // Same text, another level: another entry.
+        l.push(Level::Info, "F5 does nothing here");
+        let lines = l.take_unwritten();
+        assert_eq!(lines.len(), 2, "{lines:?}");
+        assert!(lines[0].ends_with("warning last message repeated 500 times"));
+        assert!(lines[1].ends_with("info    F5 does nothing here"));
+        assert_eq!(l.len(), 3);
     }
 }

@@ -189,6 +189,41 @@ impl Prompt {
         true
     }
 
+    /// Why typing `c` makes the text a session name cannot be whatever
+    /// follows ([`SessionName::new`]'s letters, separators and `..`
+    /// errors), when the text so far has no such fault; a name too short
+    /// or starting badly yet is left to Enter.
+    ///
+    /// [`SessionName::new`]: crate::formats::names::SessionName::new
+    fn refused_letter(&self, c: char) -> Option<crate::formats::names::NameError> {
+        use crate::formats::names::{NameError, SessionName};
+        let letters = |text: &str| {
+            SessionName::new(text).err().filter(|e| {
+                matches!(
+                    e,
+                    NameError::BadChar { .. }
+                        | NameError::PathSeparator { .. }
+                        | NameError::DotDot { .. }
+                )
+            })
+        };
+        let mut typed = if self.selected {
+            String::new()
+        } else {
+            self.text.clone()
+        };
+        let at = if self.selected {
+            0
+        } else {
+            self.byte(self.cursor)
+        };
+        typed.insert(at, c);
+        if !self.selected && letters(&self.text).is_some() {
+            return None;
+        }
+        letters(&typed)
+    }
+
     /// A readline key.
     pub fn edit(&mut self, a: ModalAction) {
         if std::mem::take(&mut self.selected)
@@ -253,16 +288,30 @@ impl Prompt {
 }
 
 impl App {
-    /// A printable key typed into the open text field.
+    /// A printable key typed into the open text field. A session name's
+    /// field refuses a character the name can never hold as it is typed,
+    /// with the words Enter would say, the text left as it was; the
+    /// refusal is also logged, so that a paste's last refusal stays said
+    /// on the message line when its next letters are taken.
     pub(super) fn prompt_typed(&mut self, key: &KeyEvent) {
         let Some(Modal::Prompt(p)) = self.chrome.modal.as_mut() else {
             return;
         };
-        if let KeyCode::Char(c) = key.code
-            && !key.modifiers.contains(KeyModifiers::CONTROL)
-            && !p.insert(c)
-            && !c.is_control()
+        let KeyCode::Char(c) = key.code else {
+            return;
+        };
+        if key.modifiers.contains(KeyModifiers::CONTROL) || c.is_control() {
+            return;
+        }
+        if p.purpose == PromptPurpose::SessionName
+            && let Some(e) = p.refused_letter(c)
         {
+            let why = format!("session name refused: {e}");
+            p.error = Some(why.clone());
+            self.chrome.log.push(Level::Error, why);
+            return;
+        }
+        if !p.insert(c) {
             p.error = Some(format!("at most {} characters", p.max));
         }
     }
