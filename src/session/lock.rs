@@ -256,7 +256,7 @@ fn identity(dir: &Path) -> Option<(u64, u64)> {
 #[error(
     "the session folder {} {}: this change was NOT saved, and nothing was written anywhere \
      else; put the folder back where it was and try again, or open the session where it now is",
-    dir.display(),
+    crate::text::path(dir),
     if *replaced {
         "is not the one opened (it was moved or deleted and another folder made in its place)"
     } else {
@@ -369,10 +369,15 @@ impl Lock {
             return None;
         }
         let read = crate::fsutil::read_input_text(&path, MAX_LOCK_LEN)
-            .map_err(|e| format!("{}: {e}", path.display()))
+            .map_err(|e| format!("{}: {e}", crate::text::path(&path)))
             .and_then(|text| {
-                toml::from_str::<LeaveRequest>(&text)
-                    .map_err(|e| format!("{}: not a request: {}", path.display(), e.message()))
+                toml::from_str::<LeaveRequest>(&text).map_err(|e| {
+                    format!(
+                        "{}: not a request: {}",
+                        crate::text::path(&path),
+                        e.message()
+                    )
+                })
             });
         // Removed whatever it holds (a link is removed, not its target).
         let _ = fs::remove_file(&path);
@@ -383,7 +388,7 @@ impl Lock {
         if req.token != self.info.token {
             return Some(Err(format!(
                 "{}: the request is for another lock than this console's",
-                path.display()
+                crate::text::path(&path)
             )));
         }
         Some(provably_vss(&req.from, "the asker").map(|()| req.from))

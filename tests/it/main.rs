@@ -12,6 +12,7 @@ mod calib_cli;
 mod calib_console;
 mod calib_real;
 mod cli_formats;
+mod cli_names;
 mod cli_pipe;
 mod cli_standalone;
 mod formats_malformed;
