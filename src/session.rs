@@ -12,6 +12,7 @@
 //! ([`Session::redo`]).
 
 pub mod check;
+pub mod folder;
 mod fresh;
 pub mod input;
 pub mod lock;
@@ -118,6 +119,8 @@ pub enum SessionError {
     LockLost { path: PathBuf, holder: String },
     #[error(transparent)]
     FolderGone(#[from] lock::FolderGone),
+    #[error(transparent)]
+    Linked(#[from] folder::Linked),
     #[error(
         "{}{}: {message}; the manifest was left as it is: fix it by hand or restore it",
         crate::text::path(path),

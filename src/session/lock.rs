@@ -282,6 +282,8 @@ impl Lock {
             source,
         };
         let dir = folder_of(path);
+        // The folder itself, never through a link to one.
+        let folder = super::folder::unlinked(dir)?;
         let name = path.file_name().unwrap_or_default();
         // Created exclusively under a random name: a link planted in the
         // folder is never written through. (No sweep of stale temporary
@@ -333,11 +335,17 @@ impl Lock {
         result?;
         // Two take-overs may race: the last rename wins, the loser learns it here.
         match read_holder(path) {
-            Some(h) if h == info => Ok(Lock {
-                path: path.to_path_buf(),
-                info,
-                folder: identity(dir),
-            }),
+            Some(h) if h == info => {
+                let lock = Lock {
+                    path: path.to_path_buf(),
+                    info,
+                    folder: Some(folder),
+                };
+                // Taken in the folder looked at, not in a link put in its
+                // place meanwhile (dropped, the lock is removed again).
+                lock.check_held()?;
+                Ok(lock)
+            }
             h => Err(SessionError::Locked {
                 path: path.to_path_buf(),
                 holder: h.map_or_else(|| "an unknown holder".to_string(), |h| h.to_string()),
@@ -400,15 +408,17 @@ impl Lock {
     /// A lock file that is gone because its folder is (moved, renamed or
     /// deleted) is said as that ([`FolderGone`]), not as a take-over.
     pub fn check_held(&self) -> Result<(), SessionError> {
+        // The folder first: one moved away, or replaced (by another
+        // folder, or by a link to one), is not written whatever it holds.
+        let dir = folder_of(&self.path);
+        if self.folder.is_some() && identity(dir) != self.folder {
+            return Err(SessionError::FolderGone(FolderGone {
+                dir: dir.to_path_buf(),
+                replaced: fs::symlink_metadata(dir).is_ok(),
+            }));
+        }
         match read_holder(&self.path) {
             Some(h) if h == self.info => Ok(()),
-            None if self.folder.is_some() && identity(folder_of(&self.path)) != self.folder => {
-                let dir = folder_of(&self.path);
-                Err(SessionError::FolderGone(FolderGone {
-                    dir: dir.to_path_buf(),
-                    replaced: identity(dir).is_some(),
-                }))
-            }
             h => Err(SessionError::LockLost {
                 path: self.path.clone(),
                 holder: h.map_or_else(

@@ -53,6 +53,7 @@ mod session_api;
 mod session_big;
 mod session_cli;
 mod session_crash;
+mod session_link;
 mod session_redo;
 mod tui_device;
 mod tui_flow;

@@ -350,8 +350,7 @@ impl App {
                 let (shown, why) = (crate::text::path(&dir), clean(&why));
                 let mut ctx = self.ctx();
                 ctx.error(format!(
-                    "session {shown} cannot be opened to work on: its lock cannot be written \
-                     ({why})"
+                    "session {shown} cannot be opened to work on: {why}"
                 ));
                 ctx.ask(
                     "The session's folder cannot be written. Open it read-only, only to look at \

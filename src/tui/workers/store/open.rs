@@ -142,8 +142,16 @@ impl Store {
             }
             // The lock cannot be written: the folder is read-only (a
             // mount, permissions). Looking is offered, not done.
+            Err(SessionError::Linked(l)) => {
+                let why = l.to_string();
+                self.reply(StoreEvent::Unwritable { dir, why });
+                Ok(None)
+            }
             Err(SessionError::Unwritable { path, source }) => {
-                let why = format!("{}: {source}", crate::text::path(&path));
+                let why = format!(
+                    "its lock cannot be written ({}: {source})",
+                    crate::text::path(&path)
+                );
                 self.reply(StoreEvent::Unwritable { dir, why });
                 Ok(None)
             }
