@@ -86,7 +86,7 @@ impl Global {
         {
             errln!(
                 "vss: note: profile `{name}` is {} (found in the working folder)",
-                src.display()
+                crate::text::path(src)
             );
         }
         Ok(p)

@@ -67,7 +67,7 @@ pub struct FormatError {
 
 impl fmt::Display for FormatError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let p = self.path.display();
+        let p = crate::text::path(&self.path);
         match self.location {
             Location::None => write!(f, "{p}: {}", self.message),
             Location::Line(n) => write!(f, "{p}:{n}: {}", self.message),

@@ -191,14 +191,14 @@ pub fn check_target(path: &Path) -> io::Result<()> {
             format!(
                 "{} is a symbolic link; vss writes no file through a link — \
                  remove the link or write to another name",
-                path.display()
+                crate::text::path(path)
             ),
         )),
         Ok(m) => Err(io::Error::new(
             io::ErrorKind::InvalidInput,
             format!(
                 "{} is {}, not a regular file; vss only replaces regular files",
-                path.display(),
+                crate::text::path(path),
                 describe(m.file_type())
             ),
         )),

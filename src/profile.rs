@@ -403,9 +403,9 @@ impl Profile {
         let path = self.resolve_path(named);
         if self.builtin && !path.exists() && BUILTIN_CDF.iter().any(|(n, _)| Path::new(n) == named)
         {
-            return Some(format!("{} (built in)", named.display()));
+            return Some(format!("{} (built in)", crate::text::path(named)));
         }
-        Some(path.display().to_string())
+        Some(crate::text::path(&path))
     }
 
     /// The `.cdf` file of camera `cam` (1-based), resolved: where a new
@@ -484,8 +484,8 @@ pub fn locate(name_or_path: &str) -> Result<Origin, ProfileError> {
     if name_or_path == "default" {
         return Ok(Origin::Builtin);
     }
-    let mut tried: Vec<String> = vec![p.display().to_string()];
-    tried.extend(candidates.iter().map(|c| c.display().to_string()));
+    let mut tried: Vec<String> = vec![crate::text::path(p)];
+    tried.extend(candidates.iter().map(crate::text::path));
     tried.dedup();
     Err(ProfileError::NotFound {
         name: crate::text::sanitize(name_or_path),

@@ -12,6 +12,7 @@
 //! ([`Session::redo`]).
 
 pub mod check;
+pub mod folder;
 mod fresh;
 pub mod input;
 pub mod lock;
@@ -67,7 +68,7 @@ pub fn check_image_number(k: u32) -> Result<(), SessionError> {
 /// and says what to do.
 #[derive(Debug, thiserror::Error)]
 pub enum SessionError {
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {source}", crate::text::path(path))]
     Io {
         path: PathBuf,
         source: std::io::Error,
@@ -78,7 +79,7 @@ pub enum SessionError {
         "{}: {source}: the session folder cannot be written (a read-only mount, or no write \
          permission), so nothing was changed; it can still be looked at (`vss session show`, \
          `vss session check`, `vss report`)",
-        path.display()
+        crate::text::path(path)
     )]
     Unwritable {
         path: PathBuf,
@@ -94,8 +95,8 @@ pub enum SessionError {
     Llv(#[from] LlvError),
     #[error(
         "session {} already exists; open it instead (`vss session show {}`)",
-        dir.display(),
-        dir.display()
+        crate::text::path(dir),
+        crate::text::path(dir)
     )]
     Exists { dir: PathBuf },
     #[error("{}", fresh::not_a_session(dir, manifest))]
@@ -113,14 +114,16 @@ pub enum SessionError {
         "session lock {} is now held by {holder}: the session was taken over, so this \
          console no longer writes it; this change was NOT saved (the session on disk is the \
          new holder's); open the session again to go on",
-        path.display()
+        crate::text::path(path)
     )]
     LockLost { path: PathBuf, holder: String },
     #[error(transparent)]
     FolderGone(#[from] lock::FolderGone),
+    #[error(transparent)]
+    Linked(#[from] folder::Linked),
     #[error(
         "{}{}: {message}; the manifest was left as it is: fix it by hand or restore it",
-        path.display(),
+        crate::text::path(path),
         if *line > 0 { format!(":{line}") } else { String::new() }
     )]
     Manifest {
@@ -128,14 +131,17 @@ pub enum SessionError {
         line: usize,
         message: String,
     },
-    #[error("session {} was opened read-only; open it for writing to change it", dir.display())]
+    #[error(
+        "session {} was opened read-only; open it for writing to change it",
+        crate::text::path(dir)
+    )]
     ReadOnly { dir: PathBuf },
     #[error("lighting {letter:?} is not one of this session's lightings ({known})")]
     UnknownLighting { letter: char, known: String },
     #[error(
         "{}: the session folder's path is {len} bytes long; with the files' names it would \
          exceed the system's limit of {} bytes: make the session in a shorter path",
-        dir.display(),
+        crate::text::path(dir),
         fresh::PATH_MAX
     )]
     PathTooLong { dir: PathBuf, len: usize },
@@ -143,10 +149,10 @@ pub enum SessionError {
     BadImage(u32),
     #[error(
         "cannot make session {}: {source}; {}",
-        dir.display(),
+        crate::text::path(dir),
         match left {
             None => "nothing of it is left (what it had made is removed)".to_string(),
-            Some(why) => format!("what it had made could not all be removed ({why}): remove {} by hand", dir.display()),
+            Some(why) => format!("what it had made could not all be removed ({why}): remove {} by hand", crate::text::path(dir)),
         }
     )]
     NotMade {
@@ -181,7 +187,7 @@ fn locked_message(path: &Path, holder: &str, stale: bool, foreign: bool) -> Stri
     };
     format!(
         "session is in use: {} is held by {holder}; {what}",
-        path.display()
+        crate::text::path(path)
     )
 }
 
@@ -224,7 +230,7 @@ impl Session {
             left: before
                 .undo()
                 .err()
-                .map(|(p, e)| format!("{}: {e}", p.display())),
+                .map(|(p, e)| format!("{}: {e}", crate::text::path(&p))),
             dir,
             source: Box::new(e),
         })

@@ -37,6 +37,40 @@ pub fn sanitize_lines(s: &str) -> String {
     out
 }
 
+/// A file's or folder's path as a message shows it: unambiguous, and on
+/// one line. What [`sanitize`] would drop is escaped instead, so that two
+/// names never read alike and a name never breaks the message: a line
+/// break as `\n` (also `\r`, `\t`), other control characters and bytes
+/// that are not UTF-8 as `\xHH`, C1 controls and bidirectional overrides
+/// as `\u{HHHH}`, and a backslash as `\\`. Every message that names a
+/// file (the command line's and the console's) shows it through this.
+pub fn path(p: impl AsRef<std::path::Path>) -> String {
+    use std::fmt::Write as _;
+    use std::os::unix::ffi::OsStrExt as _;
+    let mut out = String::new();
+    for chunk in p.as_ref().as_os_str().as_bytes().utf8_chunks() {
+        for c in chunk.valid().chars() {
+            match c {
+                '\\' => out.push_str("\\\\"),
+                '\n' => out.push_str("\\n"),
+                '\r' => out.push_str("\\r"),
+                '\t' => out.push_str("\\t"),
+                c if c.is_ascii_control() => {
+                    let _ = write!(out, "\\x{:02x}", u32::from(c));
+                }
+                c if shown(c) != Some(c) => {
+                    let _ = write!(out, "\\u{{{:04x}}}", u32::from(c));
+                }
+                c => out.push(c),
+            }
+        }
+        for b in chunk.invalid() {
+            let _ = write!(out, "\\x{b:02x}");
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -54,5 +88,17 @@ mod tests {
             sanitize_lines("one\x1b]0;title\x07\ntwo\r\n\u{9b}2Jthree"),
             "one]0;title\ntwo\n2Jthree"
         );
+    }
+
+    #[test]
+    fn paths_are_shown_escaped_on_one_line() {
+        use std::os::unix::ffi::OsStrExt as _;
+        assert_eq!(path("sessions/cube/cube1a.img"), "sessions/cube/cube1a.img");
+        assert_eq!(path("a\nb.img"), "a\\nb.img");
+        assert_eq!(path("a\\nb.img"), "a\\\\nb.img");
+        assert_eq!(path("x\x1b[2J\ty\r"), "x\\x1b[2J\\ty\\r");
+        assert_eq!(path("p\u{9b}q\u{202e}r Grün"), "p\\u{009b}q\\u{202e}r Grün");
+        let bytes = std::ffi::OsStr::from_bytes(b"f\xffg");
+        assert_eq!(path(std::path::Path::new(bytes)), "f\\xffg");
     }
 }

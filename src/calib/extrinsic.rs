@@ -29,7 +29,7 @@ pub fn extrinsic(view: &View, plate: &Plate, m: &CameraModel) -> Result<Extrinsi
             plate
                 .source
                 .as_ref()
-                .map_or(plate.name.clone(), |p| p.display().to_string()),
+                .map_or(plate.name.clone(), crate::text::path),
         )
     })?;
     if !plate.oriented() {

@@ -56,10 +56,7 @@ fn names_a_file(name_or_path: &str) -> bool {
 pub fn in_use(name_or_path: &str) -> String {
     if names_a_file(name_or_path) {
         let p = Path::new(name_or_path);
-        std::path::absolute(p)
-            .unwrap_or_else(|_| p.to_path_buf())
-            .display()
-            .to_string()
+        crate::text::path(std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()))
     } else {
         format!("{name_or_path} (built in)")
     }

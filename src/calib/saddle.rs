@@ -460,13 +460,27 @@ pub fn detect(img: &GreyImage, plate: &Plate) -> Result<Detection, DetectError> 
     let want = (plate.columns as usize - 1, plate.rows as usize - 1);
     match find(img, want) {
         Ok(g) => label(img, plate, &g),
-        Err(e) => Err(blurred(img, want).unwrap_or(e)),
+        Err(Missed { error, best }) => {
+            // A part of the board found whose edges are smeared: the blur
+            // is why the rest was not (a motion blur breaks the lattice
+            // across the motion), not the plate file's size.
+            if let Some(b) = best {
+                let width = grid_edge_width(img, &b, |p| p);
+                if width > MAX_EDGE_WIDTH {
+                    return Err(DetectError::Blurred {
+                        width,
+                        corners: b.pts.iter().flatten().count(),
+                    });
+                }
+            }
+            Err(blurred(img, want).unwrap_or(error))
+        }
     }
 }
 
 /// When no board is found: the board found at half the size (where a
-/// blur is half as wide) is a blurred board, said so with its edges'
-/// width measured in the image itself.
+/// blur is half as wide), with edges wider than [`MAX_EDGE_WIDTH`]
+/// measured in the image itself, is a blurred board.
 fn blurred(img: &GreyImage, want: (usize, usize)) -> Option<DetectError> {
     let (w, h) = img.size();
     let (hw, hh) = (w / 2, h / 2);
@@ -487,37 +501,35 @@ fn blurred(img: &GreyImage, want: (usize, usize)) -> Option<DetectError> {
         .collect();
     let small = GreyImage::new(hw, hh, half).ok()?;
     let g = find(&small, want).ok()?;
-    let up = |p: [f64; 2]| [2.0 * p[0] + 0.5, 2.0 * p[1] + 0.5];
-    let contrast = {
-        let mut v = g.contrast.clone();
-        v.sort_by(f64::total_cmp);
-        v.get(v.len() / 2).copied().unwrap_or(0.0)
-    };
-    let mut sides = Vec::new();
-    for j in 0..g.nj {
-        for i in 0..g.ni.saturating_sub(1) {
-            if let (Some(p), Some(q)) = (g.pts[j * g.ni + i], g.pts[j * g.ni + i + 1]) {
-                let (p, q) = (up(p), up(q));
-                sides.push((p, sub(q, p), contrast));
-            }
-        }
-    }
-    Some(DetectError::Blurred {
-        width: edge_width(img, &sides),
+    let width = grid_edge_width(img, &g, |p| [2.0 * p[0] + 0.5, 2.0 * p[1] + 0.5]);
+    // Edges that measure sharp are not called blurred ("5.6 px wide (at
+    // most 6 px)" would contradict itself): the full size's reason stands.
+    (width > MAX_EDGE_WIDTH).then(|| DetectError::Blurred {
+        width,
         corners: g.pts.iter().flatten().count(),
     })
 }
 
+/// Why [`find`] found no whole grid, with the largest part of one it
+/// found (if any), whose edges tell a blurred board.
+struct Missed {
+    error: DetectError,
+    best: Option<Box<Grid>>,
+}
+
 /// The one whole grid of `want` inner corners in `img`, or why not.
-fn find(img: &GreyImage, want: (usize, usize)) -> Result<Grid, DetectError> {
+fn find(img: &GreyImage, want: (usize, usize)) -> Result<Grid, Missed> {
     let (w, h) = img.size();
     let s = smooth(img);
     let r = saddle_response(&s, w, h, 2);
     let mut c = candidates(&r, w, h);
-    let not_found = |found: usize| DetectError::NoGrid {
-        saddles: found,
-        columns: want.0,
-        rows: want.1,
+    let not_found = |found: usize| Missed {
+        error: DetectError::NoGrid {
+            saddles: found,
+            columns: want.0,
+            rows: want.1,
+        },
+        best: None,
     };
     if c.len() < 4 {
         return Err(not_found(c.len()));
@@ -559,38 +571,48 @@ fn find(img: &GreyImage, want: (usize, usize)) -> Result<Grid, DetectError> {
     }
     let whole = grids.iter().filter(|g| complete(g)).count();
     if whole >= 2 {
-        let mut it = grids.iter().filter(|g| complete(g));
-        let (first, second) = (it.next(), it.next());
-        if let (Some(first), Some(second)) = (first, second) {
-            return Err(DetectError::TwoBoards {
-                first: (first.ni, first.nj),
-                second: (second.ni, second.nj),
+        let mut it = grids.into_iter().filter(|g| complete(g));
+        if let (Some(first), Some(second)) = (it.next(), it.next()) {
+            // A smeared board can also grow twice: its edges tell.
+            return Err(Missed {
+                error: DetectError::TwoBoards {
+                    first: (first.ni, first.nj),
+                    second: (second.ni, second.nj),
+                },
+                best: Some(Box::new(first)),
             });
         }
+        return Err(not_found(c.len()));
     }
     match grids.iter().position(complete) {
         Some(k) => Ok(grids.swap_remove(k)),
         None => {
-            let Some(best) = grids.iter().max_by_key(|g| count(g)) else {
+            let Some(k) = (0..grids.len()).max_by_key(|&k| count(&grids[k])) else {
                 return Err(not_found(c.len()));
             };
-            if count(best) < 6 {
+            let best = grids.swap_remove(k);
+            if count(&best) < 6 {
                 return Err(not_found(c.len()));
             }
             let fits_in = best.ni <= want.0.max(want.1) && best.nj <= want.0.max(want.1);
-            if best.at_edge && fits_in {
-                return Err(DetectError::PartlyOut {
+            let error = if best.at_edge && fits_in {
+                DetectError::PartlyOut {
                     columns: best.ni,
                     rows: best.nj,
                     want_columns: want.0,
                     want_rows: want.1,
-                });
-            }
-            Err(DetectError::GridSize {
-                columns: best.ni,
-                rows: best.nj,
-                want_columns: want.0,
-                want_rows: want.1,
+                }
+            } else {
+                DetectError::GridSize {
+                    columns: best.ni,
+                    rows: best.nj,
+                    want_columns: want.0,
+                    want_rows: want.1,
+                }
+            };
+            Err(Missed {
+                error,
+                best: Some(Box::new(best)),
             })
         }
     }
@@ -689,7 +711,6 @@ fn label(img: &GreyImage, plate: &Plate, g: &Grid) -> Result<Detection, DetectEr
     let win = ((0.25 * small).floor() as i32).clamp(2, 5);
     let mut corners = Vec::new();
     let mut by_key = HashMap::new();
-    let mut widths = Vec::new();
     for j in 0..nj {
         for i in 0..ni {
             let Some(p) = at(i, j) else { continue };
@@ -707,22 +728,11 @@ fn label(img: &GreyImage, plate: &Plate, g: &Grid) -> Result<Detection, DetectEr
                 },
                 px: q,
             });
-            if let Some(nb) = at(i + 1, j) {
-                widths.push((p, sub(nb, p), 0.0));
-            }
         }
     }
     corners.sort_by_key(|c| (c.corner.key.1, c.corner.key.0));
-    // Edge sharpness, with the grid's contrast.
-    let contrast = {
-        let mut v = g.contrast.clone();
-        v.sort_by(f64::total_cmp);
-        v.get(v.len() / 2).copied().unwrap_or(0.0)
-    };
-    for x in &mut widths {
-        x.2 = contrast;
-    }
-    let width = edge_width(img, &widths);
+    // Edge sharpness, along both of the grid's directions.
+    let width = grid_edge_width(img, g, |p| p);
     if width > MAX_EDGE_WIDTH {
         return Err(DetectError::Blurred {
             width,

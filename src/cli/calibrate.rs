@@ -94,7 +94,7 @@ fn read_images(paths: &[PathBuf]) -> anyhow::Result<Vec<(String, GreyImage)>> {
         .iter()
         .map(|p| {
             let f = imageio::read_any(p)?;
-            Ok((p.display().to_string(), f.image))
+            Ok((crate::text::path(p), f.image))
         })
         .collect()
 }
@@ -122,7 +122,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     };
     let name = match a.camera {
         Some(cam) => format!("camera {cam}"),
-        None => out.display().to_string(),
+        None => crate::text::path(&out),
     };
     if a.images.is_empty() {
         bail!("no images: give the images of the plate after the options");
@@ -162,14 +162,14 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         cdf::read_cdf(&out).with_context(|| {
             format!(
                 "{} is there and cannot be read (the calibration keeps its other entries): mend it, or move it away; nothing written",
-                out.display()
+                crate::text::path(&out)
             )
         })?;
         if !a.yes {
             bail!(
                 "{} exists: --yes replaces its S, C, f and D (its other entries are kept, the old file as {}), or choose another --out",
-                out.display(),
-                calib::backup_name(&out).display()
+                crate::text::path(&out),
+                crate::text::path(calib::backup_name(&out))
             );
         }
     }
@@ -232,13 +232,13 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     if let Some(r) = &a.report {
         let ps = crate::report::calibration::document_named(&name, &c);
         crate::fsutil::write_atomic(r, ps.as_bytes())
-            .with_context(|| format!("cannot write {}; nothing written", r.display()))?;
-        outln!("wrote the calibration page {}", r.display());
+            .with_context(|| format!("cannot write {}; nothing written", crate::text::path(r)))?;
+        outln!("wrote the calibration page {}", crate::text::path(r));
     }
     let bak = calib::write_intrinsics(&out, &c)?;
     outln!(
         "wrote {}: C{} f, D, K calibrated, S {}{}",
-        out.display(),
+        crate::text::path(&out),
         if centre.is_some() { " stated," } else { "," },
         if c.scale_estimated {
             "with sy estimated"
@@ -246,7 +246,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             "stated"
         },
         match bak {
-            Some(b) => format!("; the old file kept as {}", b.display()),
+            Some(b) => format!("; the old file kept as {}", crate::text::path(&b)),
             None => String::new(),
         }
     );
@@ -259,11 +259,12 @@ fn out_scale(out: &Path) -> anyhow::Result<(f64, f64)> {
     if !out.exists() {
         bail!(
             "{} does not exist yet, so no scale S: {hint}",
-            out.display()
+            crate::text::path(out)
         );
     }
     let c = cdf::read_cdf(out).with_context(|| format!("the scale S: {hint}"))?;
-    calib::scale_of(&c).with_context(|| format!("{} has no scale S: {hint}", out.display()))
+    calib::scale_of(&c)
+        .with_context(|| format!("{} has no scale S: {hint}", crate::text::path(out)))
 }
 
 /// `S` of camera `cam`'s `.cdf` in the profile.
@@ -329,11 +330,14 @@ fn extrinsic(a: &Args, plate: &Plate, out: &Path) -> anyhow::Result<ExitCode> {
     let old = cdf::read_cdf(out).with_context(|| {
         format!(
             "the intrinsics: calibrate them first (vss calibrate --camera N --plate PLATE IMAGES… --out {})",
-            out.display()
+            crate::text::path(out)
         )
     })?;
     let model = old.model().map_err(|why| {
-        anyhow::anyhow!("{} {why}: calibrate the intrinsics first", out.display())
+        anyhow::anyhow!(
+            "{} {why}: calibrate the intrinsics first",
+            crate::text::path(out)
+        )
     })?;
     let imgs = read_images(std::slice::from_ref(image))?;
     let (name, img) = &imgs[0];
@@ -378,8 +382,8 @@ fn extrinsic(a: &Args, plate: &Plate, out: &Path) -> anyhow::Result<ExitCode> {
     let bak = calib::write_extrinsic(out, &old, &e.t)?.1;
     outln!(
         "wrote T into {} (its other entries kept, the old file as {})",
-        out.display(),
-        bak.map_or("-".into(), |b| b.display().to_string())
+        crate::text::path(out),
+        bak.map_or("-".into(), |b| crate::text::path(&b))
     );
     Ok(ExitCode::SUCCESS)
 }

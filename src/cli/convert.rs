@@ -29,19 +29,19 @@ pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     let out_kind = ImageKind::of(&a.output).with_context(|| {
         format!(
             "{}: unknown output format; use .img, .imc, .png, .pgm, .tif, .tiff or .bmp",
-            a.output.display()
+            crate::text::path(&a.output)
         )
     })?;
     if !out_kind.writable() {
         anyhow::bail!(
             "{}: vss reads JPEG but does not write it (lossy); use .png, .pgm, .tif or .bmp",
-            a.output.display()
+            crate::text::path(&a.output)
         );
     }
     let (mut f, notes) = read_any_noted(&a.input)?;
     let in_kind = ImageKind::of(&a.input);
     for n in notes {
-        errln!("vss: note: {}: {n}", a.input.display());
+        errln!("vss: note: {}: {n}", crate::text::path(&a.input));
     }
     if let Some(c) = a.comment {
         f.comment = c;
@@ -62,11 +62,15 @@ pub fn run(_g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     if !out_kind.keeps_header() && (!f.comment.is_empty() || f.x0 != 0 || f.y0 != 0) {
         errln!(
             "vss: note: {}: this format keeps only the pixels (comment and upper-left corner dropped)",
-            a.output.display()
+            crate::text::path(&a.output)
         );
     }
     write_any(&a.output, &f)?;
     let (w, h) = f.image.size();
-    outln!("{} → {} ({w} × {h})", a.input.display(), a.output.display());
+    outln!(
+        "{} → {} ({w} × {h})",
+        crate::text::path(&a.input),
+        crate::text::path(&a.output)
+    );
     Ok(ExitCode::SUCCESS)
 }

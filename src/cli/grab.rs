@@ -72,9 +72,18 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         .session
         .file_name()
         .and_then(|n| n.to_str())
-        .with_context(|| format!("{}: the session path ends in no name", a.session.display()))?;
-    let session = SessionName::new(name)
-        .with_context(|| format!("{}: not a valid session name", a.session.display()))?;
+        .with_context(|| {
+            format!(
+                "{}: the session path ends in no name",
+                crate::text::path(&a.session)
+            )
+        })?;
+    let session = SessionName::new(name).with_context(|| {
+        format!(
+            "{}: not a valid session name",
+            crate::text::path(&a.session)
+        )
+    })?;
     crate::session::check_image_number(a.image).context("--image")?;
     // A letter named twice would be captured twice, the second frame
     // replacing the first without --yes.
@@ -110,7 +119,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         let existing: Vec<String> = files
             .iter()
             .filter(|(_, p)| p.exists())
-            .map(|(_, p)| p.display().to_string())
+            .map(|(_, p)| crate::text::path(p))
             .collect();
         if !existing.is_empty() {
             bail!(
@@ -155,15 +164,19 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     cell.grabber.check_camera(a.camera)?;
     let mut sess = match existing {
         Some(s) => s,
-        None => Session::create(&parent, session.as_str(), &profile)
-            .with_context(|| format!("cannot create the session {}", a.session.display()))?,
+        None => Session::create(&parent, session.as_str(), &profile).with_context(|| {
+            format!(
+                "cannot create the session {}",
+                crate::text::path(&a.session)
+            )
+        })?,
     };
     // A session made with another profile may letter its lightings otherwise.
     let known = sess.letters();
     if let Some(letter) = a.lighting.iter().find(|l| !known.contains(l)) {
         bail!(
             "lighting {letter} is not one of the lightings of session {} ({}); nothing was captured",
-            a.session.display(),
+            crate::text::path(&a.session),
             known.iter().collect::<String>()
         );
     }
@@ -201,7 +214,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             bail!(
                 "session {} was taken over by {by}: {stem} was not captured (nothing of it \
                  saved), the lightings saved before are kept; the lock is released",
-                a.session.display()
+                crate::text::path(&a.session)
             );
         }
     }
@@ -216,7 +229,7 @@ fn open_existing(
     session: &SessionName,
     a: &Args,
 ) -> anyhow::Result<Option<Session>> {
-    let context = || format!("cannot open the session {}", a.session.display());
+    let context = || format!("cannot open the session {}", crate::text::path(&a.session));
     match Session::open_existing(parent, session.as_str()) {
         Err(e @ SessionError::Locked { .. }) => {
             if a.take_over || ask_take_over(&e)? {
@@ -224,7 +237,7 @@ fn open_existing(
                 let mut say = |text: String| errln!("{text}");
                 let s = crate::session::takeover::open_taking_over(&dir, &mut say)
                     .with_context(context)?;
-                errln!("took over the lock of {}", dir.display());
+                errln!("took over the lock of {}", crate::text::path(&dir));
                 Ok(Some(s))
             } else {
                 Err(anyhow::Error::new(e).context(context()))
@@ -306,7 +319,7 @@ fn capture_one(
     };
     outln!(
         "{}: camera {camera}, lighting {letter} ({on}), crc {:08X}, {} ms",
-        path.display(),
+        crate::text::path(&path),
         cap.frame.crc,
         cap.elapsed.as_millis()
     );

@@ -54,7 +54,7 @@ pub fn describe(path: &Path) -> anyhow::Result<String> {
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
-    let shown = sanitize(&path.display().to_string());
+    let shown = crate::text::path(path);
     let mut s = String::new();
     match ext.as_str() {
         "img" | "imc" => {
@@ -324,7 +324,7 @@ fn session_files(
     writeln!(
         s,
         "  in {}: {grey} of {expected} grey images (for {} of {} image numbers), {lines} .ldr line files",
-        dir.display(),
+        crate::text::path(&dir),
         images.len(),
         x.images
     )

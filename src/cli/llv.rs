@@ -138,8 +138,12 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     let profile = g.load_profile()?;
     let p = params(&profile, &a)?;
     if let Some(out) = &a.out {
-        std::fs::create_dir_all(out)
-            .with_context(|| format!("{}: cannot create the output directory", out.display()))?;
+        std::fs::create_dir_all(out).with_context(|| {
+            format!(
+                "{}: cannot create the output directory",
+                crate::text::path(out)
+            )
+        })?;
     }
     if let Some(files) = &a.from_edges {
         let [hpo, vpo] = files.as_slice() else {
@@ -155,7 +159,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
         (Some(path), _) => Some((
             cdf::read_cdf(path)?
                 .model()
-                .map_err(|why| lacks(&path.display(), why))?,
+                .map_err(|why| lacks(&crate::text::path(path), why))?,
             path.clone(),
         )),
         // The one owner of a camera's description (as the console uses).
@@ -197,7 +201,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             if super::is_broken_pipe(&e) {
                 return Err(e);
             }
-            errln!("vss: error: {}: {e:#}", grp.stem);
+            errln!("vss: error: {}: {e:#}", crate::text::path(&grp.stem));
             failed += 1;
         }
     }
@@ -234,7 +238,7 @@ fn run_group(
             // The size from the header, before the pixels are read.
             let (img, notes) = imageio::read_any_sized(f, crate::llv::image::check_stage_size)?;
             for n in notes {
-                errln!("vss: note: {}: {n}", f.display());
+                errln!("vss: note: {}: {n}", crate::text::path(f));
             }
             Ok::<_, crate::formats::FormatError>(img)
         })
@@ -243,7 +247,7 @@ fn run_group(
     for (path, f) in grp.files.iter().zip(&files) {
         f.image
             .check_stage_size()
-            .with_context(|| path.display().to_string())?;
+            .with_context(|| crate::text::path(path))?;
     }
     // The lightings of one view and the ambient image are one picture each:
     // a file of another size is named (the stages said only "image sizes
@@ -261,10 +265,10 @@ fn run_group(
             bail!(
                 "{} is {} × {} pixels but {} is {} × {}: the lightings of one view and \
                  the ambient image must be the same size",
-                other.display(),
+                crate::text::path(other),
                 o.width(),
                 o.height(),
-                first.display(),
+                crate::text::path(first),
                 size.0,
                 size.1
             );
@@ -450,7 +454,7 @@ fn check_edge_pair(
             bail!(
                 "{}: byte {}: the header says direction {}, but the {which} file of \
                  --from-edges must be the {} scan's (STEM.hpo STEM.vpo, in that order)",
-                path.display(),
+                crate::text::path(path),
                 edgefile::MAGIC.len() + 3,
                 named(d),
                 named(want)
@@ -462,10 +466,10 @@ fn check_edge_pair(
         bail!(
             "{} holds the edges of a {} × {} image, {} of a {} × {} one: the two edge \
              files must come from the same image",
-            hpo.display(),
+            crate::text::path(hpo),
             h.width,
             h.height,
-            vpo.display(),
+            crate::text::path(vpo),
             v.width,
             v.height
         );
@@ -476,7 +480,8 @@ fn check_edge_pair(
 /// What `--auto` changed, in text.
 fn print_auto(stem: &str, t: &Target, r: &AutoResult) -> anyhow::Result<()> {
     outln!(
-        "{stem}: auto {t}: {} lines (was {}) after {} pipeline runs",
+        "{}: auto {t}: {} lines (was {}) after {} pipeline runs",
+        crate::text::path(stem),
         r.lines.len(),
         r.base_lines,
         r.runs
@@ -515,7 +520,7 @@ fn report(
     proposal: Option<&AutoResult>,
 ) -> anyhow::Result<()> {
     let t = &out.timings;
-    let shown = |p: &PathBuf| crate::formats::sanitize(&p.display().to_string());
+    let shown = |p: &PathBuf| crate::text::path(p);
     if a.json {
         let attrs: Vec<_> = out
             .lines
@@ -523,7 +528,7 @@ fn report(
             .map(|l| json!({"response": l.response, "residual": l.residual, "shadow": l.shadow}))
             .collect();
         let mut v = json!({
-            "image": stem,
+            "image": crate::text::path(stem),
             "profile": crate::formats::sanitize(profile),
             "files": files.iter().map(shown).collect::<Vec<_>>(),
             "width": size.0,
@@ -545,7 +550,8 @@ fn report(
     }
     let ms = |us: u64| us as f64 / 1000.0;
     outln!(
-        "{stem} ({}): {} × {}",
+        "{} ({}): {} × {}",
+        crate::text::path(stem),
         files.iter().map(shown).collect::<Vec<_>>().join(" "),
         size.0,
         size.1

@@ -98,7 +98,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                     write_par(&o, &f)?;
                     errln!(
                         "vss: wrote {} ({} parameters, set \"{}\")",
-                        o.display(),
+                        crate::text::path(&o),
                         f.entries.len(),
                         f.name
                     );
@@ -116,42 +116,42 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                 Origin::Builtin => Profile::builtin()?,
             };
             let text = crate::fsutil::read_input(&file, crate::formats::max_len(&file))
-                .with_context(|| format!("cannot read {}", file.display()))?;
+                .with_context(|| format!("cannot read {}", crate::text::path(&file)))?;
             let text = std::str::from_utf8(&text).map_err(|_| {
                 anyhow::anyhow!(
                     "{}: not UTF-8 text; expected a parameter file",
-                    file.display()
+                    crate::text::path(&file)
                 )
             })?;
             let (params, notes) = import_params(text, &file, &base.llv)?;
             for n in notes {
-                errln!("vss: note: {}: {n}", file.display());
+                errln!("vss: note: {}: {n}", crate::text::path(&file));
             }
             match out {
                 Some(o) => {
                     let new_text = edit::set_llv(&base_text, &base_path, &params)?;
                     crate::fsutil::write_atomic(&o, new_text.as_bytes())
-                        .with_context(|| format!("cannot write {}", o.display()))?;
+                        .with_context(|| format!("cannot write {}", crate::text::path(&o)))?;
                     let moved = o.parent().map(|d| d.canonicalize().ok())
                         != base_path.parent().map(|d| d.canonicalize().ok());
                     let relative = base.survey.cdf.iter().any(|c| c.is_relative());
                     if base.builtin && relative {
                         errln!(
                             "vss: note: {} names the built-in cameras' .cdf files (sim/cam1.cdf, …), which are not files: put them beside it or change survey.cdf",
-                            o.display()
+                            crate::text::path(&o)
                         );
                     } else if moved && relative {
                         errln!(
                             "vss: note: {} is in another folder than {}: its relative survey.cdf paths now point elsewhere",
-                            o.display(),
-                            base_path.display()
+                            crate::text::path(&o),
+                            crate::text::path(&base_path)
                         );
                     }
                     errln!(
                         "vss: wrote {} ({} from {})",
-                        o.display(),
+                        crate::text::path(&o),
                         changed_text(&base.llv, &params),
-                        file.display()
+                        crate::text::path(&file)
                     );
                 }
                 None => out!("{}", llv_toml(&params)),

@@ -68,11 +68,11 @@ fn write(
     write_atomic_with(path, fill).with_context(|| {
         format!(
             "cannot write {} ({})",
-            path.display(),
+            crate::text::path(path),
             survey::on_disk(path)
         )
     })?;
-    outln!("wrote {}", path.display());
+    outln!("wrote {}", crate::text::path(path));
     Ok(())
 }
 
@@ -83,7 +83,7 @@ fn lines_report(ldr: &Path, a: &Args) -> anyhow::Result<ExitCode> {
         None => guess_size(ldr, &lines),
     };
     let caption = ldr.file_name().map_or_else(
-        || ldr.display().to_string(),
+        || crate::text::path(ldr),
         |n| n.to_string_lossy().into_owned(),
     );
     let ps_path =
@@ -158,7 +158,7 @@ fn grey_report(a: &Args) -> anyhow::Result<ExitCode> {
         })?;
         total += f.image.width() * f.image.height();
         let name = p.file_name().map_or_else(
-            || p.display().to_string(),
+            || crate::text::path(p),
             |n| n.to_string_lossy().into_owned(),
         );
         images.push((name, f.image));
@@ -204,7 +204,7 @@ fn session_report(dir: &Path, a: &Args) -> anyhow::Result<ExitCode> {
         None => e.into(),
     })?;
     for p in &written.files {
-        outln!("wrote {}", p.display());
+        outln!("wrote {}", crate::text::path(p));
     }
     if written.problems.is_empty() {
         return Ok(ExitCode::SUCCESS);

@@ -141,11 +141,15 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     if let Some(photos) = &a.export_real {
         let p = params(g, &a)?;
         let dir = a.dir.as_deref().context("--export-real needs --dir DIR")?;
-        let n = real::export_real(photos, dir, &p, a.runs)
-            .with_context(|| format!("running vss on the photographs of {}", photos.display()))?;
+        let n = real::export_real(photos, dir, &p, a.runs).with_context(|| {
+            format!(
+                "running vss on the photographs of {}",
+                crate::text::path(photos)
+            )
+        })?;
         outln!(
             "vss on {n} photographs: segments and times written to {}",
-            dir.display()
+            crate::text::path(dir)
         );
         return Ok(ExitCode::SUCCESS);
     }
@@ -155,7 +159,10 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             None => {
                 let p = params(g, &a)?;
                 let (m, _, by_contrast) = real::evaluate_real(photos, &p).with_context(|| {
-                    format!("running vss on the photographs of {}", photos.display())
+                    format!(
+                        "running vss on the photographs of {}",
+                        crate::text::path(photos)
+                    )
                 })?;
                 vec![real::RealScore {
                     detector: compare::VSS.into(),
@@ -203,7 +210,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             runs: a.runs,
         };
         let m = compare::export(dir, &cfg, &llv)
-            .with_context(|| format!("exporting the scenes to {}", dir.display()))?;
+            .with_context(|| format!("exporting the scenes to {}", crate::text::path(dir)))?;
         for f in &m.families {
             outln!(
                 "{}: {} scenes of {}×{} px at noise {} written to {}",
@@ -212,7 +219,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                 f.size,
                 f.size,
                 f.levels.join(", "),
-                dir.join(&f.name).display()
+                crate::text::path(dir.join(&f.name))
             );
         }
         return Ok(ExitCode::SUCCESS);

@@ -163,7 +163,7 @@ fn new(g: &Global, name: &str, dir: Option<PathBuf>) -> anyhow::Result<ExitCode>
     if let Some(w) = s.name().dos_warning(s.manifest().session.planned_images) {
         errln!("vss: note: {w}");
     }
-    outln!("created session {}", s.dir().display());
+    outln!("created session {}", crate::text::path(s.dir()));
     print_checklist(&s)?;
     Ok(ExitCode::SUCCESS)
 }
@@ -174,7 +174,11 @@ fn show(dir: &Path) -> anyhow::Result<ExitCode> {
     // Every text from the manifest is one line: a line break in a note must
     // not make a line of its own that looks like the checklist's.
     let t = crate::text::sanitize;
-    outln!("session {} in {}", t(&m.session.name), s.dir().display());
+    outln!(
+        "session {} in {}",
+        t(&m.session.name),
+        crate::text::path(s.dir())
+    );
     outln!(
         "  created {}, modified {} by vss {}, profile \"{}\"",
         t(&m.session.created),
@@ -316,7 +320,7 @@ fn redo(g: &Global, dir: &Path, k: u32, stage: Stage, take_over: bool) -> anyhow
     };
     let summary = s
         .redo(k, stage, &profile.llv)
-        .with_context(|| format!("redo image {k} of {}", dir.display()))?;
+        .with_context(|| format!("redo image {k} of {}", crate::text::path(dir)))?;
     outln!("{summary}");
     Ok(ExitCode::SUCCESS)
 }

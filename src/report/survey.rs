@@ -26,7 +26,7 @@ use crate::session::{Session, SessionError};
 pub enum ReportError {
     #[error(transparent)]
     Session(#[from] SessionError),
-    #[error("cannot write {}: {source}", path.display())]
+    #[error("cannot write {}: {source}", crate::text::path(path))]
     Write {
         path: PathBuf,
         source: std::io::Error,
@@ -47,7 +47,7 @@ pub enum ReportError {
 
 /// `a.ps, a1.svg`.
 fn list(paths: &[PathBuf]) -> String {
-    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    let names: Vec<String> = paths.iter().map(crate::text::path).collect();
     names.join(", ")
 }
 
@@ -78,7 +78,7 @@ impl ReportError {
 pub fn on_disk(path: &Path) -> String {
     let meta = std::fs::symlink_metadata(path);
     if meta.as_ref().is_ok_and(|m| !m.is_file()) {
-        return format!("nothing was written at {}", path.display());
+        return format!("nothing was written at {}", crate::text::path(path));
     }
     match meta.and_then(|m| m.modified()) {
         Ok(t) => {
@@ -87,11 +87,11 @@ pub fn on_disk(path: &Path) -> String {
                 .map_or(0, |d| d.as_secs());
             format!(
                 "{} on disk is the OLD report, untouched, written {}",
-                path.display(),
+                crate::text::path(path),
                 crate::clock::rfc3339(secs)
             )
         }
-        Err(_) => format!("there is no {} yet", path.display()),
+        Err(_) => format!("there is no {} yet", crate::text::path(path)),
     }
 }
 

@@ -353,7 +353,7 @@ impl SimCell {
         let fail = |e: String| {
             RigError::Sim(format!(
                 "cannot link {} to the grabber: {e}",
-                link.display()
+                crate::text::path(link)
             ))
         };
         match std::fs::symlink_metadata(link) {
@@ -361,7 +361,7 @@ impl SimCell {
                 return Err(fail(format!(
                     "{} exists and is not a symbolic link; vss replaces only a link \
                      (remove it or choose another name)",
-                    link.display()
+                    crate::text::path(link)
                 )));
             }
             _ => {}
@@ -371,7 +371,7 @@ impl SimCell {
                 "it points at {}, a terminal that was open before the link was made and \
                  still is (another `vss sim --link` serving it?); stop that one, or remove \
                  the link if nothing uses it, or choose another name",
-                target.display()
+                crate::text::path(&target)
             )));
         }
         let name = link.file_name().map(|n| n.to_string_lossy().into_owned());
@@ -391,7 +391,7 @@ impl SimCell {
             let _ = std::fs::remove_file(&tmp);
             return Err(fail(format!(
                 "{} appeared and is not a link",
-                link.display()
+                crate::text::path(link)
             )));
         }
         if let Err(e) = std::fs::rename(&tmp, link) {

@@ -97,13 +97,13 @@ pub fn check(s: &Session) -> CheckReport {
         r.warnings.push(format!(
             "{}: a file of this session that the manifest does not record (another \
              writer's, or a save that failed): outputs and reports ignore it",
-            s.path(&file).display()
+            crate::text::path(s.path(&file))
         ));
     }
     for p in s.leftovers() {
         r.warnings.push(format!(
             "{}: left over from an interrupted save; opening the session for writing removes it",
-            p.display()
+            crate::text::path(&p)
         ));
     }
     r
@@ -142,14 +142,16 @@ fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) -> Optio
         && let Err(e @ crate::llv::LlvError::TooLarge { .. }) =
             crate::llv::image::check_stage_size(h.width.into(), h.height.into())
     {
-        r.problems
-            .push(format!("{}: byte 4: {e}; not read", path.display()));
+        r.problems.push(format!(
+            "{}: byte 4: {e}; not read",
+            crate::text::path(path)
+        ));
         return None;
     }
     let bytes = match crate::fsutil::read_input(path, formats::max_len(path)) {
         Ok(b) => b,
         Err(e) => {
-            r.problems.push(format!("{}: {e}", path.display()));
+            r.problems.push(format!("{}: {e}", crate::text::path(path)));
             return None;
         }
     };
@@ -160,7 +162,7 @@ fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) -> Optio
             Ok(t) => formats::lines::parse_lines(t, path).map(|_| None),
             Err(e) => {
                 r.problems
-                    .push(format!("{}: not text: {e}", path.display()));
+                    .push(format!("{}: not text: {e}", crate::text::path(path)));
                 return None;
             }
         },
@@ -168,7 +170,7 @@ fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) -> Optio
             Ok(t) => formats::cdf::parse_cdf(t, path).map(|_| None),
             Err(e) => {
                 r.problems
-                    .push(format!("{}: not text: {e}", path.display()));
+                    .push(format!("{}: not text: {e}", crate::text::path(path)));
                 return None;
             }
         },
@@ -185,7 +187,7 @@ fn check_file(path: &Path, file: &str, hash: &str, r: &mut CheckReport) -> Optio
                 r.changed.push(file.to_string());
                 r.warnings.push(format!(
                     "{}: changed since the manifest recorded it (outputs made from it may be stale)",
-                    path.display()
+                    crate::text::path(path)
                 ));
             }
             size
@@ -206,7 +208,7 @@ fn contradictions(
     r: &mut CheckReport,
 ) {
     let manifest = s.path(&format!("{}.toml", s.name()));
-    let m = manifest.display();
+    let m = crate::text::path(&manifest);
     let k = rec.number;
     for (i, g) in rec.grey.iter().enumerate() {
         if let Some(first) = rec.grey[..i].iter().find(|o| o.letter == g.letter) {

@@ -109,12 +109,12 @@ pub(super) fn not_a_session(dir: &Path, manifest: &str) -> String {
     if !super::present(dir) {
         format!(
             "{}: no such folder, so no session there (`vss session new NAME` makes one)",
-            dir.display()
+            crate::text::path(dir)
         )
     } else {
         format!(
             "{} is not a session folder: no manifest {manifest} in it (make one with `vss session new NAME`)",
-            dir.display()
+            crate::text::path(dir)
         )
     }
 }

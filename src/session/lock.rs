@@ -256,7 +256,7 @@ fn identity(dir: &Path) -> Option<(u64, u64)> {
 #[error(
     "the session folder {} {}: this change was NOT saved, and nothing was written anywhere \
      else; put the folder back where it was and try again, or open the session where it now is",
-    dir.display(),
+    crate::text::path(dir),
     if *replaced {
         "is not the one opened (it was moved or deleted and another folder made in its place)"
     } else {
@@ -282,6 +282,8 @@ impl Lock {
             source,
         };
         let dir = folder_of(path);
+        // The folder itself, never through a link to one.
+        let folder = super::folder::unlinked(dir)?;
         let name = path.file_name().unwrap_or_default();
         // Created exclusively under a random name: a link planted in the
         // folder is never written through. (No sweep of stale temporary
@@ -333,11 +335,17 @@ impl Lock {
         result?;
         // Two take-overs may race: the last rename wins, the loser learns it here.
         match read_holder(path) {
-            Some(h) if h == info => Ok(Lock {
-                path: path.to_path_buf(),
-                info,
-                folder: identity(dir),
-            }),
+            Some(h) if h == info => {
+                let lock = Lock {
+                    path: path.to_path_buf(),
+                    info,
+                    folder: Some(folder),
+                };
+                // Taken in the folder looked at, not in a link put in its
+                // place meanwhile (dropped, the lock is removed again).
+                lock.check_held()?;
+                Ok(lock)
+            }
             h => Err(SessionError::Locked {
                 path: path.to_path_buf(),
                 holder: h.map_or_else(|| "an unknown holder".to_string(), |h| h.to_string()),
@@ -369,10 +377,15 @@ impl Lock {
             return None;
         }
         let read = crate::fsutil::read_input_text(&path, MAX_LOCK_LEN)
-            .map_err(|e| format!("{}: {e}", path.display()))
+            .map_err(|e| format!("{}: {e}", crate::text::path(&path)))
             .and_then(|text| {
-                toml::from_str::<LeaveRequest>(&text)
-                    .map_err(|e| format!("{}: not a request: {}", path.display(), e.message()))
+                toml::from_str::<LeaveRequest>(&text).map_err(|e| {
+                    format!(
+                        "{}: not a request: {}",
+                        crate::text::path(&path),
+                        e.message()
+                    )
+                })
             });
         // Removed whatever it holds (a link is removed, not its target).
         let _ = fs::remove_file(&path);
@@ -383,7 +396,7 @@ impl Lock {
         if req.token != self.info.token {
             return Some(Err(format!(
                 "{}: the request is for another lock than this console's",
-                path.display()
+                crate::text::path(&path)
             )));
         }
         Some(provably_vss(&req.from, "the asker").map(|()| req.from))
@@ -395,15 +408,17 @@ impl Lock {
     /// A lock file that is gone because its folder is (moved, renamed or
     /// deleted) is said as that ([`FolderGone`]), not as a take-over.
     pub fn check_held(&self) -> Result<(), SessionError> {
+        // The folder first: one moved away, or replaced (by another
+        // folder, or by a link to one), is not written whatever it holds.
+        let dir = folder_of(&self.path);
+        if self.folder.is_some() && identity(dir) != self.folder {
+            return Err(SessionError::FolderGone(FolderGone {
+                dir: dir.to_path_buf(),
+                replaced: fs::symlink_metadata(dir).is_ok(),
+            }));
+        }
         match read_holder(&self.path) {
             Some(h) if h == self.info => Ok(()),
-            None if self.folder.is_some() && identity(folder_of(&self.path)) != self.folder => {
-                let dir = folder_of(&self.path);
-                Err(SessionError::FolderGone(FolderGone {
-                    dir: dir.to_path_buf(),
-                    replaced: identity(dir).is_some(),
-                }))
-            }
             h => Err(SessionError::LockLost {
                 path: self.path.clone(),
                 holder: h.map_or_else(

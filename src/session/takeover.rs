@@ -39,15 +39,18 @@ pub enum TakeOverError {
     Session(#[from] SessionError),
     #[error(
         "session {} is still held by {holder} after asking it to end; nothing changed",
-        dir.display()
+        crate::text::path(dir)
     )]
     NoAnswer { dir: PathBuf, holder: String },
     #[error(
         "the take-over of session {} was given up before {holder} was signalled; nothing changed",
-        dir.display()
+        crate::text::path(dir)
     )]
     GivenUp { dir: PathBuf, holder: String },
-    #[error("session {} is held by {holder}, which was not asked to end: {why}; nothing changed", dir.display())]
+    #[error(
+        "session {} is held by {holder}, which was not asked to end: {why}; nothing changed",
+        crate::text::path(dir)
+    )]
     Refused {
         dir: PathBuf,
         holder: String,
@@ -102,13 +105,13 @@ pub fn open_taking_over(dir: &Path, taker: &mut dyn Taker) -> Result<Session, Ta
         Err(e) => taker.say(format!(
             "cannot ask process {} through {} ({e}): signalling it instead",
             h.pid,
-            leave.display()
+            crate::text::path(&leave)
         )),
         Ok(()) => {
             taker.say(format!(
                 "asking process {} to release session {}…",
                 h.pid,
-                dir.display()
+                crate::text::path(dir)
             ));
             if let Some(s) = wait_for_lock(dir, LEAVE_WAIT, taker)? {
                 let _ = std::fs::remove_file(&leave);
@@ -128,7 +131,7 @@ pub fn open_taking_over(dir: &Path, taker: &mut dyn Taker) -> Result<Session, Ta
     taker.say(format!(
         "process {} did not release session {}: asking it to end…",
         h.pid,
-        dir.display()
+        crate::text::path(dir)
     ));
     if let Err(why) = lock::ask_holder_to_leave(h)
         && !h.is_stale()

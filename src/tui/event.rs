@@ -473,7 +473,10 @@ pub enum StoreError {
     },
     #[error("report NOT written: {why}{old}")]
     Report { why: String, old: String },
-    #[error("log file {}: {source} — messages are still in the log pane (m)", path.display())]
+    #[error(
+        "log file {}: {source} — messages are still in the log pane (m)",
+        crate::text::path(path)
+    )]
     Log {
         path: PathBuf,
         #[source]
@@ -486,7 +489,7 @@ pub enum StoreError {
     TakeOver(crate::session::takeover::TakeOverError),
     #[error("the profile names no .cdf for camera {camera}: add it to [survey] cdf")]
     NoCdf { camera: u32 },
-    #[error("{} NOT written: {source}", path.display())]
+    #[error("{} NOT written: {source}", crate::text::path(path))]
     Cdf {
         path: PathBuf,
         #[source]

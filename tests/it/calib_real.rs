@@ -209,6 +209,81 @@ fn a_blurred_board_is_called_blurred_not_missing() {
     detect(&blur(&imgs[0].1, 1), &board(9, 7)).unwrap();
 }
 
+/// A horizontal motion blur: each pixel the mean of `n` pixels of its row
+/// (the board moved `n` px while the shutter was open).
+fn motion_blur(img: &GreyImage, n: usize) -> GreyImage {
+    let (w, h) = img.size();
+    let d = img.data();
+    let out = (0..h)
+        .flat_map(|y| {
+            (0..w).map(move |x| {
+                let x0 = x as i64 - (n / 2) as i64;
+                let sum: u32 = (0..n as i64)
+                    .map(|k| u32::from(d[y * w + (x0 + k).clamp(0, w as i64 - 1) as usize]))
+                    .sum();
+                ((sum + n as u32 / 2) / n as u32) as u8
+            })
+        })
+        .collect();
+    GreyImage::new(w, h, out).unwrap()
+}
+
+#[test]
+fn a_motion_blurred_board_is_called_blurred_not_the_wrong_size() {
+    let imgs = photos();
+    // Photograph 13 smeared 20 px sideways: a part of the board is found
+    // (the lattice breaks across the motion); photograph 1 smeared 15 px:
+    // the whole board is found, its corners 3 px off. Both were taken for
+    // what they are not (a wrong plate file; a good view).
+    for (k, n) in [(12, 20), (0, 15), (0, 12)] {
+        let e = detect(&motion_blur(&imgs[k].1, n), &board(9, 7))
+            .expect_err(&format!("{} smeared {n} px was used", imgs[k].0));
+        let m = e.to_string();
+        assert!(matches!(e, DetectError::Blurred { .. }), "{m}");
+        let width: f64 = m
+            .split("its edges are ")
+            .nth(1)
+            .and_then(|t| t.split(" px wide (at most 6 px").next())
+            .and_then(|t| t.parse().ok())
+            .unwrap_or_else(|| panic!("{m}"));
+        assert!(width > 6.0, "{m}");
+        assert!(!m.contains("the plate file says"), "{m}");
+    }
+    // Through the command line: the smeared view is left out saying so,
+    // the others calibrate.
+    let tmp = tempfile::tempdir().unwrap();
+    let plate = write_board(tmp.path());
+    let smeared = tmp.path().join("smeared.png");
+    let img = imageio::read_any(&photo_paths()[12]).unwrap();
+    let image = motion_blur(&img.image, 20);
+    imageio::write_any(&smeared, &vss::formats::img::ImgFile { image, ..img }).unwrap();
+    let mut paths = photo_paths()[..6].to_vec();
+    paths.push(smeared);
+    let r = vss()
+        .args(["calibrate", "--plate"])
+        .arg(&plate)
+        .args(["--scale", "0.001,0.001", "--out"])
+        .arg(tmp.path().join("cam1.cdf"))
+        .args(&paths)
+        .output()
+        .unwrap();
+    let (so, se) = (
+        String::from_utf8_lossy(&r.stdout),
+        String::from_utf8_lossy(&r.stderr),
+    );
+    assert!(r.status.success(), "{so}\n{se}");
+    let line = se
+        .lines()
+        .find(|l| l.contains("smeared.png"))
+        .unwrap_or_else(|| panic!("{se}"));
+    assert!(
+        line.contains("left out") && line.contains("but blurred: its edges are"),
+        "{line}"
+    );
+    assert!(!line.contains("plate file"), "{line}");
+    assert!(so.contains("in 6 views"), "{so}");
+}
+
 #[test]
 fn a_board_half_out_of_frame_is_called_so() {
     let imgs = photos();

@@ -240,3 +240,30 @@ pub(super) fn edge_width(img: &GreyImage, pts: &[([f64; 2], [f64; 2], f64)]) -> 
     widths.sort_by(f64::total_cmp);
     widths[widths.len() / 2]
 }
+
+/// How wide the edges of grid `g` are (px, as [`edge_width`] measures
+/// them): the wider of the medians along the grid's two directions. A
+/// motion blur widens only the edges that cross the motion, so the sides
+/// of one direction alone can read sharp on a smeared board. `up` maps the
+/// grid's points into `img` (a grid found at half size is doubled).
+pub(super) fn grid_edge_width(img: &GreyImage, g: &Grid, up: impl Fn([f64; 2]) -> [f64; 2]) -> f64 {
+    let contrast = {
+        let mut v = g.contrast.clone();
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(0.0)
+    };
+    let at = |i: usize, j: usize| g.pts.get(j * g.ni + i).copied().flatten().map(&up);
+    let (mut along_i, mut along_j) = (Vec::new(), Vec::new());
+    for j in 0..g.nj {
+        for i in 0..g.ni {
+            let Some(p) = at(i, j) else { continue };
+            if let Some(q) = at(i + 1, j).filter(|_| i + 1 < g.ni) {
+                along_i.push((p, sub(q, p), contrast));
+            }
+            if let Some(q) = at(i, j + 1) {
+                along_j.push((p, sub(q, p), contrast));
+            }
+        }
+    }
+    edge_width(img, &along_i).max(edge_width(img, &along_j))
+}

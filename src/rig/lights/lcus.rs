@@ -120,7 +120,7 @@ impl<P: Link> LcusBoard<P> {
             Err(why) => {
                 self.note = Some(format!(
                     "{}: ignored the LCUS state file: {why}",
-                    file.display()
+                    crate::text::path(&file)
                 ));
             }
         }
@@ -180,7 +180,7 @@ impl<P: Link> LcusBoard<P> {
         let io = |e: std::io::Error| {
             RigError::Config(format!(
                 "{}: cannot keep the LCUS board's state: {e}",
-                file.display()
+                crate::text::path(file)
             ))
         };
         if let Some(dir) = file.parent() {

@@ -223,7 +223,7 @@ impl CalibrateScreen {
         let mut unread = Vec::new();
         let mut size = None;
         for p in &paths {
-            let name = p.display().to_string();
+            let name = crate::text::path(p);
             match crate::formats::imageio::read_any(p) {
                 Ok(f) => {
                     let s = f.image.size();
@@ -525,7 +525,7 @@ impl CalibrateScreen {
         ctx.ask(
             format!(
                 "write S, C, f, D of camera {cam} into {}? (its other entries are kept, an old file as .bak)",
-                path.display()
+                crate::text::path(&path)
             ),
             Pending::CalibWrite,
         );
@@ -583,7 +583,7 @@ fn photo_paths(text: &str) -> Result<Vec<PathBuf>, String> {
         if let Some(missing) = v.iter().find(|p| !p.is_file()) {
             return Err(format!(
                 "{}: no such file (a folder, or files separated by spaces)",
-                missing.display()
+                crate::text::path(missing)
             ));
         }
         v

@@ -319,7 +319,7 @@ impl App {
                     .iter()
                     .find(|p| p.extension().is_some_and(|e| e == "ps"))
                     .or(paths.first())
-                    .map(|p| clean(&p.display().to_string()))
+                    .map(crate::text::path)
                     .unwrap_or_default();
                 let svg = paths
                     .iter()
@@ -347,11 +347,10 @@ impl App {
                 Vec::new()
             }
             StoreEvent::Unwritable { dir, why } => {
-                let (shown, why) = (clean(&dir.display().to_string()), clean(&why));
+                let (shown, why) = (crate::text::path(&dir), clean(&why));
                 let mut ctx = self.ctx();
                 ctx.error(format!(
-                    "session {shown} cannot be opened to work on: its lock cannot be written \
-                     ({why})"
+                    "session {shown} cannot be opened to work on: {why}"
                 ));
                 ctx.ask(
                     "The session's folder cannot be written. Open it read-only, only to look at \
@@ -368,7 +367,7 @@ impl App {
                      that is your own console in a detached tmux or screen (an SSH drop), go \
                      back to it: `tmux attach`. Taking it over makes that console's saves fail; \
                      looking at it read-only leaves that console alone.",
-                    dir.display()
+                    crate::text::path(&dir)
                 ));
                 // Looking is the read-only open of an unwritable folder:
                 // no lock written, no request made, nothing saved.
@@ -390,13 +389,13 @@ impl App {
                 self.ctx().error(format!(
                     "session {} was taken over by {} at its request: this console no longer \
                      writes it (what it had saved is on disk); choose or create a session",
-                    clean(&dir.display().to_string()),
+                    crate::text::path(&dir),
                     clean(&by)
                 ));
                 Vec::new()
             }
             StoreEvent::LogFile(path) => {
-                let p = clean(&path.display().to_string());
+                let p = crate::text::path(&path);
                 self.chrome.log.set_file(path);
                 self.ctx().info(format!("log file: {p}"));
                 Vec::new()

@@ -213,7 +213,7 @@ impl SurveyScreen {
                 "session {} cannot be opened: {why} — `vss session check {}` lists every \
                  problem; mend or move the folder, then open it again",
                 e.name,
-                e.dir.display()
+                crate::text::path(&e.dir)
             ));
             ctx.chrome.overlay = Some(super::Overlay::Message { scroll: 0 });
             return Vec::new();
@@ -445,7 +445,11 @@ impl Ctx<'_> {
     pub fn session_opened(&mut self, v: SessionView) -> Vec<Cmd> {
         self.session.saving.clear();
         self.session.refused.clear();
-        self.info(format!("session {} open in {}", v.name, v.dir.display()));
+        self.info(format!(
+            "session {} open in {}",
+            v.name,
+            crate::text::path(&v.dir)
+        ));
         let last = v
             .images
             .iter()

@@ -142,7 +142,7 @@ pub fn log_pane(app: &App, area: Rect, buf: &mut Buffer) {
         .chrome
         .log
         .file()
-        .map(|p| format!(" · {}", p.display()))
+        .map(|p| format!(" · {}", crate::text::path(p)))
         .unwrap_or_default();
     let b = block(app, &format!("log: {n} messages{file}"));
     let inner = b.inner(area);
@@ -610,7 +610,7 @@ pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
                 lines.push(Line::raw(""));
                 lines.extend(
                     wrap(
-                        &format!("Every message of this run is in {}", f.display()),
+                        &format!("Every message of this run is in {}", crate::text::path(f)),
                         inner_w,
                     )
                     .into_iter()

@@ -24,7 +24,7 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
     let done = s.images.iter().filter(|i| i.outputs && !i.stale).count();
     let mut info = vec![
         Line::styled(s.name.clone(), t.title()),
-        Line::raw(format!("{}", s.dir.display())),
+        Line::raw(crate::text::path(&s.dir).to_string()),
         Line::raw(format!("images {} (done {done})", s.images.len())),
         Line::raw(format!(
             "lightings {}",

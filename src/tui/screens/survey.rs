@@ -100,7 +100,7 @@ pub fn session_rows(app: &App, width: usize) -> Vec<(usize, Line<'static>)> {
         let text = match &e.damaged {
             Some(why) => {
                 // The row is narrow: the file's name, not its folder.
-                let folder = format!("{}/", e.dir.display());
+                let folder = format!("{}/", crate::text::path(&e.dir));
                 let why = why.strip_prefix(folder.as_str()).unwrap_or(why);
                 format!(" {}  DAMAGED: {why}", e.name)
             }

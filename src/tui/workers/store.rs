@@ -174,7 +174,7 @@ impl Store {
             }
             Some(Err(why)) => self.reply(StoreEvent::Note(format!(
                 "a request to leave session {} was ignored: {why}",
-                dir.display()
+                crate::text::path(&dir)
             ))),
         }
     }
@@ -450,7 +450,7 @@ impl Store {
                         s.record_calibration(camera, &path, &calibration)
                             .map_err(session_err(format!(
                                 "camera {camera}: {} written, but not recorded in the session",
-                                path.display()
+                                crate::text::path(&path)
                             )))?;
                         format!("; recorded in session {}", s.name())
                     }
@@ -458,7 +458,7 @@ impl Store {
                 };
                 self.reply(StoreEvent::Note(format!(
                     "camera {camera}: wrote {} (RMS {:.3} px over {} views){recorded}",
-                    path.display(),
+                    crate::text::path(&path),
                     calibration.rms,
                     calibration.views.len()
                 )));
@@ -528,7 +528,7 @@ impl Store {
         let dir = s.dir().to_path_buf();
         let s = Session::inspect(&dir).map_err(session_err(format!(
             "cannot read {} again (the view shows it as it was)",
-            dir.display()
+            crate::text::path(&dir)
         )))?;
         let v = self.adopt(s);
         self.reply(StoreEvent::Updated(v));

@@ -135,7 +135,14 @@ impl Lister {
                     } else {
                         holder.map_or(String::new(), |h| in_use(&h))
                     };
-                    let summary = format!("{done}/{all} done{busy}");
+                    // A link is opened only to look (no session is
+                    // written through one): marked before Enter.
+                    let link = if e.file_type().is_ok_and(|t| t.is_symlink()) {
+                        " (a link)"
+                    } else {
+                        ""
+                    };
+                    let summary = format!("{done}/{all} done{busy}{link}");
                     let entry = SessionEntry {
                         name,
                         dir,

@@ -42,7 +42,7 @@ impl Opening {
     fn shown(&self) -> String {
         match self {
             Opening::Create(name) => format!("new session {name}"),
-            Opening::Open(d) | Opening::TakeOver(d) | Opening::Look(d) => d.display().to_string(),
+            Opening::Open(d) | Opening::TakeOver(d) | Opening::Look(d) => crate::text::path(d),
         }
     }
 }
@@ -114,7 +114,7 @@ impl Store {
     /// Opens the session `how` asks for, leaving the open one alone;
     /// `None` when the operator is asked first (held, unwritable).
     fn open_new(&mut self, how: &Opening) -> Result<Option<Session>, StoreError> {
-        let cannot = |d: &Path| session_err(format!("cannot open {}", d.display()));
+        let cannot = |d: &Path| session_err(format!("cannot open {}", crate::text::path(d)));
         let dir = match how {
             Opening::Create(name) => {
                 return Session::create(&self.profile.survey.dir, name, &self.profile)
@@ -130,7 +130,7 @@ impl Store {
             Err(SessionError::Locked { stale: true, .. }) => {
                 self.reply(StoreEvent::Note(format!(
                     "took over the lock of {}: its holder is gone",
-                    dir.display()
+                    crate::text::path(&dir)
                 )));
                 Session::open_take_over(&dir)
                     .map(Some)
@@ -142,8 +142,16 @@ impl Store {
             }
             // The lock cannot be written: the folder is read-only (a
             // mount, permissions). Looking is offered, not done.
+            Err(SessionError::Linked(l)) => {
+                let why = l.to_string();
+                self.reply(StoreEvent::Unwritable { dir, why });
+                Ok(None)
+            }
             Err(SessionError::Unwritable { path, source }) => {
-                let why = format!("{}: {source}", path.display());
+                let why = format!(
+                    "its lock cannot be written ({}: {source})",
+                    crate::text::path(&path)
+                );
                 self.reply(StoreEvent::Unwritable { dir, why });
                 Ok(None)
             }
@@ -188,7 +196,7 @@ impl Store {
         use crate::session::takeover::{self, TakeOverError};
         takeover::open_taking_over(dir, &mut Taking(self)).map_err(|e| match e {
             TakeOverError::Session(e) => {
-                session_err(format!("cannot take over {}", dir.display()))(e)
+                session_err(format!("cannot take over {}", crate::text::path(dir)))(e)
             }
             e => StoreError::TakeOver(e),
         })
