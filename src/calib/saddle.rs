@@ -571,7 +571,7 @@ fn find(img: &GreyImage, want: (usize, usize)) -> Result<Grid, Missed> {
     }
     let whole = grids.iter().filter(|g| complete(g)).count();
     if whole >= 2 {
-        let mut it = grids.into_iter().filter(|g| complete(g));
+        let mut it = grids.into_iter().filter(&complete);
         if let (Some(first), Some(second)) = (it.next(), it.next()) {
             // A smeared board can also grow twice: its edges tell.
             return Err(Missed {
