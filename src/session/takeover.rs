@@ -91,14 +91,30 @@ impl<F: FnMut(String)> Taker for F {
 /// holds it by the rule above; `taker` hears each step and answers, while
 /// it waits, requests for what it holds ([`Taker::meanwhile`]).
 pub fn open_taking_over(dir: &Path, taker: &mut dyn Taker) -> Result<Session, TakeOverError> {
-    let inspected = Session::inspect(dir).ok();
-    let holder = inspected.as_ref().and_then(Session::lock_holder);
-    let local = holder
-        .as_ref()
-        .is_some_and(|h| h.host == LockInfo::current().host && !h.is_stale());
-    let (true, Some(h), Some(s)) = (local, holder.as_ref(), inspected.as_ref()) else {
-        return Ok(Session::open_take_over(dir)?);
+    let mut looks = 0;
+    let (s, h) = loop {
+        looks += 1;
+        let Ok(s) = Session::inspect(dir) else {
+            return Ok(Session::open_take_over(dir)?);
+        };
+        match s.lock_holder() {
+            Some(h) if h.host == LockInfo::current().host && !h.is_stale() => break (s, h),
+            Some(_) => return Ok(Session::open_take_over(dir)?),
+            None => {}
+        }
+        // No lock when looked at: opened as it is. A holder that let the
+        // lock go between two saves (a `vss grab` between frames) may have
+        // taken it again meanwhile: it is then asked like any other, not
+        // refused as "in use".
+        match Session::open(dir) {
+            Err(SessionError::Locked { stale: false, .. }) if looks < 3 => continue,
+            Err(SessionError::Locked { stale: true, .. }) => {
+                return Ok(Session::open_take_over(dir)?);
+            }
+            opened => return Ok(opened?),
+        }
     };
+    let h = &h;
     let lock_path = s.lock_path();
     let leave = lock::leave_path(&lock_path);
     match lock::request_leave(&lock_path, h) {
