@@ -5,11 +5,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 fn vss(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vss"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .unwrap()
+    crate::support::run::output_in(cwd, args)
 }
 
 fn text(o: &Output) -> String {

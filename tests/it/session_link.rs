@@ -5,7 +5,7 @@
 //! the session through it still works.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 use std::time::SystemTime;
 
 use vss::tui::keymap::{Action, ModalAction, Scope};
@@ -14,11 +14,7 @@ use super::tui_harness::{Console, flat};
 use super::tui_pty_readonly::files;
 
 fn vss(args: &[&str], cwd: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vss"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .unwrap()
+    crate::support::run::output_in(cwd, args)
 }
 
 /// The folder's entries (length, modification time) and its own

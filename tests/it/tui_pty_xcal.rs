@@ -140,6 +140,16 @@ fn wait_saved(c: &Console, n: usize) {
     });
 }
 
+/// Says yes to replacing image 1's saved outputs, waits until they are
+/// saved, and quits.
+fn replace_and_quit(c: &mut Console) {
+    c.wait_text("Replace its saved outputs", 10);
+    c.yes();
+    wait_saved(c, 2);
+    c.send("q");
+    c.wait_exit(15);
+}
+
 /// Image 1's `.lex` after `vss session redo --from lens`, with the
 /// console's profile.
 fn redone(c: &Console) -> Vec<u8> {
@@ -185,11 +195,7 @@ fn an_image_surveyed_before_a_recalibration_runs_with_its_recorded_camera() {
         });
     }
     c.press(PIPELINE, Action::Pipeline(PipelineAction::Save));
-    c.wait_text("Replace its saved outputs", 10);
-    c.yes();
-    wait_saved(&c, 2);
-    c.send("q");
-    c.wait_exit(15);
+    replace_and_quit(&mut c);
     let session = c.session();
     assert!(
         std::fs::read(session.join("cube1.cdf")).unwrap() == recorded,
@@ -219,11 +225,7 @@ fn an_image_captured_again_after_a_recalibration_is_recorded_with_the_new_camera
     c.yes();
     c.capture_current(1);
     c.press(SURVEY, Action::Survey(SurveyAction::Accept));
-    c.wait_text("Replace its saved outputs", 10);
-    c.yes();
-    wait_saved(&c, 2);
-    c.send("q");
-    c.wait_exit(15);
+    replace_and_quit(&mut c);
     let session = c.session();
     let now = vss::formats::cdf::format_cdf(&read_cdf(&c.dir.path().join("cam1.cdf")).unwrap());
     let on_record = std::fs::read(session.join("cube1.cdf")).unwrap();

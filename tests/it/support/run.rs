@@ -22,3 +22,12 @@ pub fn run_in(cwd: &Path, args: &[&str], timeout: Duration) -> (bool, String) {
     );
     (o.status.success(), text)
 }
+
+/// `vss ARGS` run in `cwd`, its whole output (status, stdout, stderr).
+pub fn output_in(cwd: &Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_vss"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("run vss")
+}
