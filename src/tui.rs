@@ -344,10 +344,6 @@ fn take_back(terminal: &mut Term, app: &mut App, stop: &AtomicBool) {
     }
 }
 
-/// Draws one frame as a synchronized update (DEC mode 2026): a terminal
-/// that knows the mode shows the frame whole, never half old and half new
-/// (over a slow SSH link, or while the machine is loaded); others ignore
-/// the two sequences.
 /// The terminal's size now, given to the App before a frame is drawn
 /// when its last resize event has not come yet: the frame (drawn at the
 /// terminal's size) and the keys that follow it (read against the App's)
@@ -362,6 +358,10 @@ fn sync_size(term: &Term, app: &mut App) -> Vec<Cmd> {
     }
 }
 
+/// Draws one frame as a synchronized update (DEC mode 2026): a terminal
+/// that knows the mode shows the frame whole, never half old and half new
+/// (over a slow SSH link, or while the machine is loaded); others ignore
+/// the two sequences.
 fn draw(term: &mut Term, app: &App) -> io::Result<()> {
     ratatui::crossterm::queue!(term.backend_mut(), terminal::BeginSynchronizedUpdate)?;
     term.draw(|f| f.render_widget(app, f.area()))?;

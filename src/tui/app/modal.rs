@@ -207,20 +207,15 @@ impl Prompt {
                 )
             })
         };
-        let mut typed = if self.selected {
-            String::new()
-        } else {
-            self.text.clone()
-        };
-        let at = if self.selected {
-            0
-        } else {
-            self.byte(self.cursor)
-        };
-        typed.insert(at, c);
-        if !self.selected && letters(&self.text).is_some() {
+        // Typing over a selection replaces it.
+        if self.selected {
+            return letters(&c.to_string());
+        }
+        if letters(&self.text).is_some() {
             return None;
         }
+        let mut typed = self.text.clone();
+        typed.insert(self.byte(self.cursor), c);
         letters(&typed)
     }
 

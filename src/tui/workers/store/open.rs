@@ -140,13 +140,15 @@ impl Store {
                 self.reply(StoreEvent::Locked { dir, holder });
                 Ok(None)
             }
-            // The lock cannot be written: the folder is read-only (a
-            // mount, permissions). Looking is offered, not done.
+            // A link to a folder is never written through: looking is
+            // offered, not done.
             Err(SessionError::Linked(l)) => {
                 let why = l.to_string();
                 self.reply(StoreEvent::Unwritable { dir, why });
                 Ok(None)
             }
+            // The lock cannot be written: the folder is read-only (a
+            // mount, permissions). Looking is offered, not done.
             Err(SessionError::Unwritable { path, source }) => {
                 let why = format!(
                     "its lock cannot be written ({}: {source})",
