@@ -8,11 +8,11 @@ use ratatui::crossterm::event::{
     KeyCode, KeyEvent, KeyEventKind, KeyEventState, KeyModifiers, ModifierKeyCode,
 };
 use vss::tui::app::{App, Modal, Overlay};
-use vss::tui::event::{DeviceEvent, Msg, StoreEvent};
+use vss::tui::event::{Msg, StoreEvent};
 use vss::tui::keymap::SurveyAction;
 
 use super::tui_harness::flat;
-use super::tui_screens::{code, colour, draw, key, profile, survey};
+use super::tui_screens::{code, colour, draw, grabber_connected, key, profile, survey};
 
 fn field_text(app: &App) -> (String, Option<String>) {
     match &app.chrome.modal {
@@ -148,10 +148,7 @@ fn a_start_up_warning_is_not_pushed_off_the_line_by_the_grabber_s_note() {
         "/srv/vss/cam1.cdf: line 3: k1 is not a number".into(),
     )])));
     app.update(Msg::Store(StoreEvent::Sessions(Vec::new())));
-    app.update(Msg::Device(DeviceEvent::Connected {
-        grabber: "VSS-SIM".into(),
-        relay: "sim relays".into(),
-    }));
+    grabber_connected(&mut app);
     let line = message_line(&app);
     assert!(
         line.contains("lens correction OFF for camera 1") && line.contains("k1 is not a number"),
@@ -171,10 +168,7 @@ fn a_quiet_start_up_lets_the_grabber_s_note_show() {
     app.start();
     app.update(Msg::Store(StoreEvent::Cameras(Vec::new())));
     app.update(Msg::Store(StoreEvent::Sessions(Vec::new())));
-    app.update(Msg::Device(DeviceEvent::Connected {
-        grabber: "VSS-SIM".into(),
-        relay: "sim relays".into(),
-    }));
+    grabber_connected(&mut app);
     let line = message_line(&app);
     assert!(line.contains("VSS-SIM"), "{line}");
     assert!(!line.contains("newer in the log"), "{line}");
@@ -196,15 +190,9 @@ fn the_same_answer_again_is_one_entry_with_its_count() {
     assert_eq!(app.chrome.log.len(), n + 1, "one entry");
     let line = message_line(&app);
     assert!(line.contains("? lists this screen's keys (×500)"), "{line}");
-    app.update(Msg::Device(DeviceEvent::Connected {
-        grabber: "VSS-SIM".into(),
-        relay: "sim relays".into(),
-    }));
+    grabber_connected(&mut app);
     code(&mut app, KeyCode::F(5));
-    app.update(Msg::Device(DeviceEvent::Connected {
-        grabber: "VSS-SIM".into(),
-        relay: "sim relays".into(),
-    }));
+    grabber_connected(&mut app);
     let line = message_line(&app);
     assert!(
         line.contains("F5 does nothing here") && line.contains("(+1 newer in the log)"),

@@ -11,8 +11,8 @@ use vss::llv::pipeline::StageOutputs;
 use vss::llv::{Point, Segment};
 use vss::tui::app::{App, Modal, Phase};
 use vss::tui::event::{
-    Cmd, DeviceCmd, DeviceEvent, FramePurpose, ImageState, LoadedImage, Msg, SavedOutputs,
-    SessionEntry, StoreCmd, StoreEvent,
+    Cmd, DeviceCmd, FramePurpose, ImageState, LoadedImage, Msg, SavedOutputs, SessionEntry,
+    StoreCmd, StoreEvent,
 };
 use vss::tui::keymap::{
     Action, EditAction, GlobalAction, ModalAction, Scope, ScreenId, SurveyAction,
@@ -20,8 +20,8 @@ use vss::tui::keymap::{
 
 use super::tui_harness::flat;
 use super::tui_screens::{
-    code, colour, draw, edit, go, key, lines_shown, press, profile, reviewed, reviewed_in, run,
-    square, survey, view,
+    code, colour, draw, edit, go, grabber_connected, key, lines_shown, press, profile, reviewed,
+    reviewed_in, run, square, survey, view,
 };
 
 fn yes(app: &mut App) -> Vec<Cmd> {
@@ -653,10 +653,7 @@ fn a_session_s_warning_is_not_pushed_off_the_line_by_a_device_note() {
         "cube1a.img: too large for this session".into(),
     )));
     app.update(Msg::Store(StoreEvent::OpeningDone));
-    app.update(Msg::Device(DeviceEvent::Connected {
-        grabber: "VSS-SIM".into(),
-        relay: "sim relays".into(),
-    }));
+    grabber_connected(&mut app);
     let (s, _) = draw(&app, 80, 24);
     let bottom = flat(&s.lines().rev().take(5).collect::<Vec<_>>().join(" "));
     assert!(bottom.contains("cube1a.img: too large"), "{s}");

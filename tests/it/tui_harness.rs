@@ -375,6 +375,15 @@ impl Console {
         self.wait_text(&format!("session {name}"), 10);
     }
 
+    /// On the session list at start: opens session `cube` once its row is
+    /// listed (an Enter before the list is read opens nothing).
+    pub fn open_cube(&mut self) {
+        self.wait_text("choose a session", 10);
+        self.wait_text(" cube ", 10);
+        self.press(SURVEY, Action::Survey(SurveyAction::Enter));
+        self.wait_text("session cube", 10);
+    }
+
     /// Captures and runs the survey's current image (Survey screen) and
     /// waits for its review.
     pub fn capture_current(&mut self, k: u32) {

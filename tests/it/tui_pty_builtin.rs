@@ -186,11 +186,7 @@ fn an_image_of_a_camera_past_the_profile_s_runs_with_its_recorded_description() 
         )
         .unwrap();
     });
-    c.wait_text("choose a session", 10);
-    // The list read (Enter on it before then opens nothing).
-    c.wait_text(" cube ", 10);
-    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
-    c.wait_text("session cube", 10);
+    c.open_cube();
     c.press(SURVEY, Action::Survey(SurveyAction::Up));
     c.press(SURVEY, Action::Survey(SurveyAction::Enter));
     c.wait_text("image 3a", 20);

@@ -45,9 +45,7 @@ fn any_image_can_be_gone_back_to_and_edited() {
     let mut c = Console::start(80, 24, &[]);
     c.survey(2);
     let mut c = c.restart_after(|_| {});
-    c.wait_text("cube", 10);
-    c.send("\r");
-    c.wait_text("session cube", 10);
+    c.open_cube();
     // The last worked image is on the Pipeline screen at once.
     c.send("3");
     c.wait_text("image 2a · lines over grey", 10);

@@ -119,10 +119,7 @@ fn surveyed_then_recalibrated() -> (Console, Vec<u8>, Vec<u8>) {
         out.set(cdf.get("S").unwrap().clone());
         write_cdf(&path, &out).unwrap();
     });
-    c.wait_text("choose a session", 10);
-    c.wait_text(" cube ", 10);
-    c.press(SURVEY, Action::Survey(SurveyAction::Enter));
-    c.wait_text("session cube", 10);
+    c.open_cube();
     c.press(SURVEY, Action::Survey(SurveyAction::Up));
     c.press(SURVEY, Action::Survey(SurveyAction::Enter));
     c.wait("image 1 shown with its saved outputs", 20, |s| {

@@ -154,6 +154,15 @@ pub fn run(app: &mut App, cmds: Vec<Cmd>) {
     }
 }
 
+/// The simulated cell's grabber and relay board answering: the device
+/// worker's note, as it comes after start-up.
+pub fn grabber_connected(app: &mut App) {
+    app.update(Msg::Device(DeviceEvent::Connected {
+        grabber: "VSS-SIM".into(),
+        relay: "sim relays".into(),
+    }));
+}
+
 /// Runs the survey for image 1 through messages; returns the app in Review.
 pub fn reviewed() -> App {
     reviewed_in(view())
