@@ -392,6 +392,19 @@ impl Console {
         self.wait(&format!("image {k} reviewed"), 60, |s| {
             s.contains(&format!("Image {k}: ")) && s.contains("before CONNECT")
         });
+        // Its lines can come before the store has written every frame
+        // (under load): wait until no lighting of its row is still pending
+        // ('.'), so that what a test does to the folder next meets the
+        // frames on disk.
+        self.wait(&format!("image {k}'s frames saved"), 30, |s| {
+            s.lines().any(|l| {
+                let f: Vec<&str> = l
+                    .trim_start_matches(['│', '|', '>', ' '])
+                    .split_whitespace()
+                    .collect();
+                l.contains('>') && f.len() >= 4 && f[0] == k.to_string() && !f[3].contains('.')
+            })
+        });
     }
 
     /// Creates session `cube` and surveys `n` images by keys alone.
