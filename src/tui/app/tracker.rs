@@ -343,14 +343,14 @@ impl Ctx<'_> {
             self.warn("nothing to save: no image processed yet");
             return None;
         };
-        let (Some(out), Some(params)) = (cur.outputs.clone(), cur.outputs_params.clone()) else {
-            self.warn("nothing to save: the pipeline has not finished");
-            return None;
-        };
         if let Some(why) = cur.camera_refused() {
             self.error(format!("not saved: {why}"));
             return None;
         }
+        let (Some(out), Some(params)) = (cur.outputs.clone(), cur.outputs_params.clone()) else {
+            self.warn("nothing to save: the pipeline has not finished");
+            return None;
+        };
         if let Some(e) = cur.failed.clone() {
             self.error(format!(
                 "not saved: the last run failed ({e}); the outputs on screen were made with \
