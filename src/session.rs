@@ -11,6 +11,7 @@
 //! [`Progress::next_step`]; nothing saved is redone unless asked
 //! ([`Session::redo`]).
 
+pub mod camera;
 pub mod check;
 pub mod folder;
 mod fresh;
@@ -43,7 +44,7 @@ pub use progress::{ImageProgress, OutputState, Progress, Step};
 pub use redo::RedoSummary;
 
 pub use manifest::FrameSettings;
-use manifest::{EditRecord, FileRecord, GreyRecord, ImageRecord, LightingInfo, SessionInfo};
+use manifest::{EditRecord, GreyRecord, ImageRecord, LightingInfo, SessionInfo};
 
 /// The largest image number a session accepts, and the most images it may
 /// plan. The number goes into every file name of the image (`cube9999b.img`,
@@ -164,6 +165,19 @@ pub enum SessionError {
     /// A camera the session does not have ([`Manifest::check_camera`]).
     #[error("session {session}: {what}; nothing was recorded")]
     NoCamera { session: String, what: String },
+    /// Image `image`'s recorded camera description does not read, or is
+    /// cut short ([`Session::image_camera`]): it is not run at all.
+    #[error(
+        "image {image}: its recorded camera description {} is damaged ({why}); the image \
+         is not run without the lens correction it was surveyed with: put the file back, or \
+         capture the image again to record the camera's description now",
+        crate::text::path(path)
+    )]
+    CameraDamaged {
+        image: u32,
+        path: PathBuf,
+        why: String,
+    },
     #[error("image {image} of session {session}: {what}")]
     Missing {
         session: String,
@@ -466,54 +480,6 @@ impl Session {
             ext: ext.to_string(),
         }
         .file_name()
-    }
-
-    /// Records which camera at which location took image `k`, and copies
-    /// its camera description into the session as `NAMEk.cdf` (checked by
-    /// parsing it first).
-    pub fn set_image_info(
-        &mut self,
-        k: u32,
-        camera: u32,
-        location: u32,
-        cdf: Option<&Path>,
-    ) -> Result<(), SessionError> {
-        let parsed = cdf.map(formats::cdf::read_cdf).transpose()?;
-        self.set_image_camera(k, camera, location, parsed.as_ref())
-    }
-
-    /// Records which camera at which location took image `k`, and writes
-    /// its camera description (as [`crate::profile::Profile::camera_cdf`]
-    /// gives it, from a file or built in) into the session as `NAMEk.cdf`.
-    pub fn set_image_camera(
-        &mut self,
-        k: u32,
-        camera: u32,
-        location: u32,
-        cdf: Option<&formats::cdf::Cdf>,
-    ) -> Result<(), SessionError> {
-        self.writable()?;
-        check_image_number(k)?;
-        self.known_camera(camera)?;
-        let cdf_record = match cdf {
-            Some(parsed) => {
-                let file = self.file_name(k, None, "cdf");
-                let bytes = formats::cdf::format_cdf(parsed).into_bytes();
-                self.write_file(&file, &bytes)?;
-                Some(FileRecord {
-                    hash: stamp::hash(&bytes),
-                    file,
-                })
-            }
-            None => None,
-        };
-        let rec = self.record_mut(k)?;
-        rec.camera = camera;
-        rec.location = location.max(1);
-        if cdf_record.is_some() {
-            rec.cdf = cdf_record;
-        }
-        self.commit()
     }
 
     /// Saves grey image `k` under lighting `letter` as `NAMEkL.img`, then

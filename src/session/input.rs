@@ -308,29 +308,6 @@ impl Session {
         )
     }
 
-    /// The camera model of image `k` from its `.cdf` in the session (none
-    /// without one, or when it lacks the intrinsic parameters).
-    pub fn camera_model(&self, k: u32) -> Result<Option<CameraModel>, SessionError> {
-        let Some(cdf) = self.manifest.image(k).and_then(|r| r.cdf.as_ref()) else {
-            return Ok(None);
-        };
-        Ok(formats::cdf::read_cdf(&self.path(&cdf.file))?.camera_model())
-    }
-
-    /// Whether image `k` is recorded with the camera description `cdf`,
-    /// byte for byte as [`Session::set_image_camera`] writes it (`None`:
-    /// with none).
-    pub fn recorded_with(&self, k: u32, cdf: Option<&formats::cdf::Cdf>) -> bool {
-        let recorded = self.manifest.image(k).and_then(|r| r.cdf.as_ref());
-        match (recorded, cdf) {
-            (None, None) => true,
-            (Some(r), Some(c)) => {
-                r.hash == super::stamp::hash(formats::cdf::format_cdf(c).as_bytes())
-            }
-            _ => false,
-        }
-    }
-
     /// Image `k`'s captured frames, split by [`Session::frame_rule`], with
     /// its camera.
     pub fn pipeline_input(&self, k: u32) -> Result<PipelineInput, SessionError> {
@@ -340,7 +317,7 @@ impl Session {
         if input.images.is_empty() {
             return Err(self.missing(k, "no grey image captured yet: capture it first".into()));
         }
-        let camera = self.camera_model(k)?;
+        let camera = self.image_camera(k)?.model();
         if let (Some(m), Some(cdf)) = (&camera, self.manifest.image(k).and_then(|r| r.cdf.as_ref()))
         {
             // A camera that leaves (almost) nothing of the image is the

@@ -202,11 +202,11 @@ pub struct LoadedImage {
     pub accepted: bool,
     /// Why its recorded outputs did not load (a file damaged or missing).
     pub outputs_damaged: Option<String>,
-    /// The camera model of the description recorded with it (`None`: none
-    /// recorded; inside, `None`: the description gives no model), or why
-    /// that file does not read: what it is run with, as `vss session redo`
-    /// runs it ([`crate::session::Session::camera_model`]).
-    pub camera: Option<Result<Option<CameraModel>, String>>,
+    /// What it runs with, or why it cannot run (its recorded description
+    /// is damaged), as `vss session redo` runs it
+    /// ([`crate::session::Session::image_camera`]); `None` for an image
+    /// the session has no record of.
+    pub camera: Option<Result<crate::session::camera::ImageCamera, String>>,
 }
 
 /// Outputs read from a session's files, with the values they were made with.

@@ -82,6 +82,7 @@ mod tui_pty_takeover;
 mod tui_pty_trouble;
 mod tui_pty_tuning;
 mod tui_pty_xcal;
+mod tui_pty_xcdf;
 mod tui_pty_xfile;
 mod tui_pty_xterm;
 mod tui_screens;

@@ -313,7 +313,7 @@ impl Ctx<'_> {
             }
             None => {
                 self.session.work.phase = Phase::Processing;
-                self.tracker.request(self.cell).into_iter().collect()
+                self.run_current().into_iter().collect()
             }
         }
     }
@@ -547,12 +547,14 @@ impl Ctx<'_> {
         l.version = version;
         l.accepted = img.accepted;
         l.recorded_camera = img.camera;
-        if let Some(Err(_)) = &l.recorded_camera
-            && let Some(why) = l.lens_problem(self.cell)
-        {
-            self.warn(format!("{why} — lens correction is off for it"));
-        }
         let complete = self.cell.letters.iter().all(|c| l.frame(*c).is_some());
+        // Not run (`run_current` says why when it would be): its frames,
+        // and its saved outputs, are shown.
+        if !(complete && img.saved.is_none())
+            && let Some(why) = l.camera_refused()
+        {
+            self.error(why.to_string());
+        }
         let mut cmds = Vec::new();
         match img.saved {
             Some(saved) if complete => {
@@ -583,7 +585,7 @@ impl Ctx<'_> {
                     if k == work_k && self.session.work.phase == Phase::Setup {
                         self.session.work.phase = Phase::Processing;
                     }
-                    cmds.extend(self.tracker.request(self.cell));
+                    cmds.extend(self.run_current());
                 }
             }
         }

@@ -11,6 +11,7 @@ use crate::llv::edit::LineEditor;
 use crate::llv::lens::CameraModel;
 use crate::llv::pipeline::StageOutputs;
 use crate::llv::{GreyImage, Params, Segment};
+use crate::session::camera::ImageCamera;
 use crate::tui::event::{Cmd, ImageKey, PipelineRequest, StoreCmd};
 
 /// The grey images of one image number and what the pipeline made of them.
@@ -47,11 +48,11 @@ pub struct Loaded {
     /// Lightings captured in this run that the session could not save,
     /// with why: the image is not accepted until they are captured again.
     pub unsaved: Vec<(char, String)>,
-    /// The camera description recorded with the image in the session, as
-    /// read back ([`crate::tui::event::LoadedImage::camera`]); `None` for
+    /// What the image runs with as the session records it, or why it
+    /// cannot run ([`crate::tui::event::LoadedImage::camera`]); `None` for
     /// an image with a frame captured in this run, which runs with the
     /// profile's camera as the console read it (and is recorded so).
-    pub recorded_camera: Option<Result<Option<CameraModel>, String>>,
+    pub recorded_camera: Option<Result<ImageCamera, String>>,
 }
 
 impl Loaded {
@@ -77,16 +78,26 @@ impl Loaded {
         }
     }
 
-    /// The camera model lens correction uses on this image: the one
-    /// recorded with it, so that a re-run here makes what `vss session
-    /// redo` makes (after a recalibration too), else the profile's camera
-    /// as the console read it. None where either gives none
+    /// The camera model lens correction uses on this image: the one the
+    /// session says it runs with, so that a re-run here makes what `vss
+    /// session redo` makes (after a recalibration too), else the profile's
+    /// camera as the console read it. None where either gives none
     /// ([`Loaded::lens_problem`] says why).
     pub fn camera_model(&self, cell: &CellState) -> Option<CameraModel> {
         match &self.recorded_camera {
-            Some(recorded) => recorded.clone().ok().flatten(),
+            Some(recorded) => recorded.as_ref().ok().and_then(ImageCamera::model),
             None => cell.camera_model(self.camera),
         }
+    }
+
+    /// Why this image is not run at all: its recorded camera description
+    /// is damaged, in the words `vss session redo` refuses it with.
+    pub fn camera_refused(&self) -> Option<&str> {
+        self.recorded_camera
+            .as_ref()?
+            .as_ref()
+            .err()
+            .map(String::as_str)
     }
 
     /// Why lens correction has no camera model for this image, in words
@@ -95,13 +106,8 @@ impl Loaded {
     pub fn lens_problem(&self, cell: &CellState) -> Option<String> {
         let k = self.k;
         match &self.recorded_camera {
-            Some(Ok(Some(_))) => None,
-            Some(Ok(None)) => Some(format!(
-                "image {k}: the camera description recorded with it gives no camera model"
-            )),
-            Some(Err(why)) => Some(format!(
-                "image {k}: its recorded camera description does not read: {why}"
-            )),
+            Some(Ok(c)) => c.problem(k),
+            Some(Err(why)) => Some(why.clone()),
             None => cell
                 .camera_problem(self.camera)
                 .map(|why| format!("camera {}: {why}", self.camera)),
@@ -212,8 +218,12 @@ impl Tracker {
     /// its frames split by the profile's rule, as the session code splits
     /// them.
     pub fn request(&mut self, cell: &super::CellState) -> Option<Cmd> {
-        let cur = self.current.as_ref()?;
+        let cur = self.current.as_mut()?;
         if cur.frames.is_empty() {
+            return None;
+        }
+        if let Some(why) = cur.camera_refused() {
+            cur.failed = Some(why.to_string());
             return None;
         }
         let camera = cur.camera_model(cell);
@@ -239,7 +249,27 @@ impl Ctx<'_> {
     /// Takes new parameter values and re-runs the pipeline on the current image.
     pub fn set_params(&mut self, p: Params) -> Vec<Cmd> {
         self.tracker.params = p;
-        self.tracker.request(self.cell).into_iter().collect()
+        self.run_current().into_iter().collect()
+    }
+
+    /// A run of the current image ([`Tracker::request`]), or none. An image
+    /// whose recorded camera description is damaged is not run: said, in
+    /// the words `vss session redo` refuses it with, and nothing is made
+    /// that the console could save.
+    pub fn run_current(&mut self) -> Option<Cmd> {
+        let cmd = self.tracker.request(self.cell);
+        if cmd.is_none()
+            && let Some(why) = self
+                .tracker
+                .current
+                .as_ref()
+                .and_then(Loaded::camera_refused)
+        {
+            let why = why.to_string();
+            self.error(format!("not run: {why}"));
+            self.pipeline_failed();
+        }
+        cmd
     }
 
     /// Puts parameter `key` (every one with `None`) back to the profile's
@@ -313,6 +343,10 @@ impl Ctx<'_> {
             self.warn("nothing to save: no image processed yet");
             return None;
         };
+        if let Some(why) = cur.camera_refused() {
+            self.error(format!("not saved: {why}"));
+            return None;
+        }
         let (Some(out), Some(params)) = (cur.outputs.clone(), cur.outputs_params.clone()) else {
             self.warn("nothing to save: the pipeline has not finished");
             return None;

@@ -251,11 +251,13 @@ impl Store {
         // and its record agree (`vss session redo` makes the same); a
         // problem with it is said on the Pipeline screen (`cameras`).
         // A frame captured into an image recorded with another description
-        // (one read before a recalibration) records this one: the console
-        // runs a newly captured frame with the camera as read now.
+        // (one read before a recalibration, or a damaged file), or with
+        // one when the profile names none now, records this one (or none):
+        // the console runs a newly captured frame with the camera as read
+        // now.
         let known = self.session.as_ref().and_then(|s| {
             s.manifest().image(k).map(|r| {
-                let same = r.cdf.is_some() && s.recorded_with(k, self.read_copy(camera).as_ref());
+                let same = s.recorded_with(k, self.read_copy(camera).as_ref());
                 (r.camera, r.location, same)
             })
         });
@@ -267,7 +269,7 @@ impl Store {
         };
         let s = self.session_mut()?;
         let what = format!("image {k} lighting {letter} NOT saved");
-        if known.is_none_or(|(c, l, same)| c != camera || l != location || !same && cdf.is_some()) {
+        if record {
             s.set_image_camera(k, camera, location, cdf.as_ref())
                 .map_err(session_err(what.clone()))?;
         }

@@ -24,9 +24,7 @@ pub fn image(s: &Session, k: u32) -> LoadedImage {
     let state = crate::session::progress::output_state(rec);
     out.accepted = state == OutputState::Done && out.damaged.is_empty();
     out.lines = s.load_lines(k).ok();
-    if rec.cdf.is_some() {
-        out.camera = Some(s.camera_model(k).map_err(|e| e.to_string()));
-    }
+    out.camera = Some(s.image_camera(k).map_err(|e| e.to_string()));
     let read = rec.outputs.as_ref().map(|o| (o, saved(s, k, o)));
     if let Some((_, Err(why))) = &read {
         out.outputs_damaged = Some(why.clone());
