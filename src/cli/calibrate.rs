@@ -183,7 +183,7 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     let found = calib::detect_all(&images, &plate);
     let detect_ms = t0.elapsed().as_secs_f64() * 1e3;
     for (name, e) in &found.refused {
-        eprintln!("vss: {name}: left out: {e}");
+        errln!("vss: {name}: left out: {e}");
     }
     let views: Vec<View> = found.views.iter().map(|(v, _)| v.clone()).collect();
     let options = calib::Options {

@@ -1,11 +1,18 @@
 //! Commands whose reader goes away (`vss info FILE | head -2`) stop quietly:
-//! no panic, no error message, success.
+//! no panic, no error message, success. A standard error whose reader has
+//! gone loses the notes, not the exit status.
 
 use std::process::{Command, Stdio};
 
 /// Runs `vss ARGS` with its output going to a pipe that is already closed,
 /// so that its first write fails as it does after `head` has quit.
 fn run_into_a_closed_pipe(args: &[&str]) -> std::process::Output {
+    run_with_a_closed_pipe(args, false)
+}
+
+/// Runs `vss ARGS` with its standard error (`stderr`) or its output going
+/// to a pipe that is already closed.
+fn run_with_a_closed_pipe(args: &[&str], stderr: bool) -> std::process::Output {
     let mut child = Command::new(assert_cmd::cargo::cargo_bin("vss"))
         .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -13,7 +20,11 @@ fn run_into_a_closed_pipe(args: &[&str]) -> std::process::Output {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    drop(child.stdout.take());
+    if stderr {
+        drop(child.stderr.take());
+    } else {
+        drop(child.stdout.take());
+    }
     child.wait_with_output().unwrap()
 }
 
@@ -45,4 +56,30 @@ fn a_closed_pipe_ends_a_command_quietly() {
     }
     // What `vss llv` saves is saved before it reports.
     assert!(dir.path().join("square1.ldr").is_file());
+}
+
+/// `vss calibrate IMAGES 2>&1 | head -1`: its notes on the images it leaves
+/// out go to a standard error whose reader has gone. It ends with its own
+/// status (1 here: no image shows the plate), not a panic (101, "failed
+/// printing to stderr").
+#[test]
+fn a_closed_standard_error_does_not_panic_calibrate() {
+    let dir = tempfile::tempdir().unwrap();
+    let cdf = dir.path().join("cam1.cdf");
+    let mut args = vec!["calibrate", "--camera", "1", "--plate", "squares", "--out"];
+    let mut paths = vec![cdf.to_str().unwrap().to_string()];
+    for k in 1..=2 {
+        // A flat grey image of the camera's size: no plate in view.
+        let image = dir.path().join(format!("flat{k}.pgm"));
+        let mut pgm = b"P5\n512 512\n255\n".to_vec();
+        pgm.resize(pgm.len() + 512 * 512, 90);
+        std::fs::write(&image, pgm).unwrap();
+        paths.push(image.to_str().unwrap().to_string());
+    }
+    args.extend(paths.iter().map(String::as_str));
+    let out = run_with_a_closed_pipe(&args, true);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{:?}\n{text}", out.status);
+    assert!(text.starts_with("plate squares:"), "{text}");
+    assert!(!cdf.exists(), "nothing written");
 }

@@ -32,6 +32,13 @@ type Before = (Vec<u8>, Vec<(PathBuf, u64, SystemTime)>);
 fn looking(n: u32) -> (Console, Console, Before) {
     let mut a = Console::start(80, 24, &[]);
     a.survey(n);
+    let (b, before) = look_at(&a);
+    (a, b, before)
+}
+
+/// A second console in `a`'s folder that chose to look at the session `a`
+/// holds read-only; the folder as it was before it started.
+fn look_at(a: &Console) -> (Console, Before) {
     let dir = a.session();
     let held = std::fs::read(dir.join("cube.lock")).expect("the first console holds the lock");
     let before = files(&dir);
@@ -55,7 +62,7 @@ fn looking(n: u32) -> (Console, Console, Before) {
     b.press(Scope::Confirm, Action::Modal(ModalAction::Look));
     let s = b.wait_text("read-only: nothing will be saved", 10);
     assert!(s.lines().next().unwrap().contains("read-only"), "{s}");
-    (a, b, (held, before))
+    (b, (held, before))
 }
 
 #[test]
@@ -191,6 +198,29 @@ fn opens_on_the_newest_done_image() {
     b.wait(&format!("image 2's {recorded} lines"), 10, |s| {
         s.contains("image 2") && line_count(s) == Some(recorded)
     });
+    b.send("q");
+    assert_eq!(b.wait_exit(10), 0);
+    a.send("q");
+    assert_eq!(a.wait_exit(10), 0);
+}
+
+/// With no image done, the read-only view opens on the newest image with
+/// frames, its row chosen and its frame shown. It opened on the survey's
+/// next image (1, whose outputs are missing) instead of on image 2, the one
+/// captured last.
+#[test]
+fn with_no_image_done_opens_on_the_newest_captured_image() {
+    let mut a = Console::start(80, 24, &[]);
+    a.create_session("cube");
+    a.capture_current(1);
+    // On to image 2 without accepting image 1, and image 2 captured.
+    a.press(SURVEY, Action::Survey(SurveyAction::Down));
+    a.press(SURVEY, Action::Survey(SurveyAction::Enter));
+    a.capture_current(2);
+    let (mut b, _) = look_at(&a);
+    let s = b.wait_text("image 2a", 20);
+    assert!(s.contains("0 of 4 done"), "{s}");
+    assert!(s.contains(">  2 ") && !s.contains(">  1 "), "{s}");
     b.send("q");
     assert_eq!(b.wait_exit(10), 0);
     a.send("q");

@@ -8,7 +8,9 @@ use super::{CellState, Ctx, Loaded, Modal, Pending, PreviewNav, PromptPurpose, T
 use crate::formats::names::MAX_SESSION_LEN;
 use crate::llv::GreyImage;
 use crate::session::FrameSettings;
-use crate::tui::event::{Cmd, DeviceCmd, FramePurpose, LoadedImage, SessionView, StoreCmd};
+use crate::tui::event::{
+    Cmd, DeviceCmd, FramePurpose, ImageState, LoadedImage, SessionView, StoreCmd,
+};
 use crate::tui::keymap::SurveyAction;
 
 mod retake;
@@ -469,10 +471,13 @@ impl Ctx<'_> {
         };
         let resume = v.images.iter().any(|i| i.k == k && !i.captured.is_empty());
         // Open only to look, nothing can be captured: the view opens on the
-        // newest image with results instead, as choosing it shows it.
+        // newest image with results instead (none done: the newest with
+        // frames), as choosing it shows it.
+        let newest =
+            |f: fn(&ImageState) -> bool| v.images.iter().filter(|i| f(i)).map(|i| i.k).max();
         let look_at = v
             .read_only
-            .then(|| v.images.iter().filter(|i| i.done()).map(|i| i.k).max())
+            .then(|| newest(ImageState::done).or_else(|| newest(|i| !i.captured.is_empty())))
             .flatten();
         self.session.work = Work {
             k,
