@@ -39,12 +39,15 @@ const FRAME: Duration = Duration::from_millis(16);
 /// Opens the console on `profile`'s cell, drawn as `look` says.
 pub fn run(profile: crate::profile::Profile, look: mode::Look) -> anyhow::Result<ExitCode> {
     // A terminal without cursor addressing gets words, not escape sequences.
+    // Said on standard error; a reader of it that has gone loses the
+    // words, not the exit status (`eprintln!` would panic).
     if let Some(why) = mode::unusable(std::env::var("TERM").ok().as_deref()) {
-        eprintln!("{why}");
+        let _ = writeln!(io::stderr(), "{why}");
         return Ok(ExitCode::from(2));
     }
     if !io::IsTerminal::is_terminal(&io::stdout()) {
-        eprintln!(
+        let _ = writeln!(
+            io::stderr(),
             "vss: the console needs a terminal on its output; use the vss subcommands \
              (`vss --help`) in scripts and pipes"
         );

@@ -83,3 +83,23 @@ fn a_closed_standard_error_does_not_panic_calibrate() {
     assert!(text.starts_with("plate squares:"), "{text}");
     assert!(!cdf.exists(), "nothing written");
 }
+
+/// `vss` started where it cannot draw (its output not a terminal, or TERM
+/// dumb) says why on standard error and ends with 2, also when that error
+/// stream's reader has gone: not a panic (101).
+#[test]
+fn the_console_refusing_to_start_ends_with_2_when_its_error_stream_is_gone() {
+    for term in ["xterm-256color", "dumb"] {
+        let mut child = Command::new(assert_cmd::cargo::cargo_bin("vss"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .env("TERM", term)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stderr.take());
+        let out = child.wait_with_output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "TERM={term}: {:?}", out.status);
+    }
+}
