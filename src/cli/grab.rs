@@ -29,7 +29,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, bail};
 
-use super::Global;
+use super::{Global, StdoutError};
 use crate::formats::img::ImgFile;
 use crate::formats::names::{SessionName, VssFile};
 use crate::rig::Cell;
@@ -189,6 +189,11 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
     });
     sess.set_image_camera(a.image, a.camera, 1, cdf.as_ref())
         .context("cannot record the camera in the session")?;
+    // A report line that cannot be written (its reader gone: `| head -1`)
+    // does not stop the capture: the frames are the job, and a script
+    // that stopped reading still gets every lighting it asked for. The
+    // first such error ends the command once they are saved.
+    let mut unreported: Option<std::io::Error> = None;
     for (letter, path) in &files {
         let stem = path
             .file_stem()
@@ -200,13 +205,17 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
                 &mut cell, &mut sess, &a, *letter, &stem, &cancel, &mut asked,
             );
             if asked.is_none() {
-                captured.with_context(|| {
+                let line = captured.with_context(|| {
                     format!(
                         "capturing {stem} (camera {}, lighting {letter}) failed; nothing of it \
                          was saved",
                         a.camera
                     )
                 })?;
+                if unreported.is_none() {
+                    let text = crate::text::sanitize_lines(&line);
+                    unreported = writeln!(std::io::stdout(), "{text}").err();
+                }
             }
         }
         if let Some(by) = asked {
@@ -218,7 +227,11 @@ pub fn run(g: &Global, a: Args) -> anyhow::Result<ExitCode> {
             );
         }
     }
-    Ok(ExitCode::SUCCESS)
+    match unreported {
+        Some(e) => Err(StdoutError(e))
+            .context("every lighting was captured and saved; their report could not be written"),
+        None => Ok(ExitCode::SUCCESS),
+    }
 }
 
 /// Opens the session if it exists, taking over its lock with `--take-over`
@@ -279,6 +292,8 @@ fn left_for(sess: &Session) -> Option<String> {
     }
 }
 
+/// Captures lighting `letter` into the session and saves its frame;
+/// returns the line that reports it (printed by the caller).
 fn capture_one(
     cell: &mut Cell,
     sess: &mut Session,
@@ -287,7 +302,7 @@ fn capture_one(
     stem: &str,
     cancel: &AtomicBool,
     asked: &mut Option<String>,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<String> {
     let camera = a.camera;
     let mut err = std::io::stderr();
     let mut last_pct = u64::MAX;
@@ -317,11 +332,10 @@ fn capture_one(
     } else {
         cap.lights_on.join(", ")
     };
-    outln!(
+    Ok(format!(
         "{}: camera {camera}, lighting {letter} ({on}), crc {:08X}, {} ms",
         crate::text::path(&path),
         cap.frame.crc,
         cap.elapsed.as_millis()
-    );
-    Ok(())
+    ))
 }

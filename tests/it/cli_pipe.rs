@@ -103,3 +103,45 @@ fn the_console_refusing_to_start_ends_with_2_when_its_error_stream_is_gone() {
         assert_eq!(out.status.code(), Some(2), "TERM={term}: {:?}", out.status);
     }
 }
+
+/// `vss grab … | head -1`: the reader of its report goes after the first
+/// line. The capture goes on: every lighting asked for is saved and the
+/// command ends quietly, as a pipeline expects. Before, it stopped after
+/// the next lighting with success, one frame missing.
+#[test]
+fn a_grab_whose_report_reader_has_gone_still_captures_every_lighting() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut p = vss::rig::sim::cell_profile(64, 64);
+    p.sim.noise = 0.0;
+    p.relay.settle_ms = 5;
+    std::fs::write(dir.path().join("p.toml"), toml::to_string(&p).unwrap()).unwrap();
+    let args = [
+        "--profile",
+        "p.toml",
+        "grab",
+        "--session",
+        "s/g",
+        "--image",
+        "1",
+        "--camera",
+        "1",
+        "--lighting",
+        "a,b,c",
+    ];
+    let mut child = Command::new(assert_cmd::cargo::cargo_bin("vss"))
+        .args(args)
+        .current_dir(dir.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{:?} {err}", out.status);
+    assert!(!err.contains("vss: error"), "{err}");
+    for l in ['a', 'b', 'c'] {
+        let frame = dir.path().join(format!("s/g/g1{l}.img"));
+        assert!(frame.is_file(), "{} missing: {err}", frame.display());
+    }
+}
