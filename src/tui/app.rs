@@ -372,6 +372,11 @@ impl App {
         }
         let name = keymap::key_name(key);
         let where_ = match (scope, &self.chrome.modal) {
+            // No screen is drawn, so ? lists nothing: what helps is room.
+            (Scope::Screen(_), _) if self.chrome.too_small() => format!(
+                "the terminal is too small: enlarge it to at least {} × {}; q quits",
+                MIN_SIZE.0, MIN_SIZE.1
+            ),
             (Scope::Screen(_), _) => "? lists this screen's keys".to_string(),
             (Scope::Confirm, Some(m)) => m
                 .choices()

@@ -227,10 +227,11 @@ impl App {
     }
 }
 
-/// A terminal too small for the screens: what goes on and what is asked
-/// stay in sight, with their keys on the bottom rows as the hint row has
-/// them, so a window only a few rows high still says how to answer or
-/// quit; why nothing else is drawn comes after, in what room is left.
+/// A terminal too small for the screens: what goes on, what is asked and
+/// the answer to the last key stay in sight, with their keys on the
+/// bottom rows as the hint row has them, so a window only a few rows high
+/// still says how to answer or quit; why nothing else is drawn comes
+/// after, in what room is left.
 fn too_small(app: &App, area: Rect, buf: &mut Buffer) {
     let t = app.theme();
     let mut text = vec![Line::styled("terminal too small", t.error())];
@@ -270,6 +271,13 @@ fn too_small(app: &App, area: Rect, buf: &mut Buffer) {
         }
         None => ("q quits".to_string(), "other keys wait for a larger window"),
     };
+    // The answer to the last key while it is held (Esc where it does
+    // nothing says so here, not only once the window is larger again).
+    if app.chrome.held.is_some()
+        && let Some((e, _)) = app.chrome.shown_message()
+    {
+        text.push(Line::styled(e.shown(), t.level(e.level)));
+    }
     text.push(Line::raw(format!(
         "now {} × {}, vss needs {} × {}: enlarge the window",
         area.width, area.height, MIN_SIZE.0, MIN_SIZE.1

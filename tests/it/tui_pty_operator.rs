@@ -1,8 +1,10 @@
 //! Found by using the console as an operator does, through the real
 //! binary in a pty at 80 × 24: a session mended while the console runs
 //! opens without a restart; keys typed while the terminal is too small
-//! do nothing unseen; a frame changed since recorded is said on the
-//! Session screen.
+//! do nothing unseen, and Esc there says to enlarge it; a frame changed
+//! since recorded is said on the Session screen.
+
+use vss::tui::keymap::{Action, GlobalAction, Scope, ScreenId};
 
 use super::tui_harness::{Console, flat};
 
@@ -99,6 +101,33 @@ fn keys_typed_in_too_small_a_terminal_act_on_nothing_unseen() {
     );
     c.send("q");
     c.wait_exit(10);
+}
+
+/// Esc where it does nothing, in too small a terminal, says there what
+/// helps: a window at least the size vss needs, and q to quit. It said
+/// "? lists this screen's keys", and ? lists nothing while no screen is
+/// drawn; and it was seen only once the window was larger again.
+#[test]
+fn esc_in_too_small_a_terminal_says_to_enlarge_it() {
+    let mut c = Console::start(80, 24, &[]);
+    c.wait_text("choose a session", 10);
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
+    );
+    c.wait_text("parameters", 10);
+    c.resize(12, 50);
+    c.wait_text("terminal too small", 10);
+    c.send("\x1b");
+    let s = c.wait_words("Esc does nothing here", 10);
+    let f = flat(&s);
+    assert!(
+        f.contains("the terminal is too small: enlarge it to at least 64 × 18; q quits"),
+        "{s}"
+    );
+    assert!(!f.contains("? lists"), "{s}");
+    c.send("q");
+    assert_eq!(c.wait_exit(10), 0);
 }
 
 /// A frame whose pixels changed since the manifest recorded it (the

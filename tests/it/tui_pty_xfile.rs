@@ -16,6 +16,13 @@ fn a_session_folder_moved_away_while_open_is_said_and_nothing_is_written() {
     c.create_session("cube");
     let d = c.session();
     c.capture_current(1);
+    // The review can come before the store has recorded the frames (the
+    // pipeline does not wait for their saves): the folder goes once they
+    // are recorded, lighting c last.
+    let manifest = d.join("cube.toml");
+    c.wait("image 1's frames recorded", 20, |_| {
+        std::fs::read_to_string(&manifest).is_ok_and(|m| m.contains("cube1c.img"))
+    });
     let moved = c.sessions().join("cube-moved");
     std::fs::rename(&d, &moved).unwrap();
     c.press(SURVEY, Action::Survey(SurveyAction::Accept));

@@ -5,9 +5,11 @@
 //!
 //! A run of the same message (same level and text, one after another: a
 //! key held whose answer is a refusal) is one entry with a count, shown
-//! `… (×500)`; the file gets its first line at once and `last message
-//! repeated 499 times` when the run ends (the next message, the last one
-//! being the console's end), so a crash loses at most the count.
+//! `03:01:12–03:14:55 … (×500)` (its first and last times); the file
+//! gets its first line at once, at the first's time, and `last message
+//! repeated 499 times` at the last's when the run ends (the next message,
+//! the last one being the console's end), so a crash loses at most the
+//! count.
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
@@ -31,7 +33,7 @@ impl Level {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct LogEntry {
-    /// `HH:MM:SS` UTC, of the first of its run.
+    /// `HH:MM:SS` UTC, of the last of its run: when it last came.
     pub time: String,
     pub level: Level,
     pub text: String,
@@ -39,8 +41,8 @@ pub struct LogEntry {
     pub count: usize,
     /// The push number ([`Log::nth_pushed`]) of the first of its run.
     seq: usize,
-    /// `HH:MM:SS` of the last of its run.
-    last_time: String,
+    /// `HH:MM:SS` of the first of its run.
+    first_time: String,
     /// How many of the run the log file has: 0 none yet, 1 its line,
     /// `count` once the repeats were said.
     filed: usize,
@@ -49,7 +51,18 @@ pub struct LogEntry {
 impl LogEntry {
     /// The entry as a line of the log file (the first of its run).
     pub fn file_line(&self) -> String {
-        format!("{} {:7} {}", self.time, self.level.word(), self.text)
+        format!("{} {:7} {}", self.first_time, self.level.word(), self.text)
+    }
+
+    /// When it came, as the pane and the message line show it: a run
+    /// over more than a second from its first to its last,
+    /// `03:01:12–03:14:55`.
+    pub fn when(&self) -> String {
+        if self.first_time == self.time {
+            self.time.clone()
+        } else {
+            format!("{}–{}", self.first_time, self.time)
+        }
     }
 
     /// Its text as the pane and the message line show it: with the count
@@ -79,15 +92,19 @@ impl Log {
     /// Adds a message; the same as the newest (level and text) adds to
     /// its count instead.
     pub fn push(&mut self, level: Level, text: impl Into<String>) {
-        let text = crate::tui::text::clean(&text.into());
-        let now = clock();
+        self.push_at(clock(), level, text.into());
+    }
+
+    /// [`Log::push`] at the time `now` (`HH:MM:SS`).
+    fn push_at(&mut self, now: String, level: Level, text: String) {
+        let text = crate::tui::text::clean(&text);
         self.pushed += 1;
         if let Some(last) = self.entries.back_mut()
             && last.level == level
             && last.text == text
         {
             last.count += 1;
-            last.last_time = now;
+            last.time = now;
             return;
         }
         if self.entries.len() == Self::CAP {
@@ -99,7 +116,7 @@ impl Log {
             text,
             count: 1,
             seq: self.pushed - 1,
-            last_time: now,
+            first_time: now,
             filed: 0,
         });
     }
@@ -168,7 +185,7 @@ impl Log {
                 let s = if times == 1 { "" } else { "s" };
                 out.push(format!(
                     "{} {:7} last message repeated {times} time{s}",
-                    e.last_time,
+                    e.time,
                     e.level.word()
                 ));
                 e.filed = e.count;
@@ -223,9 +240,10 @@ mod tests {
     #[test]
     fn a_run_of_one_message_is_one_entry_and_its_count() {
         let mut l = Log::default();
-        l.push(Level::Info, "start");
+        let at = |l: &mut Log, level, text: &str| l.push_at("03:01:12".into(), level, text.into());
+        at(&mut l, Level::Info, "start");
         for _ in 0..500 {
-            l.push(Level::Warn, "F5 does nothing here");
+            at(&mut l, Level::Warn, "F5 does nothing here");
         }
         assert_eq!((l.len(), l.pushed()), (2, 501));
         assert_eq!(l.last().unwrap().shown(), "F5 does nothing here (×500)");
@@ -236,14 +254,49 @@ mod tests {
         let lines = l.take_unwritten();
         assert_eq!(lines.len(), 2, "{lines:?}");
         assert!(lines[1].ends_with("warning F5 does nothing here"));
-        l.push(Level::Warn, "F5 does nothing here");
+        at(&mut l, Level::Warn, "F5 does nothing here");
         assert!(l.take_unwritten().is_empty(), "the run goes on");
         // Same text, another level: another entry.
-        l.push(Level::Info, "F5 does nothing here");
+        at(&mut l, Level::Info, "F5 does nothing here");
         let lines = l.take_unwritten();
         assert_eq!(lines.len(), 2, "{lines:?}");
         assert!(lines[0].ends_with("warning last message repeated 500 times"));
         assert!(lines[1].ends_with("info    F5 does nothing here"));
         assert_eq!(l.len(), 3);
+    }
+
+    /// A run that went on for minutes shows when it began and when it last
+    /// came, in the pane and on the message line (both show
+    /// [`LogEntry::when`] before [`LogEntry::shown`]); the file has the
+    /// first line at the first's time and the count at the last's. The
+    /// pane showed 03:01:12 for a message that still came at 03:14:55.
+    #[test]
+    fn a_run_shows_when_it_last_came() {
+        let mut l = Log::default();
+        let at = |l: &mut Log, time: &str, text: &str| {
+            l.push_at(time.into(), Level::Warn, text.into());
+        };
+        at(&mut l, "03:01:12", "relay board not answering");
+        at(&mut l, "03:07:40", "relay board not answering");
+        at(&mut l, "03:14:55", "relay board not answering");
+        let e = l.last().unwrap();
+        assert_eq!(
+            format!("{} {}", e.when(), e.shown()),
+            "03:01:12–03:14:55 relay board not answering (×3)"
+        );
+        assert_eq!(e.time, "03:14:55", "when it last came");
+        at(&mut l, "03:15:00", "relay board answering again");
+        let lines = l.take_unwritten();
+        assert_eq!(
+            lines,
+            [
+                "03:01:12 warning relay board not answering",
+                "03:14:55 warning last message repeated 2 times",
+                "03:15:00 warning relay board answering again",
+            ]
+        );
+        // A run within one second has one time.
+        at(&mut l, "03:15:00", "relay board answering again");
+        assert_eq!(l.last().unwrap().when(), "03:15:00");
     }
 }

@@ -38,7 +38,7 @@ fn newest(app: &App) -> Option<(String, crate::tui::app::Level)> {
         } else {
             String::new()
         };
-        (format!("{} {}{more}", e.time, e.shown()), e.level)
+        (format!("{} {}{more}", e.when(), e.shown()), e.level)
     })
 }
 
@@ -199,7 +199,11 @@ fn newest_items(app: &App, width: usize, want: usize) -> Vec<Item> {
     let mut items: Vec<Item> = Vec::new();
     let mut rows = 0;
     for e in app.chrome.log.entries().rev() {
-        let item = Item::wrapped(format!("{} {}", e.time, e.shown()), width, t.level(e.level));
+        let item = Item::wrapped(
+            format!("{} {}", e.when(), e.shown()),
+            width,
+            t.level(e.level),
+        );
         rows += item.rows.len();
         items.push(item);
         if rows >= want {
@@ -579,7 +583,7 @@ pub fn overlay(app: &App, o: Overlay, area: Rect, buf: &mut Buffer) {
                     lines.push(Line::raw(""));
                 }
                 lines.push(Line::styled(
-                    format!("{what} {} {}", e.time, e.level.word()),
+                    format!("{what} {} {}", e.when(), e.level.word()),
                     t.title(),
                 ));
                 lines.extend(

@@ -212,12 +212,12 @@ impl Store {
             .flatten()
     }
 
-    /// Camera `camera`'s description as [`Store::cameras`] read it, which
-    /// image `k` is recorded with; a warning when the file has changed on
-    /// disk since (a hand edit, a `vss calibrate` in another terminal),
-    /// because the console goes on correcting with the one it read.
-    fn camera_read(&self, camera: u32, k: u32) -> Option<Cdf> {
-        let read = self.read_copy(camera);
+    /// Camera `camera`'s description as [`Store::cameras`] read it
+    /// ([`Store::read_copy`]), `read`, which image `k` is recorded with; a
+    /// warning when the file has changed on disk since (a hand edit, a
+    /// `vss calibrate` in another terminal), because the console goes on
+    /// correcting with the one it read.
+    fn camera_read(&self, camera: u32, k: u32, read: Option<Cdf>) -> Option<Cdf> {
         let now = self.profile.camera_cdf(camera);
         if now.as_ref().ok().and_then(Option::as_ref) != read.as_ref() {
             let file = self.profile.cdf_shown(camera).unwrap_or_default();
@@ -255,15 +255,16 @@ impl Store {
         // one when the profile names none now, records this one (or none):
         // the console runs a newly captured frame with the camera as read
         // now.
+        let read = self.read_copy(camera);
         let known = self.session.as_ref().and_then(|s| {
             s.manifest().image(k).map(|r| {
-                let same = s.recorded_with(k, self.read_copy(camera).as_ref());
+                let same = s.recorded_with(k, read.as_ref());
                 (r.camera, r.location, same)
             })
         });
         let record = known.is_none_or(|(c, l, same)| c != camera || l != location || !same);
         let cdf = if record {
-            self.camera_read(camera, k)
+            self.camera_read(camera, k, read)
         } else {
             None
         };
