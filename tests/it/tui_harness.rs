@@ -412,6 +412,23 @@ impl Console {
         });
     }
 
+    /// Waits until the console's devices have answered: the grabber's
+    /// note read in the log pane, as the message line shows the newest
+    /// message only and the note can come before another start-up line
+    /// ("log file: …"). `m` cycles the log: one line, expanded, hidden;
+    /// it is left as one line again.
+    pub fn wait_devices(&mut self, secs: u64) {
+        use vss::tui::keymap::GlobalAction;
+        let m = Action::Global(GlobalAction::ToggleLog);
+        self.press(Scope::Global, m);
+        self.wait("the grabber's note in the log pane", secs, |s| {
+            s.contains("┌ log:") && s.contains("grabber")
+        });
+        self.press(Scope::Global, m);
+        self.press(Scope::Global, m);
+        self.wait("the log pane closed", 5, |s| !s.contains("┌ log:"));
+    }
+
     /// Creates session `cube` and surveys `n` images by keys alone.
     pub fn survey(&mut self, n: u32) {
         self.create_session("cube");
@@ -617,7 +634,7 @@ fn frames_reach_the_screen_whole() {
 #[test]
 fn the_test_cell_starts_without_a_warning() {
     let mut c = Console::start(80, 24, &[]);
-    c.wait_text("relay board", 10);
+    c.wait_devices(10);
     let file = c.dir.path().join("state/vss/console.log");
     c.wait("the grabber's note in the log file", 10, |_| {
         std::fs::read_to_string(&file).is_ok_and(|l| l.contains("relay board"))

@@ -178,7 +178,7 @@ fn idle_writes_nothing_and_hangup_restores_the_terminal() {
     let mut c = Console::start(80, 24, &[]);
     c.wait_text("choose a session", 10);
     // Once the devices have answered, an idle console writes nothing.
-    c.wait_text("relay board", 10);
+    c.wait_devices(10);
     std::thread::sleep(Duration::from_millis(300));
     let before = c.raw.lock().unwrap().len();
     std::thread::sleep(Duration::from_millis(1500));

@@ -71,7 +71,7 @@ fn a_second_console_says_who_holds_the_ports_and_takes_them_when_free() {
     p.relay.settle_ms = 5;
     let profile = toml::to_string(&p).unwrap();
     let mut a = Console::start_with(&profile, 80, 24, &[], |_| {});
-    a.wait_text("VSS-SIM", 20);
+    a.wait_devices(20);
     let holder = a.child.process_id().expect("the first console's pid");
     let mut b = a.another(80, 24);
     let s = b.wait("the second console says the port is busy", 20, |s| {

@@ -210,7 +210,7 @@ fn a_console_that_quits_during_a_take_over_signals_nobody() {
     let a_pid = a.child.process_id().expect("A's pid").to_string();
     // Its devices found first, so that what the take-over says is the
     // newest message (under load the devices' line came after it).
-    b.wait_text("grabber", 20);
+    b.wait_devices(20);
     signal(&a, "-STOP");
     b.wait_text(" cube ", 10);
     b.press(SURVEY, Action::Survey(SurveyAction::Enter));

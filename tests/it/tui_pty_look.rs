@@ -44,16 +44,8 @@ fn look_at(a: &Console) -> (Console, Before) {
     let before = files(&dir);
     let mut b = a.another(80, 24);
     b.wait_text("in use by", 10);
-    // Its devices found first, so that what opening says is the newest:
-    // read in the log pane, as the message line shows the newest only
-    // (the note can come before the log file's).
-    b.press(Scope::Global, Action::Global(GlobalAction::ToggleLog));
-    b.wait("the grabber's note in the log pane", 10, |s| {
-        s.contains("┌ log:") && s.contains("grabber")
-    });
-    b.press(Scope::Global, Action::Global(GlobalAction::ToggleLog));
-    b.press(Scope::Global, Action::Global(GlobalAction::ToggleLog));
-    b.wait("the log pane closed", 5, |s| !s.contains("┌ log:"));
+    // Its devices found first, so that what opening says is the newest.
+    b.wait_devices(10);
     // Esc leaves the question and the session alone.
     b.send("\r");
     b.wait_text("over anyway?", 10);

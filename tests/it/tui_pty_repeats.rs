@@ -10,15 +10,7 @@ fn a_key_held_is_one_entry_with_its_count_and_the_log_file_says_it() {
     c.wait_words("? help", 10);
     // The devices' note first: arriving between the presses (under load it
     // comes late) it would stand between F5's entry and F6's.
-    let file = c.dir.path().join("state/vss/console.log");
-    let end = std::time::Instant::now() + std::time::Duration::from_secs(20);
-    while !std::fs::read_to_string(&file).is_ok_and(|t| t.contains("grabber ")) {
-        assert!(
-            std::time::Instant::now() < end,
-            "the devices did not connect"
-        );
-        std::thread::sleep(std::time::Duration::from_millis(100));
-    }
+    c.wait_devices(20);
     c.send(&"\x1b[15~".repeat(500));
     let s = c.wait_words(
         "F5 does nothing here — ? lists this screen's keys (×500)",
@@ -36,6 +28,7 @@ fn a_key_held_is_one_entry_with_its_count_and_the_log_file_says_it() {
     c.wait_words("F6 does nothing here", 5);
     c.send("q");
     c.wait_exit(10);
+    let file = c.dir.path().join("state/vss/console.log");
     let text = std::fs::read_to_string(&file).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     let f5: Vec<usize> = (0..lines.len())

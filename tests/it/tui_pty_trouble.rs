@@ -33,7 +33,7 @@ fn global(c: &mut Console, g: GlobalAction) {
 #[test]
 fn a_long_message_is_readable_and_kept() {
     let mut c = Console::start(80, 24, &[]);
-    c.wait_text("relay board", 10);
+    c.wait_devices(10);
     c.press(SURVEY, Action::Survey(SurveyAction::NewSession));
     c.wait_text("new session name", 5);
     c.send("-bad-name-starting-with-a-dash\r");
