@@ -111,10 +111,7 @@ fn the_console_refusing_to_start_ends_with_2_when_its_error_stream_is_gone() {
 #[test]
 fn a_grab_whose_report_reader_has_gone_still_captures_every_lighting() {
     let dir = tempfile::tempdir().unwrap();
-    let mut p = vss::rig::sim::cell_profile(64, 64);
-    p.sim.noise = 0.0;
-    p.relay.settle_ms = 5;
-    std::fs::write(dir.path().join("p.toml"), toml::to_string(&p).unwrap()).unwrap();
+    crate::support::fixtures::quick_sim_profile(dir.path(), "p.toml");
     let args = [
         "--profile",
         "p.toml",

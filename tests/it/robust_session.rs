@@ -19,10 +19,7 @@ fn vss(cwd: &Path, args: &[&str]) -> (bool, String) {
 
 /// A simulated cell with small frames: cameras 1 to 4, lightings a to e.
 fn write_profile(dir: &Path) {
-    let mut p = cell_profile(64, 64);
-    p.sim.noise = 0.0;
-    p.relay.settle_ms = 5;
-    std::fs::write(dir.join("p.toml"), toml::to_string(&p).expect("profile")).expect("write");
+    crate::support::fixtures::quick_sim_profile(dir, "p.toml");
 }
 
 fn grab(dir: &Path, image: &str, camera: &str, lighting: &str) -> (bool, String) {

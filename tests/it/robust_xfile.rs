@@ -76,10 +76,7 @@ fn a_manifest_that_is_not_a_file_is_named_as_what_it_is() {
 /// A session `s/g` of one image grabbed in lighting a on the simulated
 /// cell (64² frames), with its outputs.
 fn grabbed_session(dir: &Path) {
-    let mut p = vss::rig::sim::cell_profile(64, 64);
-    p.sim.noise = 0.0;
-    p.relay.settle_ms = 5;
-    std::fs::write(dir.join("cell.toml"), toml::to_string(&p).unwrap()).unwrap();
+    crate::support::fixtures::quick_sim_profile(dir, "cell.toml");
     let (ok, out) = vss(
         dir,
         &[

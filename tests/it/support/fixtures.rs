@@ -1,7 +1,8 @@
 //! Profile fragments several test modules build their cells from, as
 //! macros that expand to string literals so that a module can `concat!`
 //! them into a `const` with its own name, `[relay]`, `[survey]` and
-//! `[sim]` tables.
+//! `[sim]` tables; and [`quick_sim_profile`], a whole profile file for
+//! the CLI tests that grab on the simulated cell.
 
 /// Two lights, `left` (relay 0) and `right` (relay 1), and three lightings:
 /// `a` left, `b` right, `c` none (the ambient image).
@@ -67,3 +68,12 @@ on = []
 
 #[allow(unused_imports)] // each test module uses some of them
 pub(crate) use {five_lightings, two_lights};
+
+/// Writes `dir/name`: the simulated cell with 64 × 64 frames, no noise
+/// and 5 ms for the lights to settle, for quick `vss grab` runs.
+pub fn quick_sim_profile(dir: &std::path::Path, name: &str) {
+    let mut p = vss::rig::sim::cell_profile(64, 64);
+    p.sim.noise = 0.0;
+    p.relay.settle_ms = 5;
+    std::fs::write(dir.join(name), toml::to_string(&p).expect("profile")).expect("write profile");
+}
