@@ -207,8 +207,8 @@ impl App {
     /// How the frame divides the terminal (used by drawing and the mouse).
     pub fn frame(&self, area: Rect) -> Frame {
         let msg_rows = match self.chrome.log_view {
-            LogView::Hidden => 0,
-            LogView::Line => chrome::message_rows(self, area.width),
+            LogView::Hidden if !self.chrome.hidden_shows_message() => 0,
+            LogView::Hidden | LogView::Line => chrome::message_rows(self, area.width),
             LogView::Expanded => (area.height / 2).max(5),
         };
         let [top, body, message, hints] = Layout::vertical([

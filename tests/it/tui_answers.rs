@@ -2,7 +2,7 @@
 //! alone: a letter a session name cannot hold refused as it is typed; a
 //! key that does nothing where it is pressed says so; a warning at
 //! start-up stays on the message line; the same message again and again
-//! is one entry with its count.
+//! is one entry with its count; a hidden log still shows answers and failures.
 
 use ratatui::crossterm::event::{
     KeyCode, KeyEvent, KeyEventKind, KeyEventState, KeyModifiers, ModifierKeyCode,
@@ -214,4 +214,35 @@ fn the_same_answer_again_is_one_entry_with_its_count() {
             .any(|l| l.ends_with("last message repeated 499 times")),
         "{lines:#?}"
     );
+}
+
+/// The log hidden (`m` twice: one line, expanded, hidden) hides notes,
+/// not what the operator must see: the answer to a key is shown while it
+/// is held, and a warning or an error that comes since (a device lost, a
+/// save that failed) takes the line. Before, the hidden log drew no
+/// message row at all: F5 seemed to do nothing and a failure went unseen.
+#[test]
+fn a_hidden_log_still_shows_answers_and_failures_but_not_notes() {
+    let mut app = App::new(&profile(), colour());
+    app.start();
+    app.update(Msg::Store(StoreEvent::Cameras(Vec::new())));
+    app.update(Msg::Store(StoreEvent::Sessions(Vec::new())));
+    key(&mut app, 'm');
+    key(&mut app, 'm');
+    assert!(!message_line(&app).contains("does nothing"));
+    code(&mut app, KeyCode::F(5));
+    let line = message_line(&app);
+    assert!(line.contains("F5 does nothing here"), "{line}");
+    // Once the answer is no longer held, a note does not bring the line.
+    let later = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    app.release_held(later);
+    grabber_connected(&mut app);
+    let line = message_line(&app);
+    assert!(!line.contains("VSS-SIM") && !line.contains("F5"), "{line}");
+    app.update(Msg::Device(vss::tui::event::DeviceEvent::Lost {
+        error: "/dev/ttyUSB0: the device vanished".into(),
+        busy: false,
+    }));
+    let line = message_line(&app);
+    assert!(line.contains("the device vanished"), "{line}");
 }

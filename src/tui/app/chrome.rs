@@ -88,6 +88,9 @@ pub struct Chrome {
     pub log_view: LogView,
     /// Rows the expanded log pane is scrolled back from its newest message.
     pub log_scroll: usize,
+    /// [`Log::pushed`] when the log was last hidden (`m` to its third
+    /// view): what came since may still need the message line.
+    pub hidden_from: usize,
     pub overlay: Option<Overlay>,
     pub modal: Option<Modal>,
     /// The search on, if any (`/`).
@@ -113,6 +116,7 @@ impl Chrome {
             log: Log::default(),
             log_view: LogView::Line,
             log_scroll: 0,
+            hidden_from: 0,
             overlay: None,
             modal: None,
             search: None,
@@ -233,6 +237,18 @@ impl Chrome {
             LogView::Expanded => LogView::Hidden,
         };
         self.log_scroll = 0;
+        self.hidden_from = self.log.pushed();
+    }
+
+    /// Whether the hidden log still shows its message line: while the
+    /// answer to a key (or a key's outcome) is held on it, or while the
+    /// newest message is a warning or an error that came since the log
+    /// was hidden. Notes stay out of sight; a key never goes unanswered
+    /// and a failed save is never unseen.
+    pub fn hidden_shows_message(&self) -> bool {
+        self.held.is_some_and(|h| h.seq >= self.hidden_from)
+            || (self.log.pushed() > self.hidden_from
+                && self.log.last().is_some_and(|e| e.level != Level::Info))
     }
 
     /// PgUp/PgDn/Home/End: scroll the log pane, expanding it first.

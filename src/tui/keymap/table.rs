@@ -224,7 +224,7 @@ pub const KEYMAP: &[Binding] = rows! {
     G, ch('6'), Global(GoTo(ScreenId::Calibrate)), "Calibrate screen", "";
     G, ch('?'), Global(Help), "help: every key, the checklist's marks", "help";
     G, k(K::F(1)), Global(Help), "help", "";
-    G, ch('m'), Global(ToggleLog), "message log: one line / expanded / hidden", "log";
+    G, ch('m'), Global(ToggleLog), "message log: one line / expanded / notes hidden", "log";
     G, ch('!'), Global(LastMessage), "the last message in full", "";
     G, k(K::PageUp), Global(LogUp), "scroll the message log up", "";
     G, k(K::PageDown), Global(LogDown), "scroll the message log down", "";
