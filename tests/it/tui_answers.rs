@@ -233,9 +233,11 @@ fn a_hidden_log_still_shows_answers_and_failures_but_not_notes() {
     code(&mut app, KeyCode::F(5));
     let line = message_line(&app);
     assert!(line.contains("F5 does nothing here"), "{line}");
-    // Once the answer is no longer held, a note does not bring the line.
+    // Once the answer is no longer held its row goes (a frame is drawn),
+    // and a note does not bring it back.
     let later = std::time::Instant::now() + std::time::Duration::from_secs(60);
-    app.release_held(later);
+    assert!(app.release_held(later), "the row goes: the screen changes");
+    assert!(!message_line(&app).contains("F5"));
     grabber_connected(&mut app);
     let line = message_line(&app);
     assert!(!line.contains("VSS-SIM") && !line.contains("F5"), "{line}");

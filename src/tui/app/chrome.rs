@@ -213,7 +213,8 @@ impl Chrome {
     }
 
     /// Lets the held answer go once its time is over (not while the
-    /// message window shows it); whether the message line changes.
+    /// message window shows it); whether the message line changes (in
+    /// the hidden log, whether its row goes).
     pub fn release_held(&mut self, now: Instant) -> bool {
         let Some(h) = self.held else {
             return false;
@@ -223,6 +224,7 @@ impl Chrome {
         }
         self.held = None;
         self.log.pushed() > h.seq + 1
+            || (self.log_view == LogView::Hidden && !self.hidden_shows_message())
     }
 
     /// The terminal is below [`MIN_SIZE`]: the screens are not drawn.
