@@ -79,6 +79,16 @@ impl fmt::Display for FormatError {
 impl std::error::Error for FormatError {}
 
 impl FormatError {
+    /// Where and what, without the file's name (which the caller's message
+    /// names already): `line 9: D needs 5 value line(s), found 1`.
+    pub fn located(&self) -> String {
+        match self.location {
+            Location::None => self.message.clone(),
+            Location::Line(n) => format!("line {n}: {}", self.message),
+            Location::Byte(b) => format!("byte {b}: {}", self.message),
+        }
+    }
+
     pub fn new(
         path: &Path,
         location: Location,
@@ -211,9 +221,14 @@ pub(crate) fn decode_text<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a str, F
 /// Reads a text file as UTF-8, without a leading byte-order mark (which
 /// some Windows editors add).
 pub(crate) fn read_text(path: &Path) -> Result<String, FormatError> {
-    let bytes = read_bytes(path)?;
-    let text = decode_text(&bytes, path)?;
-    Ok(text.strip_prefix('\u{feff}').unwrap_or(text).to_string())
+    Ok(text_of(&read_bytes(path)?, path)?.to_string())
+}
+
+/// A text file's bytes as [`read_text`] reads them: UTF-8, without a
+/// leading byte-order mark.
+pub(crate) fn text_of<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a str, FormatError> {
+    let text = decode_text(bytes, path)?;
+    Ok(text.strip_prefix('\u{feff}').unwrap_or(text))
 }
 
 /// The lines of a text with their 1-based numbers, without `\r\n`/`\n`.

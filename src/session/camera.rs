@@ -73,15 +73,11 @@ impl Session {
             path: path.clone(),
             why,
         };
-        let at = |e: formats::FormatError| match e.location {
-            formats::Location::Line(n) => format!("line {n}: {}", e.message),
-            formats::Location::Byte(b) => format!("byte {b}: {}", e.message),
-            formats::Location::None => e.message,
-        };
-        let bytes = formats::read_bytes(&path).map_err(|e| damaged(at(e)))?;
-        let text = formats::decode_text(&bytes, &path).map_err(|e| damaged(at(e)))?;
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let cdf = formats::cdf::parse_cdf(text, &path).map_err(|e| damaged(at(e)))?;
+        let at = |e: formats::FormatError| damaged(e.located());
+        // Read as `read_cdf` reads it, keeping the bytes for the record's hash.
+        let bytes = formats::read_bytes(&path).map_err(at)?;
+        let text = formats::text_of(&bytes, &path).map_err(at)?;
+        let cdf = formats::cdf::parse_cdf(text, &path).map_err(at)?;
         match cdf.model() {
             Ok(m) => Ok(ImageCamera::Model(m)),
             Err(why) if stamp::hash(&bytes) == rec.hash => Ok(ImageCamera::NoModel(why)),
