@@ -65,6 +65,12 @@ impl LogEntry {
         }
     }
 
+    /// The entry as the pane and the message line show it: when it came
+    /// ([`LogEntry::when`]), then its text ([`LogEntry::shown`]).
+    pub fn dated(&self) -> String {
+        format!("{} {}", self.when(), self.shown())
+    }
+
     /// Its text as the pane and the message line show it: with the count
     /// of a run, `… (×500)`.
     pub fn shown(&self) -> String {
@@ -267,7 +273,7 @@ mod tests {
 
     /// A run that went on for minutes shows when it began and when it last
     /// came, in the pane and on the message line (both show
-    /// [`LogEntry::when`] before [`LogEntry::shown`]); the file has the
+    /// [`LogEntry::dated`]); the file has the
     /// first line at the first's time and the count at the last's. The
     /// pane showed 03:01:12 for a message that still came at 03:14:55.
     #[test]
@@ -281,7 +287,7 @@ mod tests {
         at(&mut l, "03:14:55", "relay board not answering");
         let e = l.last().unwrap();
         assert_eq!(
-            format!("{} {}", e.when(), e.shown()),
+            e.dated(),
             "03:01:12–03:14:55 relay board not answering (×3)"
         );
         assert_eq!(e.time, "03:14:55", "when it last came");

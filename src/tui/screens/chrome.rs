@@ -38,7 +38,7 @@ fn newest(app: &App) -> Option<(String, crate::tui::app::Level)> {
         } else {
             String::new()
         };
-        (format!("{} {}{more}", e.when(), e.shown()), e.level)
+        (format!("{}{more}", e.dated()), e.level)
     })
 }
 
@@ -199,11 +199,7 @@ fn newest_items(app: &App, width: usize, want: usize) -> Vec<Item> {
     let mut items: Vec<Item> = Vec::new();
     let mut rows = 0;
     for e in app.chrome.log.entries().rev() {
-        let item = Item::wrapped(
-            format!("{} {}", e.when(), e.shown()),
-            width,
-            t.level(e.level),
-        );
+        let item = Item::wrapped(e.dated(), width, t.level(e.level));
         rows += item.rows.len();
         items.push(item);
         if rows >= want {
