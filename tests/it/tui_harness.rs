@@ -441,6 +441,16 @@ impl Console {
         }
     }
 
+    /// Goes to the Pipeline screen and waits for its parameter panel.
+    pub fn open_pipeline(&mut self) {
+        use vss::tui::keymap::GlobalAction;
+        self.press(
+            Scope::Global,
+            Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
+        );
+        self.wait_text("parameters", 10);
+    }
+
     /// On the Pipeline screen with the first parameter chosen, chooses
     /// parameter `key` (by the panel's key, as an operator steps down).
     pub fn choose_param(&mut self, key: &str) {

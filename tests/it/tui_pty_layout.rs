@@ -10,7 +10,7 @@
 
 use std::time::{Duration, Instant};
 
-use vss::tui::keymap::{Action, GlobalAction, PipelineAction, Scope, ScreenId};
+use vss::tui::keymap::{Action, PipelineAction, Scope, ScreenId};
 
 use super::tui_harness::{Console, PIPELINE, panel_value};
 
@@ -101,11 +101,7 @@ fn parameter_keys_keep_the_picture_still(cols: u16, rows: u16, ceiling: usize) {
     let mut c = start_bare(cols, rows, home.path());
     c.create_session("cube");
     c.capture_current(1);
-    c.press(
-        Scope::Global,
-        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
-    );
-    c.wait_text("parameters", 10);
+    c.open_pipeline();
     let mut report = Vec::new();
     let mut at = 0;
     for param in ["edges.floor", "connect.min_line_length"] {

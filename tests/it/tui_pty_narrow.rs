@@ -3,7 +3,7 @@
 //! 80 × 24: the session list's "(in use by …)", the DEVICE LOST banner on
 //! the hint rows, the Pipeline screen's zoom readout.
 
-use vss::tui::keymap::{Action, GlobalAction, NavAction, Scope, ScreenId, SurveyAction};
+use vss::tui::keymap::{Action, NavAction, SurveyAction};
 
 use super::tui_harness::{Console, PIPELINE, PROFILE, SURVEY};
 
@@ -81,11 +81,7 @@ fn the_zoom_readout_fits_at_80_columns() {
     let mut c = Console::start_with(&profile, 80, 24, &[], |_| {});
     c.create_session("cube");
     c.capture_current(1);
-    c.press(
-        Scope::Global,
-        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
-    );
-    c.wait_text("parameters", 10);
+    c.open_pipeline();
     for _ in 0..3 {
         c.press(PIPELINE, Action::Nav(NavAction::ZoomIn));
     }

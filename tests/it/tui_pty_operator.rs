@@ -4,8 +4,6 @@
 //! do nothing unseen, and Esc there says to enlarge it; a frame changed
 //! since recorded is said on the Session screen.
 
-use vss::tui::keymap::{Action, GlobalAction, Scope, ScreenId};
-
 use super::tui_harness::{Console, flat};
 
 /// A session whose manifest does not read is listed as damaged; the
@@ -111,11 +109,7 @@ fn keys_typed_in_too_small_a_terminal_act_on_nothing_unseen() {
 fn esc_in_too_small_a_terminal_says_to_enlarge_it() {
     let mut c = Console::start(80, 24, &[]);
     c.wait_text("choose a session", 10);
-    c.press(
-        Scope::Global,
-        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
-    );
-    c.wait_text("parameters", 10);
+    c.open_pipeline();
     c.resize(12, 50);
     c.wait_text("terminal too small", 10);
     c.send("\x1b");

@@ -4,7 +4,7 @@
 //! range"), `o` on the start screen opens no second picker, the session's
 //! log says why the console ended.
 
-use vss::tui::keymap::{Action, GlobalAction, PipelineAction, Scope, ScreenId, SurveyAction};
+use vss::tui::keymap::{Action, PipelineAction, SurveyAction};
 
 use super::tui_harness::{Console, PIPELINE, SURVEY};
 
@@ -51,11 +51,7 @@ fn a_fraction_for_a_whole_number_is_called_that() {
     let mut c = Console::start(80, 24, &[]);
     c.create_session("cube");
     c.capture_current(1);
-    c.press(
-        Scope::Global,
-        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
-    );
-    c.wait_text("parameters", 10);
+    c.open_pipeline();
     c.choose_param("edges.per_region");
     c.press(PIPELINE, Action::Pipeline(PipelineAction::Type));
     c.wait_text("edges.per_region =", 5);

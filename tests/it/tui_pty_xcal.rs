@@ -170,13 +170,9 @@ fn redone(c: &Console) -> Vec<u8> {
 /// used the new file while the session still recorded the old one.
 #[test]
 fn an_image_surveyed_before_a_recalibration_runs_with_its_recorded_camera() {
-    use vss::tui::keymap::{PipelineAction, Scope};
+    use vss::tui::keymap::PipelineAction;
     let (mut c, recorded, first) = surveyed_then_recalibrated();
-    c.press(
-        Scope::Global,
-        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
-    );
-    c.wait_text("parameters", 10);
+    c.open_pipeline();
     c.choose_param("lens.enabled");
     for action in [PipelineAction::Dec, PipelineAction::Inc] {
         c.press(PIPELINE, Action::Pipeline(action));

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use vss::tui::keymap::{Action, GlobalAction, PipelineAction, Scope, ScreenId, SurveyAction};
+use vss::tui::keymap::{Action, PipelineAction, SurveyAction};
 
 use super::tui_harness::{Console, PIPELINE, SURVEY, five_lightings, write_cdfs};
 
@@ -86,11 +86,7 @@ fn a_damaged_recorded_camera_description_is_refused_alike_by_the_console_and_red
     show_image_1(&mut c);
     c.wait("the load says why", 20, |_| log(&c).contains(&words));
     // A tuned value asks for a run: refused, and nothing to save.
-    c.press(
-        Scope::Global,
-        Action::Global(GlobalAction::GoTo(ScreenId::Pipeline)),
-    );
-    c.wait_text("parameters", 10);
+    c.open_pipeline();
     c.choose_param("lens.enabled");
     c.press(PIPELINE, Action::Pipeline(PipelineAction::Dec));
     c.wait("the run refused", 20, |_| {
