@@ -2,6 +2,7 @@
 //! no panic, no error message, success. A standard error whose reader has
 //! gone loses the notes, not the exit status.
 
+use std::path::Path;
 use std::process::{Command, Stdio};
 
 /// Runs `vss ARGS` with its output going to a pipe that is already closed,
@@ -13,9 +14,22 @@ fn run_into_a_closed_pipe(args: &[&str]) -> std::process::Output {
 /// Runs `vss ARGS` with its standard error (`stderr`) or its output going
 /// to a pipe that is already closed.
 fn run_with_a_closed_pipe(args: &[&str], stderr: bool) -> std::process::Output {
-    let mut child = Command::new(assert_cmd::cargo::cargo_bin("vss"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+    let mut vss = vss_in(Path::new(env!("CARGO_MANIFEST_DIR")));
+    vss.args(args);
+    closed(vss, stderr)
+}
+
+/// `vss` to be run in `dir`.
+fn vss_in(dir: &Path) -> Command {
+    let mut vss = Command::new(assert_cmd::cargo::cargo_bin("vss"));
+    vss.current_dir(dir);
+    vss
+}
+
+/// Runs `cmd` with its standard error (`stderr`) or its output going to a
+/// pipe that is already closed.
+fn closed(mut cmd: Command, stderr: bool) -> std::process::Output {
+    let mut child = cmd
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -90,16 +104,9 @@ fn a_closed_standard_error_does_not_panic_calibrate() {
 #[test]
 fn the_console_refusing_to_start_ends_with_2_when_its_error_stream_is_gone() {
     for term in ["xterm-256color", "dumb"] {
-        let mut child = Command::new(assert_cmd::cargo::cargo_bin("vss"))
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .env("TERM", term)
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        drop(child.stderr.take());
-        let out = child.wait_with_output().unwrap();
+        let mut vss = vss_in(Path::new(env!("CARGO_MANIFEST_DIR")));
+        vss.env("TERM", term).stdin(Stdio::null());
+        let out = closed(vss, true);
         assert_eq!(out.status.code(), Some(2), "TERM={term}: {:?}", out.status);
     }
 }
@@ -125,15 +132,9 @@ fn a_grab_whose_report_reader_has_gone_still_captures_every_lighting() {
         "--lighting",
         "a,b,c",
     ];
-    let mut child = Command::new(assert_cmd::cargo::cargo_bin("vss"))
-        .args(args)
-        .current_dir(dir.path())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
+    let mut vss = vss_in(dir.path());
+    vss.args(args);
+    let out = closed(vss, false);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{:?} {err}", out.status);
     assert!(!err.contains("vss: error"), "{err}");
