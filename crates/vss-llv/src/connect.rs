@@ -482,14 +482,14 @@ mod tests {
     fn a_short_line_stays_when_its_direction_is_sure() {
         let p = ConnectParams::default();
         assert!(p.min_line_length > 10.0 && p.short_line_deg > 0.0);
-        // 10 px: √12 · 0.05 / 10^1.5 is 0.31° of direction error; 0.3 px
-        // of scatter is 1.9°.
+        // 10 px: √12 · 0.05 / 10^1.5 is 0.31° of direction error; 0.5 px
+        // of scatter is 3.1°.
         let sure = Segment {
             residual: 0.05,
             ..seg(0.0, 0.0, 10.0, 0.0)
         };
         let unsure = Segment {
-            residual: 0.3,
+            residual: 0.5,
             ..seg(0.0, 50.0, 10.0, 50.0)
         };
         let unknown = Segment {
@@ -557,14 +557,18 @@ mod tests {
             b,
             seg(100.0, 100.0, 100.0, 140.0),
             seg(100.3, 144.0, 100.1, 170.0),
-            seg(0.0, 100.0, 5.0, 100.0),
+            Segment {
+                residual: 0.3,
+                ..seg(0.0, 100.0, 5.0, 100.0)
+            },
         ];
         let p = ConnectParams::default();
         let out1 = connect(&lines, &p);
         let mut rev = lines.clone();
         rev.reverse();
         assert_eq!(out1, connect(&rev, &p));
-        // 2 merged lines; the 5 px segment falls to the length filter.
+        // 2 merged lines; the 5 px segment, its direction unsure, falls to
+        // the length filter.
         assert_eq!(out1.len(), 2);
         assert!(connect(&[], &p).is_empty());
     }

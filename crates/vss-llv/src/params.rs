@@ -340,7 +340,7 @@ params! {
         /// (docs/accuracy.md). Not in a noisy image (`edges.noisy_sigma`),
         /// where a dozen points' scatter says too little. 0 is off: the
         /// spec's rule alone.
-        short_line_deg: f64 = 1.0,
+        short_line_deg: f64 = 2.0,
             "deg", 0.0..=10.0, step 0.25,
             "shorter lines kept when their points fix their direction within this; 0 is off";
         /// Corner closing radius (px): endpoints of different lines within it move
