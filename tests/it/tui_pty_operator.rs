@@ -2,7 +2,8 @@
 //! binary in a pty at 80 × 24: a session mended while the console runs
 //! opens without a restart; keys typed while the terminal is too small
 //! do nothing unseen, and Esc there says to enlarge it; a frame changed
-//! since recorded is said on the Session screen.
+//! since recorded is said on the Session screen; going to an image with
+//! nothing captured says what Enter does.
 
 use super::tui_harness::{Console, flat};
 
@@ -153,6 +154,19 @@ fn a_frame_changed_since_recorded_is_said_on_the_session_screen() {
         flat.contains("cube1b.img CHANGED since the manifest"),
         "the changed frame is said:\n{s}"
     );
+    c.send("q");
+    c.wait_exit(10);
+}
+
+/// `Enter` on a checklist row whose image has nothing captured says so
+/// and what `Enter` does next; it once said only "image 2".
+#[test]
+fn going_to_an_image_with_nothing_captured_says_what_enter_does() {
+    let mut c = Console::start(80, 24, &[]);
+    c.create_session("cube");
+    c.send("\x1b[B");
+    c.send("\r");
+    c.wait_words("image 2: nothing captured yet — Enter captures it", 10);
     c.send("q");
     c.wait_exit(10);
 }

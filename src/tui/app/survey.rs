@@ -620,11 +620,19 @@ impl Ctx<'_> {
         if !self.set_image_under_work(k) {
             return Vec::new();
         }
-        self.info(format!("image {k}"));
         let captured = self
             .session
             .image(k)
             .is_some_and(|i| !i.captured.is_empty());
+        if captured {
+            self.info(format!("image {k}: loading what the session holds of it"));
+        } else {
+            let w = &self.session.work;
+            self.info(format!(
+                "image {k}: nothing captured yet — Enter captures it (camera {}, location {})",
+                w.camera, w.location
+            ));
+        }
         match &self.tracker.current {
             Some(c) if c.k == k && c.outputs.is_some() => {
                 self.session.work.phase = Phase::Review;
