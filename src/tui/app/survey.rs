@@ -624,22 +624,24 @@ impl Ctx<'_> {
             .session
             .image(k)
             .is_some_and(|i| !i.captured.is_empty());
-        if captured {
-            self.info(format!("image {k}: loading what the session holds of it"));
-        } else {
-            let w = &self.session.work;
-            self.info(format!(
-                "image {k}: nothing captured yet — Enter captures it (camera {}, location {})",
-                w.camera, w.location
-            ));
-        }
         match &self.tracker.current {
             Some(c) if c.k == k && c.outputs.is_some() => {
                 self.session.work.phase = Phase::Review;
+                self.info(format!("image {k}: its outputs are on screen"));
                 Vec::new()
             }
-            _ if captured => vec![Cmd::Store(StoreCmd::Load(k))],
-            _ => Vec::new(),
+            _ if captured => {
+                self.info(format!("image {k}: loading its frames and outputs"));
+                vec![Cmd::Store(StoreCmd::Load(k))]
+            }
+            _ => {
+                let w = &self.session.work;
+                self.info(format!(
+                    "image {k}: nothing captured yet — Enter captures it (camera {}, location {})",
+                    w.camera, w.location
+                ));
+                Vec::new()
+            }
         }
     }
 
