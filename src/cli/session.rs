@@ -216,6 +216,9 @@ fn show(dir: &Path) -> anyhow::Result<ExitCode> {
     }
     print_checklist(&s)?;
     for r in &m.image {
+        if !r.grey.is_empty() {
+            outln!("  {}", camera_note(&s, r));
+        }
         if let Some(o) = &r.outputs {
             let c = &o.counts;
             outln!(
@@ -239,6 +242,33 @@ fn show(dir: &Path) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The camera description image `r` runs with, as [`Session::image_camera`]
+/// decides for `vss session redo` and the console: its recorded file, or
+/// why it runs without lens correction, or why it does not run at all.
+fn camera_note(s: &Session, r: &crate::session::manifest::ImageRecord) -> String {
+    use crate::session::camera::ImageCamera;
+    let t = crate::text::sanitize;
+    let (k, file) = (r.number, r.cdf.as_ref().map_or("", |c| c.file.as_str()));
+    match s.image_camera(k) {
+        Ok(ImageCamera::Model(_)) => {
+            format!(
+                "image {k}: camera description {} (recorded at capture)",
+                t(file)
+            )
+        }
+        Ok(ImageCamera::Unrecorded) => {
+            format!("image {k}: no camera description recorded: it runs without lens correction")
+        }
+        Ok(ImageCamera::NoModel(why)) => format!(
+            "image {k}: camera description {} gives no camera model ({}): it runs without \
+             lens correction",
+            t(file),
+            t(&why)
+        ),
+        Err(e) => t(&e.to_string()),
+    }
 }
 
 fn print_checklist(s: &Session) -> anyhow::Result<()> {

@@ -1,5 +1,6 @@
 //! `vss session` as a person uses it: new, show, check (exit codes), bad
-//! names refused, a nonsense manifest reported with file:line and kept.
+//! names refused, a nonsense manifest reported with file:line and kept;
+//! show names the camera description each image runs with.
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -557,4 +558,44 @@ fn check_names_records_that_contradict_their_frames() {
         assert!(!o.status.success(), "{}", text(&o));
         assert!(text(&o).contains(says), "{says}\n{}", text(&o));
     }
+}
+
+/// `vss session show` says which camera description each captured image
+/// runs with (the answer `vss session redo` and the console take from
+/// `Session::image_camera`): the file recorded at capture, and once that
+/// file is damaged, that it is and that the image does not run.
+#[test]
+fn show_names_each_images_camera_description_and_a_damaged_one() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let d = tmp.path();
+    // The built-in simulated cell: its cameras have descriptions.
+    let grab = [
+        "grab",
+        "--session",
+        "s/g",
+        "--image",
+        "1",
+        "--camera",
+        "1",
+        "--lighting",
+        "a",
+    ];
+    let o = vss(&grab, d);
+    assert!(o.status.success(), "{}", text(&o));
+    let show = || text(&vss(&["session", "show", "s/g"], d));
+    let s = show();
+    assert!(
+        s.contains("image 1: camera description g1.cdf (recorded at capture)"),
+        "{s}"
+    );
+    let cdf = d.join("s/g/g1.cdf");
+    let whole = std::fs::read(&cdf).expect("g1.cdf");
+    std::fs::write(&cdf, &whole[..whole.len() / 2]).expect("cut g1.cdf");
+    let s = show();
+    assert!(
+        s.contains("image 1: its recorded camera description")
+            && s.contains("g1.cdf is damaged (line")
+            && s.contains("the image is not run"),
+        "{s}"
+    );
 }
