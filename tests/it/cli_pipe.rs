@@ -119,19 +119,7 @@ fn the_console_refusing_to_start_ends_with_2_when_its_error_stream_is_gone() {
 fn a_grab_whose_report_reader_has_gone_still_captures_every_lighting() {
     let dir = tempfile::tempdir().unwrap();
     crate::support::fixtures::quick_sim_profile(dir.path(), "p.toml");
-    let args = [
-        "--profile",
-        "p.toml",
-        "grab",
-        "--session",
-        "s/g",
-        "--image",
-        "1",
-        "--camera",
-        "1",
-        "--lighting",
-        "a,b,c",
-    ];
+    let args = crate::support::fixtures::grab_args(Some("p.toml"), "1", "1", "a,b,c");
     let mut vss = vss_in(dir.path());
     vss.args(args);
     let out = closed(vss, false);

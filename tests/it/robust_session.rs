@@ -25,19 +25,7 @@ fn write_profile(dir: &Path) {
 fn grab(dir: &Path, image: &str, camera: &str, lighting: &str) -> (bool, String) {
     vss(
         dir,
-        &[
-            "--profile",
-            "p.toml",
-            "grab",
-            "--session",
-            "s/g",
-            "--image",
-            image,
-            "--camera",
-            camera,
-            "--lighting",
-            lighting,
-        ],
+        &crate::support::fixtures::grab_args(Some("p.toml"), image, camera, lighting),
     )
 }
 

@@ -77,22 +77,8 @@ fn a_manifest_that_is_not_a_file_is_named_as_what_it_is() {
 /// cell (64² frames), with its outputs.
 fn grabbed_session(dir: &Path) {
     crate::support::fixtures::quick_sim_profile(dir, "cell.toml");
-    let (ok, out) = vss(
-        dir,
-        &[
-            "--profile",
-            "cell.toml",
-            "grab",
-            "--session",
-            "s/g",
-            "--image",
-            "1",
-            "--camera",
-            "1",
-            "--lighting",
-            "a",
-        ],
-    );
+    let grab = crate::support::fixtures::grab_args(Some("cell.toml"), "1", "1", "a");
+    let (ok, out) = vss(dir, &grab);
     assert!(ok, "{out}");
     let (ok, out) = vss(
         dir,

@@ -569,17 +569,7 @@ fn show_names_each_images_camera_description_and_a_damaged_one() {
     let tmp = tempfile::tempdir().expect("tmp");
     let d = tmp.path();
     // The built-in simulated cell: its cameras have descriptions.
-    let grab = [
-        "grab",
-        "--session",
-        "s/g",
-        "--image",
-        "1",
-        "--camera",
-        "1",
-        "--lighting",
-        "a",
-    ];
+    let grab = crate::support::fixtures::grab_args(None, "1", "1", "a");
     let o = vss(&grab, d);
     assert!(o.status.success(), "{}", text(&o));
     let show = || text(&vss(&["session", "show", "s/g"], d));

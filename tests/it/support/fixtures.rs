@@ -77,3 +77,27 @@ pub fn quick_sim_profile(dir: &std::path::Path, name: &str) {
     p.relay.settle_ms = 5;
     std::fs::write(dir.join(name), toml::to_string(&p).expect("profile")).expect("write profile");
 }
+
+/// The arguments of `vss grab` into session `s/g` (under the current
+/// folder): image `image` of camera `camera` under `lighting` (`a,b,c`),
+/// on the cell of profile file `profile`, or the built-in one.
+pub fn grab_args<'a>(
+    profile: Option<&'a str>,
+    image: &'a str,
+    camera: &'a str,
+    lighting: &'a str,
+) -> Vec<&'a str> {
+    let mut args = profile.map_or_else(Vec::new, |p| vec!["--profile", p]);
+    args.extend([
+        "grab",
+        "--session",
+        "s/g",
+        "--image",
+        image,
+        "--camera",
+        camera,
+        "--lighting",
+        lighting,
+    ]);
+    args
+}
