@@ -2,8 +2,8 @@
 //! the real binary started with no profile in an empty folder, with an
 //! empty home and the XDG folders inside it, so nothing beside the binary
 //! can stand in for what is compiled in. Lens correction must run there
-//! (its time on the Pipeline screen, a corrected view that is not the grey
-//! one), the Calibrate screen must compute with the built-in camera's
+//! (its time on the Pipeline screen, kept by a re-run from the edges; a
+//! corrected view that is not the grey one), the Calibrate screen must compute with the built-in camera's
 //! scale, and accepting writes the camera's `.cdf` where the profile names
 //! it, keeping the built-in description's other entries.
 
@@ -12,7 +12,7 @@ use vss::tui::keymap::{
     Action, CalibrateAction as CA, GlobalAction, PipelineAction, Scope, ScreenId, SurveyAction,
 };
 
-use super::tui_harness::{Console, PIPELINE, SURVEY, flat};
+use super::tui_harness::{Console, PIPELINE, SURVEY, flat, panel_value};
 
 /// The console with the built-in profile in an empty folder, `HOME` and
 /// the XDG folders in another empty one (kept alive by the caller).
@@ -77,6 +77,15 @@ fn builtin_cell_from_an_empty_folder_corrects_lenses_and_calibrates() {
         "lens correction ran on the built-in cell (lens {ms} ms):\n{s}"
     );
     assert!(!s.contains("lens OFF"), "{s}");
+    // A change to the edges re-runs from the edges: the lens stage keeps
+    // the time of the run that made its output (it showed 0.0, as if lens
+    // correction were off).
+    c.choose_param("edges.noise_sigmas");
+    c.press(PIPELINE, Action::Pipeline(PipelineAction::Inc));
+    let s = c.wait("edges.noise_sigmas = 2.75 run", 30, |s| {
+        panel_value(s, "edges.noise_sigmas").as_deref() == Some("2.75") && !s.contains("running")
+    });
+    assert_eq!(lens_ms(&s), Some(ms), "the lens time after a re-run:\n{s}");
     // The views in turn from the overlay: the grey one, then the corrected.
     c.press(PIPELINE, Action::Pipeline(PipelineAction::ViewNext));
     c.wait_text("· grey ─", 10);

@@ -32,8 +32,10 @@ mod noise;
 
 pub use noise::noise_level;
 
-/// Wall-clock time of each stage of one run, in microseconds (0 for a
-/// stage that a [`rerun`] did not repeat).
+/// Wall-clock time of each stage, in microseconds: the time its outputs
+/// took to make (a stage a [`rerun`] did not repeat keeps the time of the
+/// run that made it), so that a re-run's panel, manifest and report show no
+/// stage as taking no time.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct Timings {
     pub lens_us: u64,
@@ -203,7 +205,19 @@ impl Workspace {
         let from = if prev_fits { from } else { Stage::Lens };
         let prev_params = std::mem::replace(&mut self.out.params, p.clone());
         self.valid = false;
-        self.out.timings = Timings::default();
+        // A stage this run does not repeat keeps the time of the run that
+        // made its outputs.
+        let t = &mut self.out.timings;
+        for (stage, us) in [
+            (Stage::Lens, &mut t.lens_us),
+            (Stage::Edges, &mut t.edges_us),
+            (Stage::Lines, &mut t.lines_us),
+            (Stage::Connect, &mut t.connect_us),
+        ] {
+            if from <= stage {
+                *us = 0;
+            }
+        }
 
         if from <= Stage::Lens {
             let t = Instant::now();
@@ -666,7 +680,9 @@ mod tests {
         let again = rerun(first.clone(), Stage::Connect, &input, &q).unwrap();
         let full = run(&input, &q).unwrap();
         assert_eq!(again.lines, full.lines);
-        assert_eq!(again.timings.edges_us, 0);
+        // The edges were not run again: they keep the first run's time.
+        assert_eq!(again.timings.edges_us, first.timings.edges_us);
+        assert!(again.timings.edges_us > 0);
         q.edges.per_region = 3;
         let again = rerun(first, Stage::Edges, &input, &q).unwrap();
         assert_eq!(again.edges_h, run(&input, &q).unwrap().edges_h);
