@@ -334,7 +334,7 @@ fn run_group(
                 y0: *y0,
             };
             let bytes = crate::formats::img::encode_img(&imc)?;
-            stage(&mut set, &target, &bytes)?;
+            stage(a, &mut set, &target, &bytes)?;
         }
     }
     write_outputs(a, &grp.dir, &grp.stem, out, true, &mut set)?;
@@ -370,21 +370,33 @@ fn write_outputs(
     if edges {
         for (ext, e) in [("hpo", &out.edges_h), ("vpo", &out.edges_v)] {
             let t = out_path(a, dir, &format!("{stem}.{ext}"));
-            stage(set, &t, &edgefile::encode_checked(&t, e)?)?;
+            stage(a, set, &t, &edgefile::encode_checked(&t, e)?)?;
         }
     }
     for (ext, l) in [("lex", &out.lines_raw), ("ldr", &out.lines)] {
         let t = out_path(a, dir, &format!("{stem}.{ext}"));
-        stage(set, &t, linefile::encode_checked(&t, l)?.as_bytes())?;
+        stage(a, set, &t, linefile::encode_checked(&t, l)?.as_bytes())?;
     }
     Ok(())
 }
 
-/// Stages one output; an error says that no output was replaced.
-fn stage(set: &mut crate::fsutil::StagedWrites, path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+/// Stages one output; an error says that no output was replaced, and
+/// where the outputs went beside the input, how to put them elsewhere.
+fn stage(
+    a: &Args,
+    set: &mut crate::fsutil::StagedWrites,
+    path: &Path,
+    bytes: &[u8],
+) -> anyhow::Result<()> {
     crate::formats::stage(set, path, bytes).map_err(|e| {
+        let elsewhere = if a.out.is_none() {
+            "; --out DIR writes the outputs to another folder"
+        } else {
+            ""
+        };
         anyhow::anyhow!(
-            "{e}; no output was replaced (those of an earlier run, if any, are as they were)"
+            "{e}; no output was replaced (those of an earlier run, if any, are as they \
+             were){elsewhere}"
         )
     })
 }

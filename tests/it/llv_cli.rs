@@ -517,10 +517,30 @@ fn an_output_that_cannot_be_written_replaces_none_and_claims_no_earlier_run() {
         "{err}"
     );
     assert!(!err.contains("previous run"), "{err}");
+    assert!(!err.contains("--out DIR"), "--out was given: {err}");
     let mut left: Vec<_> = std::fs::read_dir(&out)
         .unwrap()
         .map(|e| e.unwrap().file_name())
         .collect();
     left.sort();
     assert_eq!(left, ["cube1.ldr"], "nothing else written");
+}
+
+/// Beside the input (no `--out`), the refusal also says how to write the
+/// outputs elsewhere: a photograph's folder is often not the operator's.
+#[test]
+fn an_output_that_cannot_be_written_beside_the_input_points_to_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "cube1a.img", |x, y| rect(x, y, 200, 40));
+    std::fs::create_dir_all(d.join("cube1.ldr")).unwrap();
+    let r = vss().arg("llv").arg(d.join("cube1a.img")).output().unwrap();
+    assert!(!r.status.success());
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("cube1.ldr")
+            && err.contains("no output was replaced")
+            && err.contains("--out DIR writes the outputs to another folder"),
+        "{err}"
+    );
 }
