@@ -468,9 +468,14 @@ mod tests {
 
     /// A bright square on a dark ground.
     fn square() -> GreyImage {
+        square_at(0)
+    }
+
+    /// [`square`] moved `dx` px to the right.
+    fn square_at(dx: usize) -> GreyImage {
         let mut g = GreyImage::filled(128, 128, 40).unwrap();
         for y in 30..90 {
-            for x in 35..95 {
+            for x in 35 + dx..95 + dx {
                 g.data_mut()[y * 128 + x] = 200;
             }
         }
@@ -487,7 +492,8 @@ mod tests {
         let mut q = p.clone();
         q.connect.corner_radius = 0.0;
         let again = r.run_changed(1, &input, &q).unwrap().clone();
-        assert_eq!(again.timings.edges_us, 0, "only CONNECT re-ran");
+        // Only CONNECT re-ran: the edges keep the first run's time.
+        assert_eq!(again.timings.edges_us, first.timings.edges_us);
         let full = Runner::new().run(&input, Stage::Lens, &q).unwrap().clone();
         assert_eq!(again.lines, full.lines);
         assert_eq!(again.edges_h, full.edges_h);
@@ -498,8 +504,12 @@ mod tests {
         let after = r.run_changed(1, &input, &q).unwrap();
         assert!(after.timings.edges_us > 0, "a full run after a failure");
         assert_eq!(after.lines, full.lines);
-        // Another key: a full run.
-        let other = r.run_changed(2, &input, &q).unwrap();
-        assert!(other.timings.edges_us > 0);
+        // Another key, other frames: a full run (edges kept from key 1
+        // would give key 1's lines).
+        let moved = FrameRule::default().split([('a', square_at(20))]);
+        let other = r.run_changed(2, &moved, &q).unwrap().clone();
+        let full = Runner::new().run(&moved, Stage::Lens, &q).unwrap().clone();
+        assert_eq!(other.edges_h, full.edges_h);
+        assert_eq!(other.lines, full.lines);
     }
 }
