@@ -216,14 +216,10 @@ impl Tracker {
 
     /// A pipeline request for the current image (`None` when there is none):
     /// its frames split by the profile's rule, as the session code splits
-    /// them.
-    pub fn request(&mut self, cell: &super::CellState) -> Option<Cmd> {
-        let cur = self.current.as_mut()?;
+    /// them. Whether the image may run at all is [`Ctx::run_current`]'s.
+    fn request(&mut self, cell: &super::CellState) -> Option<Cmd> {
+        let cur = self.current.as_ref()?;
         if cur.frames.is_empty() {
-            return None;
-        }
-        if let Some(why) = cur.camera_refused() {
-            cur.failed = Some(why.to_string());
             return None;
         }
         let camera = cur.camera_model(cell);
@@ -252,24 +248,28 @@ impl Ctx<'_> {
         self.run_current().into_iter().collect()
     }
 
-    /// A run of the current image ([`Tracker::request`]), or none. An image
+    /// A run of the current image (`Tracker::request`), or none. An image
     /// whose recorded camera description is damaged is not run: said, in
     /// the words `vss session redo` refuses it with, and nothing is made
     /// that the console could save.
     pub fn run_current(&mut self) -> Option<Cmd> {
-        let cmd = self.tracker.request(self.cell);
-        if cmd.is_none()
-            && let Some(why) = self
-                .tracker
-                .current
-                .as_ref()
-                .and_then(Loaded::camera_refused)
+        let Some(why) = self
+            .tracker
+            .current
+            .as_ref()
+            .and_then(Loaded::camera_refused)
+            .map(str::to_string)
+        else {
+            return self.tracker.request(self.cell);
+        };
+        if let Some(cur) = self.tracker.current.as_mut()
+            && !cur.frames.is_empty()
         {
-            let why = why.to_string();
-            self.error(format!("not run: {why}"));
-            self.pipeline_failed();
+            cur.failed = Some(why.clone());
         }
-        cmd
+        self.error(format!("not run: {why}"));
+        self.pipeline_failed();
+        None
     }
 
     /// Puts parameter `key` (every one with `None`) back to the profile's
