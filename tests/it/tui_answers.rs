@@ -160,14 +160,21 @@ fn a_start_up_warning_is_not_pushed_off_the_line_by_the_grabber_s_note() {
     assert!(message_line(&app).contains("F5 does nothing here"));
 }
 
-/// A start-up with nothing to warn of holds nothing: the grabber's note
-/// shows at once.
-#[test]
-fn a_quiet_start_up_lets_the_grabber_s_note_show() {
+/// The console started, the store having answered with no cameras'
+/// problems and no sessions: nothing to warn of.
+fn started_quietly() -> App {
     let mut app = App::new(&profile(), colour());
     app.start();
     app.update(Msg::Store(StoreEvent::Cameras(Vec::new())));
     app.update(Msg::Store(StoreEvent::Sessions(Vec::new())));
+    app
+}
+
+/// A start-up with nothing to warn of holds nothing: the grabber's note
+/// shows at once.
+#[test]
+fn a_quiet_start_up_lets_the_grabber_s_note_show() {
+    let mut app = started_quietly();
     grabber_connected(&mut app);
     let line = message_line(&app);
     assert!(line.contains("VSS-SIM"), "{line}");
@@ -223,10 +230,7 @@ fn the_same_answer_again_is_one_entry_with_its_count() {
 /// message row at all: F5 seemed to do nothing and a failure went unseen.
 #[test]
 fn a_hidden_log_still_shows_answers_and_failures_but_not_notes() {
-    let mut app = App::new(&profile(), colour());
-    app.start();
-    app.update(Msg::Store(StoreEvent::Cameras(Vec::new())));
-    app.update(Msg::Store(StoreEvent::Sessions(Vec::new())));
+    let mut app = started_quietly();
     key(&mut app, 'm');
     key(&mut app, 'm');
     assert!(!message_line(&app).contains("does nothing"));
