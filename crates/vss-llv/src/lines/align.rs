@@ -33,12 +33,16 @@
 //! A direction is only as good as the gradient it comes from: where the
 //! gradient is below `q / sin ALIGN_DEG`, a quantisation error of `q` grey
 //! levels can turn it beyond the tolerance (LSD's argument for its
-//! threshold ρ). A line whose mean gradient magnitude along it is below
-//! that, with `q` one grey level (2.6 grey levels a pixel), lies on
-//! shading, a faint cloud or faint print, and is dropped whatever its
-//! alignment. The mean is taken along the whole line, not per sample: a
-//! faint edge in noise (10 grey levels at a blur of σ 1.5 px has a slope
-//! of 2.7) dips below it at single pixels but not on average. A gradient
+//! threshold ρ). A line whose mean gradient across it is below that,
+//! with `q` one grey level (2.6 grey levels a pixel), lies on shading, a
+//! faint cloud or faint print, and is dropped whatever its alignment. The
+//! mean is taken along the whole line, not per sample: a faint edge in
+//! noise (10 grey levels at a blur of σ 1.5 px has a slope of 2.7) dips
+//! below it at single pixels but not on average. It is the gradient's
+//! component across the line, not its magnitude: where a line crosses a
+//! strong edge (a post in front of a faint shading boundary, a joint
+//! between two faint pieces that CONNECT bridged), that edge's gradient
+//! runs along the line and is no evidence for it. A gradient
 //! above ρ may still be shading's, not the line's: what counts is the
 //! gradient along the line less the shading beside it
 //! ([`super::step`]).
@@ -66,7 +70,7 @@ pub const ALIGN_DEG: f64 = 22.5;
 /// A line this unlikely under random directions is kept whole (log10).
 pub const LOG10_SIGNIFICANT: f64 = -5.0;
 
-/// Least mean gradient magnitude along a line (grey levels a pixel),
+/// Least mean gradient across a line (grey levels a pixel),
 /// [`min_slope`]: one grey level of quantisation over `sin ALIGN_DEG`.
 pub fn min_slope() -> f64 {
     1.0 / ALIGN_DEG.to_radians().sin()
@@ -127,7 +131,7 @@ pub enum Sample {
 }
 
 /// The samples of a line (module doc), one a pixel; returns the mean
-/// gradient magnitude (grey levels a pixel) of the samples with evidence.
+/// gradient across it (grey levels a pixel) of the samples with evidence.
 pub fn samples(images: &[GreyImage], s: &Segment, out: &mut Vec<Sample>) -> f64 {
     out.clear();
     let len = s.length();
@@ -203,7 +207,7 @@ fn sobel(d: &[u8], w: usize, at: usize) -> Option<(f64, f64)> {
 
 /// A sample of gradient `g` on a line of unit direction `d` (module doc):
 /// aligned when the gradient is within [`ALIGN_DEG`] of across the line
-/// (`c2` its cosine squared), and the gradient's magnitude.
+/// (`c2` its cosine squared), and the gradient's component across it.
 #[inline(always)]
 fn classify((gx, gy): (f64, f64), (dx, dy): (f64, f64), c2: f64) -> (Sample, f64) {
     let g2 = gx * gx + gy * gy;
@@ -214,11 +218,12 @@ fn classify((gx, gy): (f64, f64), (dx, dy): (f64, f64), c2: f64) -> (Sample, f64
     } else {
         Sample::Across
     };
-    (sample, g2.sqrt())
+    (sample, across.abs())
 }
 
 /// The mean slope (grey levels a pixel) of `counted` samples whose Sobel
-/// magnitudes sum to `mag` (Sobel's sum is 8 times the slope); 0 for none.
+/// gradients across the line sum to `mag` (Sobel's sum is 8 times the
+/// slope); 0 for none.
 fn mean_slope(mag: f64, counted: usize) -> f64 {
     if counted > 0 {
         mag / (8.0 * counted as f64)
@@ -521,6 +526,34 @@ mod tests {
         assert!(min_slope_of_length(40.0) > g);
         assert_eq!(min_slope_of_length(SHORT), min_slope());
         assert_eq!(min_slope_of_length(1.0), 2.0 * min_slope());
+    }
+
+    #[test]
+    fn strong_edges_crossing_a_faint_line_are_no_evidence_for_it() {
+        // A vertical step of 4 grey levels (a slope of 2, under ρ), crossed
+        // every 20 rows by a dark bar 4 rows tall across the whole image
+        // (posts in front of a faint shading boundary): the bars' gradient
+        // runs along the line, and only its component across counts.
+        let s = line(32.0, 5.0, 32.0, 150.0);
+        let plain = tall(&|x, _| if x < 32 { 100 } else { 104 });
+        let barred = tall(&|x, y| {
+            let dark = if y % 20 < 4 { 60 } else { 0 };
+            (if x < 32 { 100 } else { 104 }) - dark
+        });
+        let mut v = Vec::new();
+        let g = samples(std::slice::from_ref(&barred), &s, &mut v);
+        assert!((g - 2.0).abs() < 1e-9, "{g}");
+        assert_eq!(g, samples(std::slice::from_ref(&plain), &s, &mut v));
+        // Most samples are aligned: the line is not cut at the bars.
+        assert!(aligned_fraction(std::slice::from_ref(&barred), &s).unwrap() > 0.7);
+        assert!(!kept(&plain, s));
+        assert!(!kept(&barred, s));
+        // A step of 8 (a slope of 4) is a line, bars or not.
+        let strong = tall(&|x, y| {
+            let dark = if y % 20 < 4 { 60 } else { 0 };
+            (if x < 32 { 100 } else { 108 }) - dark
+        });
+        assert!(kept(&strong, s));
     }
 
     #[test]

@@ -11,7 +11,7 @@
 //! changes at the line more than on either side of it. The quantisation
 //! argument behind ρ then applies to what the line adds to the shading.
 //!
-//! The gradient is the line's mean Sobel magnitude (as for ρ); the shading
+//! The gradient is the line's mean Sobel gradient across it (as for ρ); the shading
 //! is read from the image's profile across the line: grey levels at
 //! whole-pixel offsets `-REACH..=REACH` along the normal (bilinear), one
 //! profile a pixel along the line up to [`PROFILES`] spread evenly over it,
@@ -23,7 +23,7 @@
 //! both). The step itself is not compared with ρ: averaged along a long
 //! line that is not exactly parallel to its edge, or on a slightly curved
 //! edge, the profile's step is smeared (the synthetic yard lost faint true
-//! edges so), while the Sobel magnitude is read pixel by pixel. A line
+//! edges so), while the Sobel gradient is read pixel by pixel. A line
 //! without one whole profile inside the image is no evidence either way.
 //!
 //! The same profiles say two more things about a faint line
