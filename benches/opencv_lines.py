@@ -338,13 +338,16 @@ def bootstrap(a, photos):
 
     rng = random.Random(1)
     n = len(photos)
-    first, rec40, flat_below = 0, [], 0
+    first, rec40, flat_below, every = 0, [], 0, 0
     for _ in range(a.bootstrap):
         pick = [rng.randrange(n) for _ in range(n)]
         got = {d: pooled([rows[i] for i in pick]) for d, rows in per.items()}
-        first += all(got["vss"][0] > g[0] for d, g in got.items() if d != "vss")
+        top = all(got["vss"][0] > g[0] for d, g in got.items() if d != "vss")
+        flat = "LSD" in got and got["vss"][2] < got["LSD"][2]
+        first += top
         rec40.append(got["vss"][1])
-        flat_below += "LSD" in got and got["vss"][2] < got["LSD"][2]
+        flat_below += flat
+        every += top and flat and got["vss"][1] >= 0.85
     rec40.sort()
     q = lambda p: rec40[min(int(p * len(rec40)), len(rec40) - 1)]
     k = a.bootstrap
@@ -354,6 +357,8 @@ def bootstrap(a, photos):
           f"{q(0.95):.3f}; >= 0.85 in {sum(r >= 0.85 for r in rec40) / k:.3f}")
     if "LSD" in per:
         print(f"  false lines on flat structure below LSD's: {flat_below / k:.3f}")
+        print(f"  all three at once (F first, recall at >= 40 >= 0.85, flat below LSD's): "
+              f"{every / k:.3f}")
 
 
 def bench(name, detect, runs):
