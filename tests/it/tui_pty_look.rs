@@ -111,6 +111,53 @@ fn a_second_console_looks_at_a_held_session_without_disturbing_it() {
     assert_eq!(a.wait_exit(10), 0);
 }
 
+/// The console holding the session is gone (its SSH connection dropped):
+/// the one looking chooses the session again in the list (`o`, Enter) and
+/// has it to write, without a restart. While the holder still ran, the same
+/// choice asked the usual question and left both as they were. Before, it
+/// only closed the list: the session stayed read-only until a restart.
+#[test]
+fn choosing_the_session_looked_at_again_asks_for_it_to_write() {
+    let (mut a, mut b, (held, _)) = looking(1);
+    let lock = a.session().join("cube.lock");
+    b.press(SURVEY, Action::Survey(SurveyAction::OpenPicker));
+    b.wait_text("open another session", 10);
+    b.send("\r");
+    b.wait_text("over anyway?", 10);
+    b.send("n");
+    let s = b.wait("the question closed", 10, |s| !s.contains("over anyway?"));
+    assert!(s.lines().next().unwrap().contains("read-only"), "{s}");
+    assert_eq!(std::fs::read(&lock).unwrap(), held, "the lock is untouched");
+    assert_eq!(a.exit_code(), None, "the first console runs on");
+    let pid = a.child.process_id().expect("pid") as i32;
+    let rc = rustix::process::kill_process(
+        rustix::process::Pid::from_raw(pid).unwrap(),
+        rustix::process::Signal::HUP,
+    );
+    assert_eq!(rc, Ok(()));
+    a.wait_exit(10);
+    b.press(SURVEY, Action::Survey(SurveyAction::OpenPicker));
+    b.wait_text("open another session", 10);
+    b.send("\r");
+    let s = b.wait("the session open to write", 10, |s| {
+        let title = s.lines().next().unwrap_or("");
+        title.contains("cube") && !title.contains("read-only") && s.contains("1 of 4 done")
+    });
+    assert!(!s.contains("over anyway?"), "{s}");
+    assert_ne!(
+        std::fs::read(&lock).unwrap(),
+        held,
+        "the lock is this console's"
+    );
+    // It writes: image 2 captured and accepted.
+    b.capture_current(2);
+    b.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    let s = b.wait_text("image 2 accepted", 20);
+    assert!(!s.contains("NOT saved"), "{s}");
+    b.send("q");
+    assert_eq!(b.wait_exit(10), 0);
+}
+
 #[test]
 fn the_read_only_view_offers_only_the_keys_that_work_there() {
     let (mut a, mut b, _) = looking(1);

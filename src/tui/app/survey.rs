@@ -224,13 +224,25 @@ impl SurveyScreen {
             ctx.warn("a capture or run is under way: wait for it before switching sessions");
             return Vec::new();
         }
-        match &ctx.session.view {
-            Some(v) if v.dir == e.dir => {
+        let open = ctx.session.view.as_ref();
+        match open.map(|v| (v.dir == e.dir, v.read_only, v.name.clone())) {
+            Some((true, false, _)) => {
                 self.picking = false;
                 Vec::new()
             }
-            Some(v) => {
-                let q = format!("Leave session {} and open session {}?", v.name, e.name);
+            // Open here only to look: choosing it again asks for it to
+            // write (its holder may have gone: an SSH drop ended it); the
+            // store says whether it got it, or asks as for any held one.
+            Some((true, true, _)) => {
+                self.picking = false;
+                ctx.info(format!(
+                    "session {}: open here only to look — asking for it to write",
+                    e.name
+                ));
+                vec![Cmd::Store(StoreCmd::Open(e.dir))]
+            }
+            Some((false, _, name)) => {
+                let q = format!("Leave session {name} and open session {}?", e.name);
                 ctx.ask(q, Pending::Switch(e.dir));
                 self.picking = false;
                 Vec::new()
