@@ -185,7 +185,7 @@ impl App {
         // A session open only to look is read again as often, on any
         // screen (another console may be surveying it); the store says it
         // only when it changed.
-        let looking = self.session.view.as_ref().is_some_and(|v| v.read_only);
+        let looking = self.session.read_only();
         if looking && due_again(&mut self.session.looked, now) {
             return vec![Cmd::Store(StoreCmd::Relook)];
         }

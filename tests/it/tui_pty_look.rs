@@ -121,7 +121,11 @@ fn choosing_the_session_looked_at_again_asks_for_it_to_write() {
     let (mut a, mut b, (held, _)) = looking(1);
     let lock = a.session().join("cube.lock");
     b.press(SURVEY, Action::Survey(SurveyAction::OpenPicker));
-    b.wait_text("open another session", 10);
+    // The next-step box beside the list says what choosing it does (it
+    // said "a accepts", as if the session could be written).
+    let s = b.wait_text("this one, to write", 10);
+    assert!(s.contains("open another session"), "{s}");
+    assert!(!s.contains("a accepts"), "{s}");
     b.send("\r");
     b.wait_text("over anyway?", 10);
     b.send("n");
@@ -268,6 +272,19 @@ fn with_no_image_done_opens_on_the_newest_captured_image() {
     let s = b.wait_text("image 2a", 20);
     assert!(s.contains("0 of 4 done"), "{s}");
     assert!(s.contains(">  2 ") && !s.contains(">  1 "), "{s}");
+    // Its stages run here, and what they found is said without the keys
+    // that only work to write (it said "a accepts, R captures again").
+    b.wait_text("image 2a + lines", 20);
+    b.press(Scope::Global, Action::Global(GlobalAction::ToggleLog));
+    let s = b.wait("the log says image 2's lines", 10, |s| {
+        let log = flat(&s.replace('│', " "));
+        let counted = log
+            .split("image 2: ")
+            .skip(1)
+            .any(|m| m.starts_with(|c: char| c.is_ascii_digit()));
+        counted || log.contains("a accepts")
+    });
+    assert!(!flat(&s.replace('│', " ")).contains("a accepts"), "{s}");
     b.send("q");
     assert_eq!(b.wait_exit(10), 0);
     a.send("q");

@@ -23,7 +23,7 @@ pub const READ_ONLY: &str = "read-only: nothing will be saved";
 impl App {
     /// Whether the open session is open only to look.
     pub fn read_only(&self) -> bool {
-        self.session.view.as_ref().is_some_and(|v| v.read_only)
+        self.session.read_only()
     }
 
     /// What `a` would do that a session open only to look refuses, when

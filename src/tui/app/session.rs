@@ -59,6 +59,11 @@ pub struct Refused {
 }
 
 impl SessionState {
+    /// Whether the open session is open only to look.
+    pub fn read_only(&self) -> bool {
+        self.view.as_ref().is_some_and(|v| v.read_only)
+    }
+
     /// Image `k`'s outputs are not saved, for `why` (`edit`: a hand edit
     /// not written); said once, the newest reason.
     pub fn refuse(&mut self, k: u32, why: String, edit: bool) {

@@ -403,6 +403,8 @@ impl Ctx<'_> {
                     let msg = not_saved_message(c);
                     self.error(format!("image {k}: {n} lines, but {msg}"));
                 }
+                // Only looking: nothing to accept, capture, tune or edit.
+                _ if self.session.read_only() => self.info(format!("image {k}: {n} lines")),
                 _ => self.info(format!(
                     "image {k}: {n} lines — a accepts, R captures again, 3 tunes, 4 edits"
                 )),

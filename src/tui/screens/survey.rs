@@ -274,16 +274,24 @@ fn step_lines(app: &App) -> Vec<Line<'static>> {
     let w = &app.session.work;
     let key = |k: &'static str| Span::styled(k, t.key());
     let sel = app.screens.survey.row(w);
-    let text: Vec<Line> = if app.read_only() && !app.screens.survey.picking {
+    let text: Vec<Line> = if app.read_only() {
         // Open only to look (`app::readonly`): nothing to capture or accept.
-        vec![
-            Line::styled("Open only to look: nothing will be saved.", t.warn()),
-            Line::from(vec![
+        let keys = if app.screens.survey.picking {
+            vec![
+                key("↑↓ Enter"),
+                Span::raw(" opens a session; this one, to write"),
+            ]
+        } else {
+            vec![
                 key("↑↓ Enter"),
                 Span::raw(" shows an image · "),
                 key("o"),
                 Span::raw(" opens another session"),
-            ]),
+            ]
+        };
+        vec![
+            Line::styled("Open only to look: nothing will be saved.", t.warn()),
+            Line::from(keys),
         ]
     } else if app.session.view.is_some() && sel != w.k && !app.screens.survey.picking {
         vec![
