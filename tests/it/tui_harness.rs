@@ -357,6 +357,15 @@ impl Console {
         c
     }
 
+    /// Sends the console `sig` (SIGHUP: its SSH connection dropped;
+    /// SIGKILL: a power cut) and waits until it has ended.
+    pub fn end_by(&mut self, sig: rustix::process::Signal) {
+        let pid = self.child.process_id().expect("pid") as i32;
+        let rc = rustix::process::kill_process(rustix::process::Pid::from_raw(pid).unwrap(), sig);
+        assert_eq!(rc, Ok(()));
+        self.wait_exit(10);
+    }
+
     /// The child's exit status, once it has ended.
     pub fn exit_code(&mut self) -> Option<u32> {
         self.child.try_wait().ok().flatten().map(|s| s.exit_code())

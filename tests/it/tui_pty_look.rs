@@ -133,13 +133,7 @@ fn choosing_the_session_looked_at_again_asks_for_it_to_write() {
     assert!(s.lines().next().unwrap().contains("read-only"), "{s}");
     assert_eq!(std::fs::read(&lock).unwrap(), held, "the lock is untouched");
     assert_eq!(a.exit_code(), None, "the first console runs on");
-    let pid = a.child.process_id().expect("pid") as i32;
-    let rc = rustix::process::kill_process(
-        rustix::process::Pid::from_raw(pid).unwrap(),
-        rustix::process::Signal::HUP,
-    );
-    assert_eq!(rc, Ok(()));
-    a.wait_exit(10);
+    a.end_by(rustix::process::Signal::HUP);
     b.press(SURVEY, Action::Survey(SurveyAction::OpenPicker));
     b.wait_text("open another session", 10);
     b.send("\r");

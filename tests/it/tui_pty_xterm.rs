@@ -117,13 +117,7 @@ fn ctrl_z_without_a_shell_says_why_and_goes_on() {
 fn a_session_left_by_a_killed_console_is_not_said_in_use() {
     let mut a = Console::start(80, 24, &[]);
     a.create_session("cube");
-    let pid = a.child.process_id().expect("pid") as i32;
-    let rc = rustix::process::kill_process(
-        rustix::process::Pid::from_raw(pid).unwrap(),
-        rustix::process::Signal::KILL,
-    );
-    assert_eq!(rc, Ok(()));
-    a.wait_exit(10);
+    a.end_by(rustix::process::Signal::KILL);
     assert!(a.session().join("cube.lock").is_file(), "the lock stays");
     let mut b = a.another(80, 24);
     // The list's rows wrap in its own column: the words are read there.
