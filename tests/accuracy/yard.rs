@@ -23,6 +23,8 @@ fn report() -> &'static YardReport {
             scenes: 6,
             size: 512,
             seed: 1,
+            // The lens check has its own 12 scenes (`lens_report`).
+            lens_noise: Vec::new(),
             ..Default::default()
         };
         let r = match evaluate_yard(&cfg, &default_params()) {
