@@ -106,6 +106,9 @@ pub struct Calibration {
     pub uncertainty: Vec<([f64; 2], f64)>,
     /// What makes the set of views weak, in words for the operator.
     pub warnings: Vec<String>,
+    /// With `S` stated: the views' own pinhole gave `f` from `sx` and from
+    /// `sy` more than 1 % apart, so `S` may not be this camera's.
+    pub scale_doubted: bool,
     /// Residual evaluations the solver needed.
     pub evaluations: usize,
     pub width: usize,
@@ -343,11 +346,13 @@ pub fn calibrate(views: &[View], o: &Options) -> Result<Calibration, CalibError>
             what: "the views do not determine the camera: they are too alike".into(),
         })?;
     let mut warnings = Vec::new();
+    let mut scale_doubted = false;
     let (f0, sy0) = if o.estimate_scale {
         (pin.fx * o.sx, pin.fx * o.sx / pin.fy)
     } else {
         let (a, b) = (pin.fx * o.sx, pin.fy * o.sy);
         if ((a - b) / (a + b)).abs() > 0.01 {
+            scale_doubted = true;
             warnings.push(format!(
                 "the stated scale S does not fit the images: f / sx and f / sy give {a:.3} and {b:.3} mm; check S (sy / sx is about {:.5}) or estimate it (--estimate-scale)",
                 o.sy / o.sx * b / a
@@ -529,6 +534,7 @@ pub fn calibrate(views: &[View], o: &Options) -> Result<Calibration, CalibError>
         fixed,
         uncertainty,
         warnings,
+        scale_doubted,
         evaluations,
         width: o.width,
         height: o.height,

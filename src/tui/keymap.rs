@@ -219,6 +219,8 @@ pub enum CalibrateAction {
     Centre,
     /// The centre `C` stated at coordinates typed.
     CentreAt,
+    /// The scale's `sy` as stated in the camera's `.cdf`, or estimated.
+    Scale,
     Solve,
     Accept,
     /// Load images from files (a folder or a list, typed).

@@ -268,3 +268,76 @@ fn a_camera_calibrated_from_a_folder_of_photographs_at_80_by_24() {
     c.send("q");
     c.wait_exit(10);
 }
+
+/// Photographs of a camera whose `sy / sx` the `.cdf` does not give (here
+/// the simulated camera's `S`, 0.696, for the phone's square pixels): the
+/// refusal names the key that estimates `sy`, `e` does, and the `.cdf`
+/// written has `S` calibrated with the ratio the views fit, at 80 × 24.
+#[test]
+fn a_scale_the_views_do_not_fit_is_estimated_with_e() {
+    let photos = super::calib_real::photo_paths();
+    let mut c = Console::start_with(PROFILE, 80, 24, &[], |dir| {
+        for cam in 1..=2 {
+            let cdf = vss::rig::sim::camera_cdf(cam, 512, 512).unwrap();
+            write_cdf(&dir.join(format!("cam{cam}.cdf")), &cdf).unwrap();
+        }
+        std::fs::create_dir(dir.join("photos")).unwrap();
+        for p in &photos[..12] {
+            std::fs::copy(p, dir.join("photos").join(p.file_name().unwrap())).unwrap();
+        }
+        std::fs::write(dir.join("board.toml"), super::calib_real::BOARD).unwrap();
+    });
+    let dir = c.dir.path().to_path_buf();
+    let stated = read_cdf(&dir.join("cam1.cdf"))
+        .unwrap()
+        .camera_model()
+        .unwrap();
+    assert!((stated.sy / stated.sx - 1.0).abs() > 0.2, "{stated:?}");
+    c.wait_text("Survey", 10);
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
+    );
+    c.wait_text("views kept: 0", 10);
+    let cb = Scope::Screen(ScreenId::Calibrate);
+    c.wait_text("scale S: as the .cdf states (e)", 10);
+    c.press(cb, Action::Calibrate(CA::PlateFile));
+    c.wait_text("plate:", 10);
+    c.send("board.toml\r");
+    c.wait_text("plate board.toml", 10);
+    c.press(cb, Action::Calibrate(CA::Open));
+    c.wait_text("photographs to load:", 10);
+    c.send("photos\r");
+    c.wait_text("views kept: 12", 60);
+    c.press(cb, Action::Calibrate(CA::Solve));
+    c.wait_words(
+        "the corners do not fit one camera with the stated scale S",
+        60,
+    );
+    c.send("!");
+    c.wait_words("here `e` estimates sy", 10);
+    c.send("\x1b");
+    c.wait("the message closed", 10, |s| !s.contains("last message"));
+    c.wait_text("refused: views do not fit S (e)", 10);
+    c.press(cb, Action::Calibrate(CA::Scale));
+    c.wait_text("scale S: sy estimated (e)", 10);
+    c.press(cb, Action::Calibrate(CA::Solve));
+    let s = c.wait("the calibration", 60, |s| s.contains("worst views"));
+    for want in ["RMS 0.3", "Cx", "sy ", "scale S: sy estimated"] {
+        assert!(s.contains(want), "{want} on the screen:\n{s}");
+    }
+    c.press(cb, Action::Calibrate(CA::Accept));
+    c.wait_text("write S, C, f, D", 10);
+    c.yes();
+    c.wait_words("camera 1: wrote", 10);
+    let got = read_cdf(&dir.join("cam1.cdf")).unwrap();
+    assert_eq!(got.get("S").unwrap().status, Status::Calibrated);
+    let m = got.camera_model().unwrap();
+    // sx as stated; sy from the views: the phone's pixels are square.
+    assert_eq!(m.sx, stated.sx);
+    assert!((m.sy / m.sx - 1.0).abs() < 0.01, "{m:?}");
+    // OpenCV's fx on these twelve views (the test above).
+    assert!((m.f / m.sx - 706.2).abs() / 706.2 < 0.005, "{m:?}");
+    c.send("q");
+    c.wait_exit(10);
+}

@@ -640,4 +640,11 @@ fn views_that_fit_only_another_scale_are_refused_naming_the_scale() {
     assert!(rms < 0.4, "{rms}");
     let text = e.to_string();
     assert!(text.contains("estimate sy"), "{text}");
+    // Twelve of them: the wrong scale converges (to C outside the image
+    // and RMS 1.8 px), and is refused all the same.
+    let e = calib::calibrate(&views[..12], &o).unwrap_err();
+    let CalibError::ScaleMismatch { fits, rms, .. } = e else {
+        panic!("{e}");
+    };
+    assert!((fits - 1.0).abs() < 0.01 && rms < 0.4, "{fits} {rms}");
 }

@@ -84,6 +84,8 @@ pub struct CalibrateScreen {
     /// Why the last solution was refused.
     pub refused: Option<String>,
     pub centre: Centre,
+    /// Whether `sy` of the scale `S` is estimated (else as stated).
+    pub estimate_scale: bool,
     pub plate_shown: bool,
     /// The plate chosen: a built-in name or a file's path.
     pub plate_name: String,
@@ -106,6 +108,7 @@ impl Default for CalibrateScreen {
             result: None,
             refused: None,
             centre: Centre::Solved,
+            estimate_scale: false,
             plate_shown: false,
             plate_name: PLATE.into(),
             photos: Vec::new(),
@@ -381,6 +384,12 @@ impl CalibrateScreen {
                 self.refused = None;
                 Vec::new()
             }
+            CalibrateAction::Scale => {
+                self.estimate_scale = !self.estimate_scale;
+                self.result = None;
+                self.refused = None;
+                Vec::new()
+            }
             CalibrateAction::CentreAt => {
                 let offered = match self.centre {
                     Centre::At([x, y]) => format!("{x},{y}"),
@@ -488,7 +497,7 @@ impl CalibrateScreen {
             height: h,
             sx: m.sx,
             sy: m.sy,
-            estimate_scale: false,
+            estimate_scale: self.estimate_scale,
             centre: self.centre_for(w, h),
             full_model: false,
         };
@@ -506,8 +515,17 @@ impl CalibrateScreen {
                 self.result = Some((cam, c));
             }
             Err(e) => {
-                ctx.error(e.to_string());
-                self.refused = Some(e.to_string());
+                // The refusal names the command line's flags; here a key
+                // does the same. The panel's line is the short why.
+                let (why, short) = match e {
+                    calib::CalibError::ScaleMismatch { .. } => (
+                        format!("{e}; here `e` estimates sy"),
+                        "views do not fit S (e)".to_string(),
+                    ),
+                    _ => (e.to_string(), e.to_string()),
+                };
+                ctx.error(why);
+                self.refused = Some(short);
                 self.result = None;
             }
         }

@@ -144,6 +144,7 @@ pub const KEYMAP: &[Binding] = rows! {
     CB, ch('n'), Calibrate(Next), "show the next photograph loaded, with its corners", "next";
     CB, ch('f'), Calibrate(PlateFile), "choose the plate: a built-in name or a plate file (typed)", "";
     CB, ch('S'), Calibrate(CentreAt), "centre C stated at X,Y (typed)", "";
+    CB, ch('e'), Calibrate(Scale), "scale S: sy as the camera's .cdf states it / estimated", "";
     // Capture.
     CA, ch('v'), Capture(ToggleLive), "live view on/off", "live";
     CA, ch('g'), Capture(Grab), "grab one frame", "grab";

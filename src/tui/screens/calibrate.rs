@@ -146,21 +146,20 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         area,
         super::panel_width(crate::tui::keymap::ScreenId::Calibrate),
     );
-    let mut lines = vec![
-        Line::styled(
-            format!("camera {cam} (c) plate {} (f)", short_name(&s.plate_name)),
-            t.title(),
-        ),
-        Line::raw(format!(
+    let mut lines = vec![Line::styled(
+        format!("camera {cam} (c) plate {} (f)", short_name(&s.plate_name)),
+        t.title(),
+    )];
+    // With a solution shown, its figures take the room of the live view's
+    // line, the grid line and the coverage map (80 × 24 has sixteen rows
+    // here; the residuals replace the picture, and the key bar keeps v, p).
+    let solved = s.result.as_ref().filter(|(c, _)| *c == cam).map(|(_, c)| c);
+    if solved.is_none() {
+        lines.push(Line::raw(format!(
             "live {} (v)  plate {} (p)",
             if app.cell.device.live { "ON" } else { "off" },
             if s.plate_shown { "shown" } else { "away" }
-        )),
-    ];
-    // With a solution shown, its figures take the room of the grid line
-    // and the coverage map (80 × 24 has sixteen rows here).
-    let solved = s.result.as_ref().filter(|(c, _)| *c == cam).map(|(_, c)| c);
-    if solved.is_none() {
+        )));
         lines.push(grid_line(s, cam, t));
     }
     let views = s.views_of(cam);
@@ -176,6 +175,11 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
         Centre::Solved => "centre C: solved (s, S)".to_string(),
         Centre::Middle => "centre C: stated, image middle (s)".to_string(),
         Centre::At([x, y]) => format!("centre C: stated {x},{y} (S)"),
+    }));
+    lines.push(Line::raw(if s.estimate_scale {
+        "scale S: sy estimated (e)"
+    } else {
+        "scale S: as the .cdf states (e)"
     }));
     match solved {
         Some(c) => {
@@ -196,7 +200,7 @@ pub fn render(app: &App, area: Rect, buf: &mut Buffer) {
             let names: Vec<String> = worst
                 .iter()
                 .take(2)
-                .map(|v| format!("{} {:.3}", v.name, v.rms))
+                .map(|v| format!("{} {:.3}", short_name(&v.name), v.rms))
                 .collect();
             lines.push(Line::styled("worst views (RMS px):", t.title()));
             lines.push(Line::raw(format!(" {}", names.join("  "))));
