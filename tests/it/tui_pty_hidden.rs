@@ -178,8 +178,9 @@ fn damage_is_counted_listed_first_and_a_damaged_ldr_made_again() {
 
 /// The session list puts the session worked on last first (alphabetical
 /// put `alpha` over the `zulu` just worked on), marks the one open in
-/// this console as such (not "in use by" its own user), and after a
-/// restart Enter opens the one just worked on.
+/// this console as such (not "in use by" its own user), the next-step box
+/// beside the list says Enter opens a session (not that it captures), and
+/// after a restart Enter opens the one just worked on.
 #[test]
 fn sessions_are_listed_most_recent_first_and_the_open_one_marked() {
     let mut c = Console::start(80, 24, &[]);
@@ -201,7 +202,21 @@ fn sessions_are_listed_most_recent_first_and_the_open_one_marked() {
         "{s}"
     );
     assert!(!s.contains("in use by"), "{s}");
+    // The next-step box says what Enter does while the list is open: it
+    // opens a session, it does not capture image 2.
+    let w = s.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        w.contains("Session zulu stays open until another is."),
+        "{s}"
+    );
+    assert!(
+        w.contains("↑↓ Enter opens a session · Esc goes back"),
+        "{s}"
+    );
+    assert!(!w.contains("Enter captures"), "{s}");
     c.send("\x1b");
+    let s = c.wait_text("Enter captures", 10);
+    assert!(!s.contains("stays open until"), "{s}");
     let mut c = c.restart(80, 24, &[]);
     c.wait_text("zulu", 10);
     c.press(SURVEY, Action::Survey(SurveyAction::Enter));

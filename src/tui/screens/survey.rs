@@ -293,6 +293,23 @@ fn step_lines(app: &App) -> Vec<Line<'static>> {
             Line::styled("Open only to look: nothing will be saved.", t.warn()),
             Line::from(keys),
         ]
+    } else if let Some(v) = app
+        .session
+        .view
+        .as_ref()
+        .filter(|_| app.screens.survey.picking)
+    {
+        // The list of sessions is open beside this one: Enter opens the
+        // session chosen there, not this one's next capture.
+        vec![
+            Line::raw(format!("Session {} stays open until another is.", v.name)),
+            Line::from(vec![
+                key("↑↓ Enter"),
+                Span::raw(" opens a session · "),
+                key("Esc"),
+                Span::raw(" goes back"),
+            ]),
+        ]
     } else if app.session.view.is_some() && sel != w.k && !app.screens.survey.picking {
         vec![
             Line::raw(format!("Image {sel} chosen in the checklist.")),
