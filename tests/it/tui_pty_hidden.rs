@@ -214,9 +214,17 @@ fn sessions_are_listed_most_recent_first_and_the_open_one_marked() {
         "{s}"
     );
     assert!(!w.contains("Enter captures"), "{s}");
+    // A key for the hidden image does nothing to it, and says why.
+    c.press(SURVEY, Action::Survey(SurveyAction::Camera));
+    wait_words(
+        &c,
+        "the session list is open: Esc goes back to the checklist first",
+        10,
+    );
     c.send("\x1b");
     let s = c.wait_text("Enter captures", 10);
     assert!(!s.contains("stays open until"), "{s}");
+    assert!(s.contains("Image 2: camera 2 (c)"), "{s}");
     let mut c = c.restart(80, 24, &[]);
     c.wait_text("zulu", 10);
     c.press(SURVEY, Action::Survey(SurveyAction::Enter));

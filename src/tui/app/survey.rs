@@ -70,6 +70,19 @@ impl SurveyScreen {
 
     pub fn update(&mut self, a: SurveyAction, ctx: &mut Ctx) -> Vec<Cmd> {
         let listing = self.picking || ctx.session.view.is_none();
+        let on_the_image = matches!(
+            a,
+            SurveyAction::Accept
+                | SurveyAction::Redo
+                | SurveyAction::Camera
+                | SurveyAction::Location
+        );
+        if self.picking && on_the_image {
+            // The checklist is hidden behind the list: a key that changes an
+            // image there would change what the operator cannot see.
+            ctx.warn("the session list is open: Esc goes back to the checklist first");
+            return Vec::new();
+        }
         match a {
             SurveyAction::NewSession => {
                 ctx.chrome.modal = Some(Modal::prompt(
