@@ -183,42 +183,13 @@ fn too_few_views_and_no_plate_are_refused_at_80_by_24() {
 /// arrows, not a blot.
 #[test]
 fn a_camera_calibrated_from_a_folder_of_photographs_at_80_by_24() {
-    let photos = super::calib_real::photo_paths();
-    let mut c = Console::start_with(PROFILE, 80, 24, &[], |dir| {
-        for cam in 1..=2 {
-            let mut cdf = vss::rig::sim::camera_cdf(cam, 512, 512).unwrap();
-            // The phone camera's square pixels, 1 µm as stated.
-            cdf.set(vss::formats::cdf::CdfParam {
-                name: "S".into(),
-                status: Status::Stated,
-                rows: vec![vec![0.001], vec![0.001]],
-            });
-            write_cdf(&dir.join(format!("cam{cam}.cdf")), &cdf).unwrap();
-        }
-        std::fs::create_dir(dir.join("photos")).unwrap();
-        for p in &photos[..12] {
-            std::fs::copy(p, dir.join("photos").join(p.file_name().unwrap())).unwrap();
-        }
-        std::fs::write(dir.join("board.toml"), super::calib_real::BOARD).unwrap();
-    });
+    let mut c = phone_cell(true);
     let dir = c.dir.path().to_path_buf();
     let before = std::fs::read(dir.join("cam1.cdf")).unwrap();
     c.wait_text("Survey", 10);
     let t0 = std::time::Instant::now();
-    c.press(
-        Scope::Global,
-        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
-    );
-    c.wait_text("views kept: 0", 10);
+    load_photos(&mut c);
     let cb = Scope::Screen(ScreenId::Calibrate);
-    c.press(cb, Action::Calibrate(CA::PlateFile));
-    c.wait_text("plate:", 10);
-    c.send("board.toml\r");
-    c.wait_text("plate board.toml", 10);
-    c.press(cb, Action::Calibrate(CA::Open));
-    c.wait_text("photographs to load:", 10);
-    c.send("photos\r");
-    c.wait_text("views kept: 12", 60);
     c.wait_text("photo 1/12: 48 corners, kept", 10);
     // Step to the third, drop it, keep it again.
     c.press(cb, Action::Calibrate(CA::Next));
@@ -275,18 +246,7 @@ fn a_camera_calibrated_from_a_folder_of_photographs_at_80_by_24() {
 /// written has `S` calibrated with the ratio the views fit, at 80 × 24.
 #[test]
 fn a_scale_the_views_do_not_fit_is_estimated_with_e() {
-    let photos = super::calib_real::photo_paths();
-    let mut c = Console::start_with(PROFILE, 80, 24, &[], |dir| {
-        for cam in 1..=2 {
-            let cdf = vss::rig::sim::camera_cdf(cam, 512, 512).unwrap();
-            write_cdf(&dir.join(format!("cam{cam}.cdf")), &cdf).unwrap();
-        }
-        std::fs::create_dir(dir.join("photos")).unwrap();
-        for p in &photos[..12] {
-            std::fs::copy(p, dir.join("photos").join(p.file_name().unwrap())).unwrap();
-        }
-        std::fs::write(dir.join("board.toml"), super::calib_real::BOARD).unwrap();
-    });
+    let mut c = phone_cell(false);
     let dir = c.dir.path().to_path_buf();
     let stated = read_cdf(&dir.join("cam1.cdf"))
         .unwrap()
@@ -294,21 +254,9 @@ fn a_scale_the_views_do_not_fit_is_estimated_with_e() {
         .unwrap();
     assert!((stated.sy / stated.sx - 1.0).abs() > 0.2, "{stated:?}");
     c.wait_text("Survey", 10);
-    c.press(
-        Scope::Global,
-        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
-    );
-    c.wait_text("views kept: 0", 10);
+    load_photos(&mut c);
     let cb = Scope::Screen(ScreenId::Calibrate);
     c.wait_text("scale S: as the .cdf states (e)", 10);
-    c.press(cb, Action::Calibrate(CA::PlateFile));
-    c.wait_text("plate:", 10);
-    c.send("board.toml\r");
-    c.wait_text("plate board.toml", 10);
-    c.press(cb, Action::Calibrate(CA::Open));
-    c.wait_text("photographs to load:", 10);
-    c.send("photos\r");
-    c.wait_text("views kept: 12", 60);
     c.press(cb, Action::Calibrate(CA::Solve));
     c.wait_words(
         "the corners do not fit one camera with the stated scale S",
@@ -340,4 +288,49 @@ fn a_scale_the_views_do_not_fit_is_estimated_with_e() {
     assert!((m.f / m.sx - 706.2).abs() / 706.2 < 0.005, "{m:?}");
     c.send("q");
     c.wait_exit(10);
+}
+
+/// The test cell with twelve of the real checkerboard photographs in
+/// `photos/` and their board in `board.toml`; each camera's `.cdf` is the
+/// simulated one's, with the phone's square 1 µm pixels as `S` when
+/// `square_pixels`.
+fn phone_cell(square_pixels: bool) -> Console {
+    let photos = super::calib_real::photo_paths();
+    Console::start_with(PROFILE, 80, 24, &[], |dir| {
+        for cam in 1..=2 {
+            let mut cdf = vss::rig::sim::camera_cdf(cam, 512, 512).unwrap();
+            if square_pixels {
+                cdf.set(vss::formats::cdf::CdfParam {
+                    name: "S".into(),
+                    status: Status::Stated,
+                    rows: vec![vec![0.001], vec![0.001]],
+                });
+            }
+            write_cdf(&dir.join(format!("cam{cam}.cdf")), &cdf).unwrap();
+        }
+        std::fs::create_dir(dir.join("photos")).unwrap();
+        for p in &photos[..12] {
+            std::fs::copy(p, dir.join("photos").join(p.file_name().unwrap())).unwrap();
+        }
+        std::fs::write(dir.join("board.toml"), super::calib_real::BOARD).unwrap();
+    })
+}
+
+/// On the Calibrate screen: `f` chooses `board.toml`, `o` loads `photos`,
+/// and the grid is kept in all twelve.
+fn load_photos(c: &mut Console) {
+    c.press(
+        Scope::Global,
+        Action::Global(GlobalAction::GoTo(ScreenId::Calibrate)),
+    );
+    c.wait_text("views kept: 0", 10);
+    let cb = Scope::Screen(ScreenId::Calibrate);
+    c.press(cb, Action::Calibrate(CA::PlateFile));
+    c.wait_text("plate:", 10);
+    c.send("board.toml\r");
+    c.wait_text("plate board.toml", 10);
+    c.press(cb, Action::Calibrate(CA::Open));
+    c.wait_text("photographs to load:", 10);
+    c.send("photos\r");
+    c.wait_text("views kept: 12", 60);
 }
