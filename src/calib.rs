@@ -103,10 +103,9 @@ pub enum CalibError {
 /// pinhole's `f` from `sx` and from `sy` disagree), is tried once more with
 /// `sy` estimated: when that fits better with another ratio, the refusal
 /// says the scale is the cause ([`CalibError::ScaleMismatch`]), not a
-/// misread grid or plate file. (With too few views a wrong `S` can still
-/// converge, to a centre outside the image and a residual of pixels: twelve
-/// phone photographs with a ratio of 0.70 gave `C` at y 775 of 480 and
-/// RMS 1.8 px, where `sy` estimated fits them to 0.3 px.)
+/// misread grid or plate file. (With few views a wrong `S` can still
+/// converge, to a centre far outside the image and a residual of pixels;
+/// the case is in docs/calibration.md.)
 pub fn calibrate(views: &[View], o: &Options) -> Result<Calibration, CalibError> {
     let stated_fit = solve::calibrate(views, o);
     let retry = !o.estimate_scale
