@@ -142,6 +142,21 @@ pub enum SurveyAction {
     ResetParams,
 }
 
+impl SurveyAction {
+    /// Whether the key acts on an image of the checklist (accept, capture
+    /// again, its camera, its location): it has nothing to act on where no
+    /// checklist is shown.
+    pub fn on_the_image(self) -> bool {
+        matches!(
+            self,
+            SurveyAction::Accept
+                | SurveyAction::Redo
+                | SurveyAction::Camera
+                | SurveyAction::Location
+        )
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CaptureAction {
     ToggleLive,

@@ -214,7 +214,12 @@ fn sessions_are_listed_most_recent_first_and_the_open_one_marked() {
         "{s}"
     );
     assert!(!w.contains("Enter captures"), "{s}");
-    // A key for the hidden image does nothing to it, and says why.
+    // The key bar offers no key for the hidden image.
+    let bar = s.lines().rev().take(2).collect::<Vec<_>>().join(" ");
+    for hint in ["a accept", "R redo", "c camera", "p place"] {
+        assert!(!bar.contains(hint), "{hint}: {s}");
+    }
+    // Its key does nothing to it, and says why.
     c.press(SURVEY, Action::Survey(SurveyAction::Camera));
     wait_words(
         &c,

@@ -70,14 +70,7 @@ impl SurveyScreen {
 
     pub fn update(&mut self, a: SurveyAction, ctx: &mut Ctx) -> Vec<Cmd> {
         let listing = self.picking || ctx.session.view.is_none();
-        let on_the_image = matches!(
-            a,
-            SurveyAction::Accept
-                | SurveyAction::Redo
-                | SurveyAction::Camera
-                | SurveyAction::Location
-        );
-        if self.picking && on_the_image {
+        if self.picking && a.on_the_image() {
             // The checklist is hidden behind the list: a key that changes an
             // image there would change what the operator cannot see.
             ctx.warn("the session list is open: Esc goes back to the checklist first");

@@ -290,25 +290,24 @@ fn key_hints_of(app: &App, scope: Scope) -> Vec<Span<'static>> {
     } else {
         Vec::new()
     };
-    // Not offered: keys a search on takes, the image keys before a
-    // session is open (there is no image to accept or capture again), and
-    // what a session open only to look refuses (`App::refused_here`).
+    // Not offered: keys a search on takes, the image keys where no
+    // checklist is shown (before a session is open there is no image, and
+    // while the session list hides it they are refused), `D` before a
+    // session is open, and what a session open only to look refuses
+    // (`App::refused_here`).
     let keep = |b: &keymap::Binding| {
         let taken = searching
             && keymap::KEYMAP
                 .iter()
                 .any(|s| s.scope == Scope::Search && s.key == b.key);
-        let no_image = app.session.view.is_none()
-            && matches!(
-                b.action,
-                Action::Survey(
-                    SurveyAction::Accept
-                        | SurveyAction::Redo
-                        | SurveyAction::Camera
-                        | SurveyAction::Location
-                        | SurveyAction::ResetParams
-                )
-            );
+        let no_session = app.session.view.is_none();
+        let no_image = match b.action {
+            Action::Survey(s) => {
+                (s.on_the_image() && (no_session || app.screens.survey.picking))
+                    || (s == SurveyAction::ResetParams && no_session)
+            }
+            _ => false,
+        };
         // A question's "all" and "read-only" where it offers them.
         let unoffered = match (b.action, &app.chrome.modal) {
             (Action::Modal(m), Some(modal)) => !modal.offers(m),
