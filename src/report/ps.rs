@@ -16,8 +16,10 @@ use crate::llv::{EdgePoints, GreyImage, Segment};
 
 /// Images per grey-image page, as in `img2ps`.
 pub const IMAGES_PER_PAGE: usize = 6;
-/// Text lines in the notes area under a line page.
-const NOTES_ON_LINE_PAGE: usize = 28;
+/// Text lines in the notes area under a line page: an image's header lines,
+/// every LLV parameter and a few edits, so that a report takes two pages an
+/// image (its text is made smaller where a page is too small to hold them).
+const NOTES_ON_LINE_PAGE: usize = 40;
 /// Text lines on a page of its own.
 const NOTES_PER_PAGE: usize = 60;
 
@@ -42,8 +44,11 @@ vssdict begin
 /frame { newpath 0 0 moveto 1 0 lineto 1 1 lineto 0 1 lineto closepath } def
 /caption { /Helvetica findfont 9 scalefont setfont px0 py0 11 sub moveto show } def
 /title { /Helvetica-Bold findfont 12 scalefont setfont llx m add ury m sub 10 sub moveto show } def
-/textcell { cellbox /ty cy0 ch add 10 sub def /Courier findfont 8 scalefont setfont } def
-/t { cx0 4 add ty moveto show /ty ty 9.5 sub def } def
+/textcell { cellbox /tmax exch 1 max def /tn exch 1 max def
+  /step ch 10 sub tn div 9.5 min def
+  /fs step 8 mul 9.5 div cw 8 sub tmax 0.6 mul div min def
+  /ty cy0 ch add 10 sub def /Courier findfont fs scalefont setfont } def
+/t { cx0 4 add ty moveto show /ty ty step sub def } def
 end
 "#;
 
@@ -428,7 +433,19 @@ pub(super) fn text_cell(
     (col, row): (usize, usize),
     (nc, nr): (usize, usize),
 ) -> io::Result<()> {
-    writeln!(out, "{col} {row} {nc} {nr} textcell")?;
+    // The printer fits the text in its cell: the lines' count and the
+    // longest line (Courier is 0.6 em a character) set the size, at most
+    // 8 pt on 9.5 pt lines.
+    let longest = text
+        .iter()
+        .map(|l| printable(l).chars().count())
+        .max()
+        .unwrap_or(0);
+    writeln!(
+        out,
+        "{} {longest} {col} {row} {nc} {nr} textcell",
+        text.len()
+    )?;
     for line in text {
         writeln!(out, "{} t", ps_string(line))?;
     }

@@ -171,17 +171,17 @@ fn session_report_has_every_image() {
         }
     }
     let text = std::fs::read_to_string(dir.path().join("all.ps")).unwrap();
-    // Per image: its grey page, its line page, and the notes' continuation
-    // (the parameter list outgrew the line page's notes area when the edge
-    // and line stages gained four parameters, issue 31).
+    // Per image: its grey page and its line page, with the notes (every
+    // parameter) under the lines, not a page of their own.
     let pages = text
         .lines()
         .find_map(|l| l.strip_prefix("%%Pages: "))
         .unwrap_or("none");
-    assert_eq!(pages, "6", "three pages per image");
+    assert_eq!(pages, "4", "two pages per image");
+    assert!(!text.contains("notes (continued)"), "no page for the notes");
     assert!(text.contains("edges.half_width = 3"), "parameters printed");
     gs::require_gs();
-    assert_eq!(gs::render(&dir.path().join("all.ps"), "a4", 36).len(), 6);
+    assert_eq!(gs::render(&dir.path().join("all.ps"), "a4", 36).len(), 4);
     let cube = std::fs::read_to_string(dir.path().join("cube.ps")).unwrap();
     let declared = cube
         .lines()

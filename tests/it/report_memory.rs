@@ -185,10 +185,10 @@ fn a_survey_report_holds_one_image_at_a_time() {
     );
     assert_ok(&o, "report of the survey");
     // Per image: two pages of five greys and two edge images, one of
-    // lines and notes, one of notes continued.
+    // lines and notes.
     let ps = root.join("all.ps");
-    assert_eq!(declared_pages(&ps), (Some(20), true));
-    assert_eq!(pages_in(&ps), 20);
+    assert_eq!(declared_pages(&ps), (Some(15), true));
+    assert_eq!(pages_in(&ps), 15);
     for k in 1..=5 {
         assert!(root.join(format!("all{k}.svg")).is_file(), "all{k}.svg");
     }

@@ -168,3 +168,47 @@ fn survey_report_renders_every_page() {
         );
     }
 }
+
+/// An image's notes (its header lines and every parameter) print under its
+/// lines on the same page, inside the page's margins on any paper: the
+/// printer sizes the text to its cell. They used to spill five lines onto a
+/// page of their own, and on a small page to run past its edges.
+#[test]
+fn an_image_s_notes_fit_under_its_lines_on_any_paper() {
+    gs::require_gs();
+    let dir = tempfile::tempdir().unwrap();
+    let r = ImageReport {
+        title: "deck1".into(),
+        width: 64,
+        height: 48,
+        greys: Vec::new(),
+        edges_h: None,
+        edges_v: None,
+        lines_raw: Some(vec![seg(16.0, 4.0, 16.0, 44.0)]),
+        lines: Some(vec![seg(16.0, 4.0, 16.0, 44.0)]),
+        notes: (0..36)
+            .map(|i| format!("note {i:2}: {}", "counts and parameters ".repeat(5)))
+            .collect(),
+        problems: Vec::new(),
+    };
+    let text = ps::survey_report("deck", &[r]);
+    assert!(text.contains("%%Pages: 1\n"), "{}", &text[..300]);
+    let path = dir.path().join("deck.ps");
+    std::fs::write(&path, &text).unwrap();
+    // At 72 dpi a device pixel is a point; the page's margin is 36 pt.
+    for paper in ["a4", "letter", "a5"] {
+        let pages = gs::render(&path, paper, 72);
+        assert_eq!(pages.len(), 1, "{paper}");
+        let p = &pages[0];
+        let (w, h) = (p.width(), p.height());
+        let ink = |x0: u32, x1: u32, y0: u32, y1: u32| {
+            (y0..y1).any(|y| (x0..x1).any(|x| gs::dark(p, x, y)))
+        };
+        assert!(!ink(0, w, h - 30, h), "{paper}: text below the margin");
+        assert!(!ink(w - 30, w, 0, h), "{paper}: text past the right margin");
+        // The last note is printed just above the bottom margin, and the
+        // longest ones reach across most of the width.
+        assert!(ink(0, w, h - 90, h - 36), "{paper}: the last note");
+        assert!(ink(w * 2 / 3, w - 36, h / 2, h - 36), "{paper}: long notes");
+    }
+}
