@@ -229,7 +229,10 @@ impl Plate {
             line: span.map_or(0, |s| line_of(text, s.start)),
             message,
         };
-        let f: PlateFile = toml::from_str(text).map_err(|e| err(e.span(), e.message().into()))?;
+        let f: PlateFile = toml::from_str(text).map_err(|e| {
+            let in_place = e.span().is_some_and(|s| s.start > 0);
+            err(e.span(), explain_missing(e.message(), in_place))
+        })?;
         let kind = *f.kind.get_ref();
         for (what, v) in [("rows", &f.rows), ("columns", &f.columns)] {
             let min = if kind == PlateKind::Checkerboard {
@@ -470,6 +473,31 @@ type Span = std::ops::Range<usize>;
 
 /// 1-based line of a byte offset (the profile's loader has its own, private
 /// to it).
+/// A parser's "missing field `x`" said as what the field is and the values
+/// it takes (`in_place`: of the `[place]` table); other messages as they are.
+fn explain_missing(message: &str, in_place: bool) -> String {
+    let Some(field) = message
+        .strip_prefix("missing field `")
+        .and_then(|m| m.strip_suffix('`'))
+    else {
+        return message.to_string();
+    };
+    let what = match (field, in_place) {
+        ("kind", _) => "\"squares\" (dark squares apart) or \"checkerboard\"",
+        ("rows", _) => "the number of squares from top to bottom",
+        ("columns", _) => "the number of squares from left to right",
+        ("square", _) => "the side of a square in mm",
+        ("origin", false) => {
+            "the corner plate coordinates start from, seen from the printed side: \"top-left\", \"top-right\", \"bottom-left\" or \"bottom-right\""
+        }
+        ("origin", true) => "where the plate's origin is in the cell, [x, y, z] in mm",
+        ("x_axis" | "y_axis", _) => "the plate's axis as a direction in the cell, [x, y, z]",
+        _ => return message.to_string(),
+    };
+    let table = if in_place { "[place] " } else { "" };
+    format!("{table}needs `{field}`: {what}")
+}
+
 fn line_of(text: &str, pos: usize) -> usize {
     text.get(..pos.min(text.len()))
         .map_or(0, |t| t.matches('\n').count())
@@ -582,6 +610,16 @@ origin_mark = true
                 "top-left",
             ),
             (format!("{SQUARES}colour = 1\n"), 9, "colour"),
+            (
+                SQUARES.replace("origin = \"top-left\"\n", ""),
+                1,
+                "needs `origin`: the corner plate coordinates start from, seen from the printed side: \"top-left\"",
+            ),
+            (
+                format!("{SQUARES}[place]\norigin = [0.0, 0.0, 0.0]\nx_axis = [1.0, 0.0, 0.0]\n"),
+                9,
+                "[place] needs `y_axis`: the plate's axis as a direction in the cell",
+            ),
             (
                 format!(
                     "{SQUARES}[place]\norigin = [0.0, 0.0, 0.0]\nx_axis = [1.0, 0.0, 0.0]\ny_axis = [0.1, 1.0, 0.0]\n"
