@@ -80,7 +80,7 @@ fn lines_report(ldr: &Path, a: &Args) -> anyhow::Result<ExitCode> {
     let lines = formats::lines::read_lines(ldr)?;
     let (w, h) = match &a.size {
         Some(s) => parse_size(s)?,
-        None => guess_size(ldr, &lines),
+        None => guess_size(ldr, &lines)?,
     };
     let caption = ldr.file_name().map_or_else(
         || crate::text::path(ldr),
@@ -112,21 +112,34 @@ fn parse_size(s: &str) -> anyhow::Result<(usize, usize)> {
     }
 }
 
-/// The picture size of a line file: a grey image of the same VSS name beside
-/// it (`test1.ldr` → `test1a.img` or `test1.img`), else 512 × 512 grown to
-/// the lines' extent.
-fn guess_size(ldr: &Path, lines: &[crate::llv::Segment]) -> (usize, usize) {
+/// The picture size of a line file: a grey image of the same name beside it
+/// in any format vss reads (`test1.ldr` → `test1.img`, `test1a.img`, …,
+/// `test1.png`, `photo.ldr` → `photo.jpg`, as `vss llv` names its outputs;
+/// a JPEG's size after its EXIF orientation, as `vss llv` drew the lines),
+/// else 512 × 512 grown to the lines' extent. Says which.
+fn guess_size(ldr: &Path, lines: &[crate::llv::Segment]) -> anyhow::Result<(usize, usize)> {
+    const EXTENSIONS: [&str; 9] = [
+        "img", "imc", "png", "pgm", "tif", "tiff", "bmp", "jpg", "jpeg",
+    ];
     let stem = ldr
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     let dir = ldr.parent().unwrap_or(Path::new("."));
-    let candidates = std::iter::once(format!("{stem}.img"))
-        .chain(('a'..='z').map(|l| format!("{stem}{l}.img")))
-        .chain(std::iter::once(format!("{stem}.imc")));
-    for c in candidates {
-        if let Ok(h) = formats::img::read_header(&dir.join(c)) {
-            return (usize::from(h.width).max(1), usize::from(h.height).max(1));
+    let names = std::iter::once(stem.clone()).chain(('a'..='z').map(|l| format!("{stem}{l}")));
+    for name in names {
+        for ext in EXTENSIONS {
+            let p = dir.join(format!("{name}.{ext}"));
+            if !p.is_file() {
+                continue;
+            }
+            if let Ok((f, _)) =
+                formats::imageio::read_any_sized(&p, crate::report::check_picture_size)
+            {
+                let (w, h) = f.image.size();
+                outln!("picture {w} × {h}, the size of {}", crate::text::path(&p));
+                return Ok((w.max(1), h.max(1)));
+            }
         }
     }
     let (mut w, mut h) = (512.0f64, 512.0f64);
@@ -134,7 +147,12 @@ fn guess_size(ldr: &Path, lines: &[crate::llv::Segment]) -> (usize, usize) {
         w = w.max(max.x.ceil() + 1.0);
         h = h.max(max.y.ceil() + 1.0);
     }
-    (w.min(65535.0) as usize, h.min(65535.0) as usize)
+    let (w, h) = (w.min(65535.0) as usize, h.min(65535.0) as usize);
+    outln!(
+        "picture {w} × {h}: no grey image named {stem}.* beside it, so 512 × 512 grown to hold \
+         every line (--size WxH gives it)"
+    );
+    Ok((w, h))
 }
 
 fn grey_report(a: &Args) -> anyhow::Result<ExitCode> {

@@ -140,6 +140,18 @@ fn an_exif_rotation_is_applied_and_said() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(err.contains("EXIF orientation"), "{err}");
+    // Its lines print on a picture the photograph's size as shown, found
+    // beside them: `vss report --ldr r.ldr` (it was 512 × 512).
+    let o = vss()
+        .args(["report", "--ldr", "r.ldr", "--svg", "r.svg"])
+        .current_dir(d.path())
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("picture 64 × 96, the size of r.jpg"), "{out}");
+    let svg = std::fs::read_to_string(d.path().join("r.svg")).unwrap();
+    assert!(svg.contains(r#"width="64" height="96""#), "{svg}");
 }
 
 #[test]
