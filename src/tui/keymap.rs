@@ -162,10 +162,14 @@ pub enum CaptureAction {
     ToggleLive,
     Grab,
     Camera,
+    /// The row above / below in the lights panel: the lights, then the
+    /// lighting configurations.
     LightPrev,
     LightNext,
+    /// The chosen light switched, or the chosen lighting configuration set.
     LightToggle,
     LightsOff,
+    /// The profile's `i`-th lighting configuration (Shift+A to F).
     Lighting(u8),
     Cancel,
     /// A GenICam camera's exposure time × 1.25 / ÷ 1.25.
@@ -466,6 +470,14 @@ pub fn lookup(scope: Scope, ev: &KeyEvent) -> Option<Action> {
             .or_else(|| find(Scope::Global, ev)),
         _ => find(scope, ev),
     }
+}
+
+/// The label of the first key bound to `action` in `scope`, if any.
+pub fn key_label(scope: Scope, action: Action) -> Option<String> {
+    KEYMAP
+        .iter()
+        .find(|b| b.scope == scope && b.action == action)
+        .map(|b| b.key.label())
 }
 
 /// The rows of a scope, with the keys of one action joined: `+ = →`.

@@ -3,9 +3,12 @@
 //! opens without a restart; keys typed while the terminal is too small
 //! do nothing unseen, and Esc there says to enlarge it; a frame changed
 //! since recorded is said on the Session screen; going to an image with
-//! nothing captured says what Enter does.
+//! nothing captured says what Enter does; every lighting of a profile
+//! with more of them than Shift keys is set from the Capture screen.
 
 use super::tui_harness::{Console, flat};
+use crate::support::fixtures::five_lightings;
+use vss::tui::keymap::{Action, CaptureAction, Scope, ScreenId};
 
 /// A session whose manifest does not read is listed as damaged; the
 /// error says to mend it "then open it again", and once mended (while
@@ -169,4 +172,64 @@ fn going_to_an_image_with_nothing_captured_says_what_enter_does() {
     c.wait_words("image 2: nothing captured yet — Enter captures it", 10);
     c.send("q");
     c.wait_exit(10);
+}
+
+/// A cell with more lighting configurations than the key table has Shift
+/// keys (eight; Shift+A to F): at 80 × 24 the Capture screen's panel lists
+/// what fits around the chosen row, and ↑↓ Space set any lighting, here h
+/// (relays 0 and 3 through the simulated board). Before, g and h had no
+/// key and their rows ran off the panel.
+#[test]
+fn every_lighting_of_a_profile_is_set_from_the_capture_screen() {
+    let profile = format!(
+        "name = \"eight lightings\"\n{}{}",
+        five_lightings!(),
+        r#"
+[[lighting]]
+letter = "f"
+on = ["lf", "rf"]
+[[lighting]]
+letter = "g"
+on = ["lb", "rb"]
+[[lighting]]
+letter = "h"
+on = ["lf", "rb"]
+
+[relay]
+settle_ms = 5
+
+[survey]
+dir = "sessions"
+cameras = 2
+
+[sim]
+width = 128
+height = 128
+
+[llv.lens]
+enabled = false
+"#
+    );
+    let mut c = Console::start_with(&profile, 80, 24, &[], |_| {});
+    c.wait_text("n new", 20);
+    c.send("2");
+    let s = c.wait_text("lightings (Space", 5);
+    assert!(s.contains("↓ 2 more"), "the rows that do not fit:\n{s}");
+    let capture = Scope::Screen(ScreenId::Capture);
+    // Four lights, then the eighth lighting.
+    for _ in 0..11 {
+        c.press(capture, Action::Capture(CaptureAction::LightNext));
+    }
+    c.wait_text("↑ 2 more", 5);
+    c.press(capture, Action::Capture(CaptureAction::LightToggle));
+    c.wait_text("lighting h", 10);
+    let s = c.wait("the board's relays 0 and 3", 10, |s| {
+        s.contains("mask 0x0009")
+    });
+    assert!(
+        s.contains(" h lf+rb  <") && s.contains(" g lb+rb") && s.contains("[x] rb"),
+        "lighting h set and marked:\n{s}"
+    );
+    c.send("q");
+    assert_eq!(c.wait_exit(10), 0);
 }

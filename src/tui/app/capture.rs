@@ -8,7 +8,9 @@ use crate::tui::keymap::CaptureAction;
 /// The Capture screen's own state.
 #[derive(Clone, Debug)]
 pub struct CaptureScreen {
-    /// The highlighted light.
+    /// The highlighted row of the lights panel: a light (`0..lights`), then
+    /// a lighting configuration, so that every one of a profile's lightings
+    /// can be set, not only the six with a Shift key.
     pub light: usize,
     pub camera: u32,
     pub nav: PreviewNav,
@@ -35,14 +37,14 @@ impl CaptureScreen {
                 Vec::new()
             }
             CaptureAction::LightNext => {
-                if self.light + 1 < ctx.cell.lights.len() {
+                if self.light + 1 < ctx.cell.lights.len() + ctx.cell.letters.len() {
                     self.light += 1;
                 }
                 Vec::new()
             }
             CaptureAction::LightToggle => {
                 let Some((name, relay)) = ctx.cell.lights.get(self.light).cloned() else {
-                    return Vec::new();
+                    return lighting(ctx, self.light - ctx.cell.lights.len().min(self.light));
                 };
                 let on = !ctx.cell.device.lights_on.contains(&name);
                 ctx.info(format!("light {name} {}", if on { "on" } else { "off" }));
@@ -52,19 +54,7 @@ impl CaptureScreen {
                 ctx.info("all lights off");
                 vec![Cmd::Device(DeviceCmd::AllOff)]
             }
-            CaptureAction::Lighting(i) => match ctx.cell.letters.get(i as usize) {
-                Some(&l) => {
-                    ctx.info(format!("lighting {l}"));
-                    vec![Cmd::Device(DeviceCmd::Lighting(l))]
-                }
-                None => {
-                    ctx.warn(format!(
-                        "the profile has no lighting configuration {}",
-                        (b'a' + i) as char
-                    ));
-                    Vec::new()
-                }
-            },
+            CaptureAction::Lighting(i) => lighting(ctx, usize::from(i)),
             CaptureAction::Cancel => super::App::cancel_transfer(ctx),
             CaptureAction::ExposureUp | CaptureAction::ExposureDown => {
                 let factor = if a == CaptureAction::ExposureUp {
@@ -88,6 +78,23 @@ impl CaptureScreen {
                     db,
                 })]
             }
+        }
+    }
+}
+
+/// Sets the profile's `i`-th lighting configuration.
+fn lighting(ctx: &mut Ctx, i: usize) -> Vec<Cmd> {
+    match ctx.cell.letters.get(i) {
+        Some(&l) => {
+            ctx.info(format!("lighting {l}"));
+            vec![Cmd::Device(DeviceCmd::Lighting(l))]
+        }
+        None => {
+            ctx.warn(format!(
+                "the profile has no lighting configuration {}",
+                char::from_u32('a' as u32 + i as u32).unwrap_or('?')
+            ));
+            Vec::new()
         }
     }
 }

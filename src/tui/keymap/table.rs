@@ -149,9 +149,9 @@ pub const KEYMAP: &[Binding] = rows! {
     CA, ch('v'), Capture(ToggleLive), "live view on/off", "live";
     CA, ch('g'), Capture(Grab), "grab one frame", "grab";
     CA, ch('c'), Capture(Camera), "next camera", "camera";
-    CA, k(K::Up), Capture(LightPrev), "choose the light above", "";
-    CA, k(K::Down), Capture(LightNext), "choose the light below", "";
-    CA, ch(' '), Capture(LightToggle), "switch the chosen light", "light";
+    CA, k(K::Up), Capture(LightPrev), "choose the light or lighting above", "";
+    CA, k(K::Down), Capture(LightNext), "choose the light or lighting below", "";
+    CA, ch(' '), Capture(LightToggle), "switch the chosen light, or to the chosen lighting", "switch";
     CA, ch('0'), Capture(LightsOff), "all lights off", "off";
     CA, ch('A'), Capture(Lighting(0)), "lighting configuration a", "";
     CA, ch('B'), Capture(Lighting(1)), "lighting configuration b", "";
