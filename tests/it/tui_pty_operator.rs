@@ -6,8 +6,8 @@
 //! nothing captured says what Enter does; every lighting of a profile
 //! with more of them than Shift keys is set from the Capture screen.
 
-use super::tui_harness::{Console, flat};
-use crate::support::fixtures::five_lightings;
+use super::tui_harness::{Console, five_lightings, flat};
+use crate::support::fixtures;
 use vss::tui::keymap::{Action, CaptureAction, Scope, ScreenId};
 
 /// A session whose manifest does not read is listed as damaged; the
@@ -183,7 +183,7 @@ fn going_to_an_image_with_nothing_captured_says_what_enter_does() {
 fn every_lighting_of_a_profile_is_set_from_the_capture_screen() {
     let profile = format!(
         "name = \"eight lightings\"\n{}{}",
-        five_lightings!(),
+        fixtures::five_lightings!(),
         r#"
 [[lighting]]
 letter = "f"
@@ -230,6 +230,26 @@ enabled = false
         s.contains(" h lf+rb  <") && s.contains(" g lb+rb") && s.contains("[x] rb"),
         "lighting h set and marked:\n{s}"
     );
+    c.send("q");
+    assert_eq!(c.wait_exit(10), 0);
+}
+
+/// A camera description the profile names but that is not there: the
+/// start-up warning names the camera once and the file's trouble (it said
+/// "camera 1: camera 1: …").
+#[test]
+fn a_missing_camera_description_is_said_once_per_camera() {
+    let mut c = Console::start_with(&five_lightings(true), 80, 24, &[], |_| {});
+    let s = c.wait_text("lens correction OFF for camera", 20);
+    let said = flat(&s);
+    // The newest of the two cameras' warnings holds the line.
+    let k = if said.contains("for camera 1:") { 1 } else { 2 };
+    assert!(
+        said.contains(&format!("lens correction OFF for camera {k}: "))
+            && said.contains(&format!("cam{k}.cdf: cannot read")),
+        "{s}"
+    );
+    assert!(!said.contains(&format!("camera {k}: camera {k}")), "{s}");
     c.send("q");
     assert_eq!(c.wait_exit(10), 0);
 }

@@ -192,6 +192,8 @@ impl Store {
                     format!("{} {why}", self.profile.cdf_shown(*c).unwrap_or_default())
                 }),
                 Ok(None) => Err("the profile names no .cdf for it ([survey] cdf)".into()),
+                // The console names the camera itself.
+                Err(crate::profile::ProfileError::Camera { source, .. }) => Err(source.to_string()),
                 Err(e) => Err(e.to_string()),
             })
             .collect();
