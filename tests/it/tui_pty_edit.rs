@@ -180,7 +180,8 @@ fn an_extension_far_outside_the_image_asks_first() {
     // A corner where the lines nearly meet is made without a question.
     if let Some((p, q)) = near {
         edit(&mut c, EditAction::Undo);
-        wait_words(&c, "undone", 10);
+        // Said as the edit was: which lines, not only "the last edit".
+        wait_words(&c, &format!("undone: extended lines {i} ("), 10);
         edit(&mut c, EditAction::ClearSelection);
         select(&mut c, p);
         for _ in p..q {

@@ -219,10 +219,14 @@ impl EditScreen {
                         format!("redone: {what}"),
                     )
                 }
-                None => (
-                    StoreCmd::UndoEdit { k, lines },
-                    "undone: the last edit".into(),
-                ),
+                // Undone, the lines are those the edit was made on, so it
+                // is described as it was when made.
+                None => {
+                    let what = ed
+                        .next_redo()
+                        .map_or_else(|| "the last edit".into(), |op| describe(op, &lines));
+                    (StoreCmd::UndoEdit { k, lines }, format!("undone: {what}"))
+                }
             };
             ctx.info(format!("image {k}: {what}"));
             return vec![Cmd::Store(cmd)];
