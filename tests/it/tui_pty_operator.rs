@@ -4,7 +4,8 @@
 //! do nothing unseen, and Esc there says to enlarge it; a frame changed
 //! since recorded is said on the Session screen; going to an image with
 //! nothing captured says what Enter does; every lighting of a profile
-//! with more of them than Shift keys is set from the Capture screen.
+//! with more of them than Shift keys is set from the Capture screen; a
+//! camera description that is not there is named once, with its camera.
 
 use super::tui_harness::{Console, five_lightings, flat};
 use crate::support::fixtures;
