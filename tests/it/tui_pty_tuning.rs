@@ -10,14 +10,20 @@
 //! and (0, 0)": the corrected ambient image was missing from the re-run)
 //! while the panel showed the new value, and the save key wrote the old
 //! value's outputs.
+//!
+//! A tuned value survives the console: a capture cut short and resumed in
+//! a new console goes on with the values the survey's images were made
+//! with, not the profile's.
 
 use std::time::{Duration, Instant};
 
 use vss::llv::params::{Kind, PARAMS};
 use vss::session::Session;
-use vss::tui::keymap::{Action, PipelineAction};
+use vss::tui::keymap::{Action, PipelineAction, SurveyAction};
 
-use super::tui_harness::{Console, PIPELINE, five_lightings, line_count, panel_value, write_cdfs};
+use super::tui_harness::{
+    Console, PIPELINE, SURVEY, five_lightings, line_count, panel_value, write_cdfs,
+};
 
 /// The parameter values and line count of image 1's saved outputs.
 fn saved(c: &Console) -> Option<(vss::llv::Params, usize)> {
@@ -178,4 +184,65 @@ fn a_typed_value_replaces_the_old_one() {
         panel_value(s, "edges.per_region").as_deref() == Some("152")
     });
     c.send("q");
+}
+
+/// The operator tunes a parameter, captures and accepts image 1; image 2's
+/// capture is cut short (here only lighting a is on disk, as `vss grab`
+/// leaves it) and the console is started again, as after a dropped SSH
+/// connection. Resuming at image 2, the panel holds the tuned value image 1
+/// was made with, and says so: before, it went back to the profile's value,
+/// and the rest of the survey was made with other values than its start
+/// without a word.
+#[test]
+fn a_tuned_value_survives_a_capture_cut_short() {
+    let mut c = Console::start_with(&five_lightings(false), 80, 24, &[], |_| {});
+    c.create_session("cube");
+    c.send("3");
+    c.wait_text("parameters", 10);
+    c.choose_param("edges.noise_sigmas");
+    c.press(PIPELINE, Action::Pipeline(PipelineAction::Inc));
+    c.wait("edges.noise_sigmas = 2.75", 20, |s| {
+        panel_value(s, "edges.noise_sigmas").as_deref() == Some("2.75")
+    });
+    c.send("1");
+    c.capture_current(1);
+    c.press(SURVEY, Action::Survey(SurveyAction::Accept));
+    c.wait_text("Image 2: camera", 20);
+    let c = c.restart_after(|dir| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_vss"))
+            .current_dir(dir)
+            .env("XDG_STATE_HOME", dir.join("state"))
+            .args(["--profile", "cell.toml", "grab", "--camera", "2"])
+            .args([
+                "--lighting",
+                "a",
+                "--image",
+                "2",
+                "--session",
+                "sessions/cube",
+            ])
+            .stdin(std::process::Stdio::null())
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{out:?}");
+    });
+    let mut c = c;
+    c.open_cube();
+    c.wait_text("Enter captures lightings bcde", 20);
+    let s = c.wait("the panel's values", 20, |s| {
+        s.contains("not the profile's")
+    });
+    assert!(
+        s.contains("edges.noise_sigmas 2.75"),
+        "the tuned value, in the next-step box:\n{s}"
+    );
+    c.send("3");
+    let s = c.wait_text("parameters", 10);
+    assert_eq!(
+        panel_value(&s, "edges.noise_sigmas").as_deref(),
+        Some("2.75"),
+        "{s}"
+    );
+    c.send("q");
+    c.wait_exit(15);
 }

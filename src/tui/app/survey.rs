@@ -527,6 +527,7 @@ impl Ctx<'_> {
         match (resume, last) {
             (true, _) => {
                 self.info(format!("resuming at image {k}"));
+                self.resume_with_the_survey_s_values(k);
                 vec![Cmd::Store(StoreCmd::Load(k))]
             }
             (false, Some(l)) => vec![Cmd::Store(StoreCmd::Load(l))],

@@ -333,6 +333,27 @@ impl Ctx<'_> {
         true
     }
 
+    /// Resuming at image `k`, whose capture was cut short (a dropped SSH
+    /// connection) before it was run, so it has no values of its own: the
+    /// panel takes those of the survey's newest outputs, as it does when
+    /// the next image has no frames (that image is loaded), not the
+    /// profile's, so that a tuned value is not lost with the console.
+    pub fn resume_with_the_survey_s_values(&mut self, k: u32) {
+        if self.session.image(k).is_none_or(|i| i.params.is_some()) {
+            return;
+        }
+        let newest = self.session.view.as_ref().and_then(|v| {
+            v.images
+                .iter()
+                .filter(|i| i.params.is_some())
+                .map(|i| i.k)
+                .max()
+        });
+        if let Some(j) = newest {
+            self.use_recorded_params(j);
+        }
+    }
+
     /// The commands that save the outputs on screen, or `None` (said in the
     /// log, or asked first) when there is nothing to save, they were not
     /// made with the panel's values, or they would replace accepted outputs
