@@ -192,7 +192,7 @@ fn a_typed_value_replaces_the_old_one() {
 /// connection. Resuming at image 2, the panel holds the tuned value image 1
 /// was made with, and says so: before, it went back to the profile's value,
 /// and the rest of the survey was made with other values than its start
-/// without a word.
+/// without a word. The Pipeline screen says why nothing runs yet.
 #[test]
 fn a_tuned_value_survives_a_capture_cut_short() {
     let mut c = Console::start_with(&five_lightings(false), 80, 24, &[], |_| {});
@@ -243,6 +243,10 @@ fn a_tuned_value_survives_a_capture_cut_short() {
         Some("2.75"),
         "{s}"
     );
+    // Nothing runs on four missing lightings, and the view says so (it
+    // said "running…" for ever).
+    assert!(s.contains("not run: lightings bcde"), "{s}");
+    assert!(!s.contains("running…"), "{s}");
     c.send("q");
     c.wait_exit(15);
 }

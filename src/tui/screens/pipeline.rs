@@ -239,7 +239,21 @@ fn stage_view(
         // where the saves that finish after it soon take its place.
         None => Paragraph::new(match &cur.failed {
             Some(why) => format!("the last run failed: {}", crate::tui::text::clean(why)),
-            None => "running…".to_string(),
+            // A capture cut short: nothing runs until every lighting is in.
+            None => match app
+                .cell
+                .letters
+                .iter()
+                .filter(|l| cur.frame(**l).is_none())
+                .collect::<String>()
+            {
+                m if m.is_empty() => "running…".to_string(),
+                m => format!(
+                    "not run: lighting{} {m} not captured yet (Survey: Enter captures {})",
+                    if m.len() > 1 { "s" } else { "" },
+                    if m.len() > 1 { "them" } else { "it" }
+                ),
+            },
         })
         .wrap(Wrap { trim: true })
         .render(inner, buf),
