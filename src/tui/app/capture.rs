@@ -44,7 +44,7 @@ impl CaptureScreen {
             }
             CaptureAction::LightToggle => {
                 let Some((name, relay)) = ctx.cell.lights.get(self.light).cloned() else {
-                    return lighting(ctx, self.light - ctx.cell.lights.len().min(self.light));
+                    return lighting(ctx, self.light.saturating_sub(ctx.cell.lights.len()));
                 };
                 let on = !ctx.cell.device.lights_on.contains(&name);
                 ctx.info(format!("light {name} {}", if on { "on" } else { "off" }));

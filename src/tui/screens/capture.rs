@@ -1,6 +1,7 @@
 //! The Capture screen: the live picture of the selected camera, camera
-//! choice, the lights panel (each light on/off, each lighting configuration
-//! one key) and what the grabber and relay board report.
+//! choice, the lights panel (each light on/off and each lighting
+//! configuration, chosen with ↑↓ and set with Space; the first six also by
+//! Shift+letter) and what the grabber and relay board report.
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
