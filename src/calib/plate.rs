@@ -471,8 +471,6 @@ fn kind_name(k: PlateKind) -> &'static str {
 
 type Span = std::ops::Range<usize>;
 
-/// 1-based line of a byte offset (the profile's loader has its own, private
-/// to it).
 /// A parser's "missing field `x`" said as what the field is and the values
 /// it takes (`in_place`: of the `[place]` table); other messages as they are.
 fn explain_missing(message: &str, in_place: bool) -> String {
@@ -498,6 +496,8 @@ fn explain_missing(message: &str, in_place: bool) -> String {
     format!("{table}needs `{field}`: {what}")
 }
 
+/// 1-based line of a byte offset (the profile's loader has its own, private
+/// to it).
 fn line_of(text: &str, pos: usize) -> usize {
     text.get(..pos.min(text.len()))
         .map_or(0, |t| t.matches('\n').count())
