@@ -310,7 +310,7 @@ fn step_lines(app: &App) -> Vec<Line<'static>> {
                 Span::raw(" goes back"),
             ]),
         ]
-    } else if app.session.view.is_some() && sel != w.k && !app.screens.survey.picking {
+    } else if app.session.view.is_some() && sel != w.k {
         vec![
             Line::raw(format!("Image {sel} chosen in the checklist.")),
             Line::from(vec![
