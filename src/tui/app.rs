@@ -49,7 +49,7 @@ pub use pipeline::{GreySource, PipelineScreen, StageView};
 pub use readonly::READ_ONLY;
 pub use session::{Opening, Refused, SessionEntry, SessionState};
 pub use survey::{Phase, SurveyScreen, Work};
-pub use tracker::{Loaded, Tracker};
+pub use tracker::{Loaded, Tracker, lightings};
 
 /// How often the session list is read again while it is shown.
 pub const RELIST: std::time::Duration = std::time::Duration::from_secs(2);

@@ -245,7 +245,7 @@ fn a_tuned_value_survives_a_capture_cut_short() {
     );
     // Nothing runs on four missing lightings, and the view says so (it
     // said "running…" for ever).
-    assert!(s.contains("not run: lightings bcde"), "{s}");
+    assert!(s.contains("not run: lightings b, c, d and e"), "{s}");
     assert!(!s.contains("running…"), "{s}");
     c.send("q");
     c.wait_exit(15);

@@ -263,15 +263,10 @@ impl SurveyScreen {
 
 /// Lighting letters of the image under work not captured yet.
 pub fn missing_letters(cell: &CellState, work: &Work, tracker: &Tracker) -> Vec<char> {
-    let have: Vec<char> = match &tracker.current {
-        Some(c) if c.k == work.k => c.frames.iter().map(|f| f.0).collect(),
-        _ => Vec::new(),
-    };
-    cell.letters
-        .iter()
-        .copied()
-        .filter(|l| !have.contains(l))
-        .collect()
+    match &tracker.current {
+        Some(c) if c.k == work.k => c.missing(&cell.letters),
+        _ => cell.letters.clone(),
+    }
 }
 
 impl Ctx<'_> {

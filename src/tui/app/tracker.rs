@@ -125,6 +125,15 @@ impl Loaded {
         self.frames.iter().find(|f| f.0 == letter).map(|f| &f.1)
     }
 
+    /// The lightings of `letters` it has no frame of.
+    pub fn missing(&self, letters: &[char]) -> Vec<char> {
+        letters
+            .iter()
+            .copied()
+            .filter(|l| self.frame(*l).is_none())
+            .collect()
+    }
+
     /// The outputs on screen are the session's and were made with `params`
     /// (the panel's): saved (a save asked, such as Ctrl-S on the Pipeline
     /// screen, counts until it fails), so accepting saves nothing. What `a`

@@ -240,18 +240,16 @@ fn stage_view(
         None => Paragraph::new(match &cur.failed {
             Some(why) => format!("the last run failed: {}", crate::tui::text::clean(why)),
             // A capture cut short: nothing runs until every lighting is in.
-            None => match app
-                .cell
-                .letters
-                .iter()
-                .filter(|l| cur.frame(**l).is_none())
-                .collect::<String>()
-            {
+            None => match cur.missing(&app.cell.letters) {
                 m if m.is_empty() => "running…".to_string(),
                 m => format!(
-                    "not run: lighting{} {m} not captured yet (Survey: Enter captures {})",
-                    if m.len() > 1 { "s" } else { "" },
-                    if m.len() > 1 { "them" } else { "it" }
+                    "not run: {} not captured yet (Survey: {})",
+                    crate::tui::app::lightings(&m),
+                    if cur.k == app.session.work.k {
+                        "Enter captures the rest"
+                    } else {
+                        "R on its row captures again"
+                    }
                 ),
             },
         })
